@@ -27,16 +27,26 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod camera;
 mod color;
 mod error;
+mod image;
 mod light;
+pub mod limits;
 mod material;
+pub mod mesh;
+pub mod primitives;
+mod scene;
 mod shading;
 
+pub use camera::{Camera, Projection, Viewer};
 pub use color::Color;
 pub use error::Error;
+pub use image::{Encoding, Image};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names};
+pub use mesh::Mesh;
+pub use scene::{ImageSettings, Interpolation, Object, Output, Scene, ShadingSettings};
 pub use shading::{
     Lighting, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, lyon,
     pow_positive, shade, specular_factor,

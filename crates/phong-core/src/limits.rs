@@ -1,0 +1,35 @@
+//! The one place for phong's magic numbers, each with its reason
+//! (llvmpipe's `lp_limits.h` style).
+
+/// Largest image width or height in pixels. 16384 is the largest texture
+/// size GPUs guarantee (wgpu's `max_texture_dimension_2d` on most adapters)
+/// and keeps the rasteriser's fixed-point products inside `i64` with margin:
+/// with [`GUARD_BAND`] and [`SUBPIXEL_BITS`], `|X| < 2.5·16384·256 < 2^24`.
+pub const MAX_IMAGE_DIMENSION: u32 = 16384;
+
+/// Largest number of pixels in one image (times samples, see
+/// [`MAX_SAMPLES_TOTAL`]): 16384², so a full-size image fits in memory.
+pub const MAX_SAMPLES_TOTAL: u64 = 16384 * 16384 * 4;
+
+/// Samples per pixel the renderers accept.
+pub const SAMPLE_COUNTS: [u32; 3] = [1, 4, 16];
+
+/// Sub-pixel precision of snapped vertex positions: 8 bits (1/256 pixel),
+/// as D3D11 and llvmpipe.
+pub const SUBPIXEL_BITS: u32 = 8;
+
+/// Guard band, in units of the viewport's half extent: triangles are
+/// clipped against `|x|, |y| <= GUARD_BAND · w` instead of the viewport, so
+/// that almost no triangle needs clipping in x and y while screen
+/// coordinates stay bounded for the fixed-point rasteriser.
+pub const GUARD_BAND: f32 = 4.0;
+
+/// Tile size of the rasteriser, in pixels: 64 × 64 keeps one tile's colour
+/// and depth samples (64·64·16·20 bytes at 16 samples) in L2.
+pub const TILE_SIZE: u32 = 64;
+
+/// Most lights in one scene (the GPU backend's storage buffer is sized from it).
+pub const MAX_LIGHTS: usize = 1024;
+
+/// Most segments for a tessellated primitive (4096² quads is already 33M triangles).
+pub const MAX_SEGMENTS: u32 = 4096;

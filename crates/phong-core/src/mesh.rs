@@ -1,0 +1,308 @@
+//! Indexed triangle meshes and their normals (seed 001: facet normals from
+//! the cross product, vertex normals from the facet normals or from the
+//! surface's formula).
+
+use crate::Error;
+use glam::{Mat3, Mat4, Vec3};
+use std::collections::HashMap;
+
+/// An indexed triangle mesh with one normal per vertex. Triangles are
+/// counter-clockwise seen from the side their normals point to.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Mesh {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
+#[inline]
+pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
+    (p2 - p1).cross(p3 - p1).normalize_or_zero()
+}
+
+impl Mesh {
+    /// A mesh from positions, per-vertex normals (same length) and triangles;
+    /// every index must be in range and every position finite.
+    pub fn new(positions: Vec<Vec3>, normals: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, Error> {
+        if normals.len() != positions.len() {
+            return Err(Error::OutOfRange {
+                what: "number of normals",
+                range: "equal to the number of positions",
+                value: normals.len() as f32,
+            });
+        }
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(Error::InvalidPosition {
+                what: "mesh vertex",
+                value: p.to_array(),
+            });
+        }
+        let n = positions.len() as u64;
+        if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| u64::from(i) >= n)) {
+            return Err(Error::OutOfRange {
+                what: "triangle vertex index",
+                range: "less than the number of vertices",
+                value: t.iter().copied().max().unwrap_or(0) as f32,
+            });
+        }
+        Ok(Mesh {
+            positions,
+            normals,
+            triangles,
+        })
+    }
+
+    /// A mesh whose normals are then computed: area-weighted smooth normals over shared vertices.
+    pub fn from_triangles(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, Error> {
+        let normals = vec![Vec3::ZERO; positions.len()];
+        Ok(Mesh::new(positions, normals, triangles)?.with_smooth_normals())
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+    /// Vertex normals (unit, or zero where undefined).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+    /// Triangles as vertex indices.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+    /// The three corners of triangle `t`.
+    pub fn corners(&self, t: usize) -> [Vec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// Appends `other`'s vertices and triangles.
+    pub fn append(&mut self, other: &Mesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+
+    /// Axis-aligned bounds `(min, max)`, `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let first = *self.positions.first()?;
+        Some(
+            self.positions
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+        )
+    }
+
+    /// The mesh in another space: positions by `m`, normals by the inverse
+    /// transpose of its upper 3×3, renormalised; a mirroring `m` (negative
+    /// determinant) reverses the triangles so they stay counter-clockwise.
+    pub fn transformed(&self, m: &Mat4) -> Mesh {
+        let nm = Mat3::from_mat4(*m).inverse().transpose();
+        let flip = Mat3::from_mat4(*m).determinant() < 0.0;
+        Mesh {
+            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            normals: self.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect(),
+            triangles: if flip {
+                self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
+            } else {
+                self.triangles.clone()
+            },
+        }
+    }
+
+    /// Flat normals: every triangle gets its own three vertices carrying its facet normal.
+    pub fn with_flat_normals(&self) -> Mesh {
+        let mut positions = Vec::with_capacity(self.triangles.len() * 3);
+        let mut normals = Vec::with_capacity(self.triangles.len() * 3);
+        let mut triangles = Vec::with_capacity(self.triangles.len());
+        for (t, _) in self.triangles.iter().enumerate() {
+            let [a, b, c] = self.corners(t);
+            let n = facet_normal(a, b, c);
+            let i = positions.len() as u32;
+            positions.extend([a, b, c]);
+            normals.extend([n; 3]);
+            triangles.push([i, i + 1, i + 2]);
+        }
+        Mesh {
+            positions,
+            normals,
+            triangles,
+        }
+    }
+
+    /// Vertices at the same position merged (exact match), so that normals
+    /// can be averaged across faces that a file gave separate vertices.
+    pub fn welded(&self) -> Mesh {
+        let mut map: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut positions = Vec::new();
+        let remap: Vec<u32> = self
+            .positions
+            .iter()
+            .map(|p| {
+                let key = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+                *map.entry(key).or_insert_with(|| {
+                    positions.push(*p);
+                    (positions.len() - 1) as u32
+                })
+            })
+            .collect();
+        let triangles = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
+        let normals = vec![Vec3::ZERO; positions.len()];
+        Mesh {
+            positions,
+            normals,
+            triangles,
+        }
+    }
+
+    /// Smooth vertex normals (seed 001: "add the facet normals of all facets
+    /// incident to a vertex, and normalize"), weighted by facet area: the sum
+    /// of the unnormalised cross products `(p2 − p1) × (p3 − p1)`. Vertices
+    /// at the same position are merged first.
+    pub fn with_smooth_normals(&self) -> Mesh {
+        let mut m = self.welded();
+        let mut acc = vec![Vec3::ZERO; m.positions.len()];
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let w = (b - a).cross(c - a);
+            for &i in t {
+                acc[i as usize] += w;
+            }
+        }
+        m.normals = acc.into_iter().map(|n| n.normalize_or_zero()).collect();
+        m
+    }
+
+    /// Normals smoothed only across edges where the faces meet at less than
+    /// `crease_deg` degrees; vertices are split at harder edges. Each corner's
+    /// normal is the area-weighted sum of the facet normals of the faces
+    /// around its vertex that are within the crease angle of its own face.
+    pub fn with_crease_normals(&self, crease_deg: f32) -> Mesh {
+        let w = self.welded();
+        let cos_crease = crease_deg.to_radians().cos();
+        let facet: Vec<Vec3> = w
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| w.positions[i as usize]);
+                (b - a).cross(c - a)
+            })
+            .collect();
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); w.positions.len()];
+        for (f, t) in w.triangles.iter().enumerate() {
+            for &i in t {
+                around[i as usize].push(f as u32);
+            }
+        }
+        let mut positions = Vec::new();
+        let mut normals = Vec::new();
+        let mut dedup: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+        let mut triangles = Vec::with_capacity(w.triangles.len());
+        for (f, t) in w.triangles.iter().enumerate() {
+            let own = facet[f].normalize_or_zero();
+            let tri = t.map(|v| {
+                let n = around[v as usize]
+                    .iter()
+                    .filter(|&&g| facet[g as usize].normalize_or_zero().dot(own) >= cos_crease)
+                    .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                    .normalize_or_zero();
+                let key = (v, n.to_array().map(f32::to_bits));
+                *dedup.entry(key).or_insert_with(|| {
+                    positions.push(w.positions[v as usize]);
+                    normals.push(n);
+                    (positions.len() - 1) as u32
+                })
+            });
+            triangles.push(tri);
+        }
+        Mesh {
+            positions,
+            normals,
+            triangles,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square in z = 0 as two triangles, plus a third triangle folded up by 90° along x = 1.
+    fn folded() -> Mesh {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 0.0, -1.0),
+        ];
+        Mesh::from_triangles(p, vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]]).unwrap()
+    }
+
+    #[test]
+    fn facet_normal_is_ccw_cross_product() {
+        // (1,0,0) × (0,1,0) = (0,0,1)
+        assert_eq!(facet_normal(Vec3::ZERO, Vec3::X, Vec3::Y), Vec3::Z);
+        assert_eq!(facet_normal(Vec3::ZERO, Vec3::Y, Vec3::X), -Vec3::Z);
+        assert_eq!(facet_normal(Vec3::ZERO, Vec3::X, Vec3::X * 2.0), Vec3::ZERO);
+    }
+
+    #[test]
+    fn smooth_normals_are_area_weighted() {
+        let m = folded();
+        // Vertex 1 touches triangle 0 (normal +z, area 1/2) and triangle 2 (1,0,0)-(1,0,-1)-(1,1,0):
+        // (0,0,−1) × (0,1,0) = (1,0,0), area 1/2. Sum (1,0,1)/√2.
+        let n = m.normals()[1];
+        let s = core::f32::consts::FRAC_1_SQRT_2;
+        assert!((n - Vec3::new(s, 0.0, s)).length() < 1e-6, "{n}");
+        // Vertex 0 only touches +z faces.
+        assert_eq!(m.normals()[0], Vec3::Z);
+    }
+
+    #[test]
+    fn crease_splits_hard_edges() {
+        let m = folded().with_crease_normals(60.0);
+        // The 90° fold is harder than 60°: every corner keeps its own face's normal.
+        for (t, tri) in m.triangles().iter().enumerate() {
+            let [a, b, c] = m.corners(t);
+            let f = facet_normal(a, b, c);
+            for &i in tri {
+                assert!((m.normals()[i as usize] - f).length() < 1e-6);
+            }
+        }
+        assert_eq!(m.positions().len(), 7); // vertices 1 and 2 (on the fold) split in two
+        // With a crease of 100°, it is smooth again.
+        let s = folded().with_crease_normals(100.0);
+        assert_eq!(s.positions().len(), 5);
+    }
+
+    #[test]
+    fn flat_normals_unshare_vertices() {
+        let m = folded().with_flat_normals();
+        assert_eq!(m.positions().len(), 9);
+        assert_eq!(m.normals()[0], Vec3::Z);
+        assert_eq!(m.normals()[6], Vec3::X);
+    }
+
+    #[test]
+    fn transform_normals_by_inverse_transpose() {
+        // Non-uniform scale (2, 1, 1) of a plane with normal (1,1,0)/√2: new normal ∝ (1/2, 1, 0).
+        let s = core::f32::consts::FRAC_1_SQRT_2;
+        let m = Mesh::new(vec![Vec3::ZERO], vec![Vec3::new(s, s, 0.0)], vec![]).unwrap();
+        let t = m.transformed(&Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0)));
+        assert!((t.normals()[0] - Vec3::new(0.5, 1.0, 0.0).normalize()).length() < 1e-6);
+        // A mirror keeps triangles counter-clockwise seen from the normal side.
+        let f = folded().transformed(&Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        let [a, b, c] = f.corners(0);
+        assert!(facet_normal(a, b, c).dot(f.normals()[0]) > 0.0);
+    }
+
+    #[test]
+    fn rejects_bad_indices() {
+        assert!(Mesh::new(vec![Vec3::ZERO], vec![Vec3::Z], vec![[0, 0, 1]]).is_err());
+        assert!(Mesh::new(vec![Vec3::NAN], vec![Vec3::Z], vec![]).is_err());
+        assert!(Mesh::new(vec![Vec3::ZERO], vec![], vec![]).is_err());
+    }
+}

@@ -1,0 +1,108 @@
+//! A scene as plain data: what a renderer needs, already resolved and
+//! validated (world space, linear RGB). File formats build it; renderers
+//! read it.
+
+use crate::{Camera, Encoding, Lighting, Material, Mesh, ShadingOptions, Viewer};
+
+/// Where lighting is computed (seed 001: per-vertex vs per-fragment).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Interpolation {
+    /// One colour per triangle, lit with its facet normal at its centroid.
+    Flat,
+    /// Lit at the vertices, colours interpolated (Gouraud; OpenGL's fixed function).
+    Gouraud,
+    /// Normals and positions interpolated and renormalised, lit per pixel.
+    #[default]
+    Phong,
+}
+
+/// What the image shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Output {
+    /// The lit colour.
+    #[default]
+    Color,
+    /// Emission plus the ambient terms.
+    Ambient,
+    /// The diffuse term.
+    Diffuse,
+    /// The specular term.
+    Specular,
+    /// The world-space unit normal as `0.5·n + 0.5`.
+    Normal,
+    /// Linear view depth, white at `near` to black at `far`.
+    Depth,
+}
+
+/// The image's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageSettings {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Background, linear RGBA (alpha < 1 gives an RGBA PNG).
+    pub background: [f32; 4],
+    /// Samples per pixel: 1, 4 or 16.
+    pub samples: u32,
+    /// 8-bit encoding of the output.
+    pub encoding: Encoding,
+}
+
+impl Default for ImageSettings {
+    fn default() -> Self {
+        ImageSettings {
+            width: 800,
+            height: 600,
+            background: [0.0, 0.0, 0.0, 1.0],
+            samples: 1,
+            encoding: Encoding::Linear,
+        }
+    }
+}
+
+/// How the scene is shaded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingSettings {
+    /// The model's options.
+    pub options: ShadingOptions,
+    /// Where lighting is evaluated.
+    pub interpolation: Interpolation,
+    /// Local or infinite viewer.
+    pub viewer: Viewer,
+    /// What the image shows.
+    pub output: Output,
+}
+
+/// A mesh in world space with its material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// A name for messages (the shape, or the file and group).
+    pub name: String,
+    /// World-space geometry.
+    pub mesh: Mesh,
+    /// Its material.
+    pub material: Material,
+}
+
+/// Everything a renderer needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Image settings.
+    pub image: ImageSettings,
+    /// The camera.
+    pub camera: Camera,
+    /// Ambient light and lights.
+    pub lighting: Lighting,
+    /// Shading settings.
+    pub shading: ShadingSettings,
+    /// The objects.
+    pub objects: Vec<Object>,
+}
+
+impl Scene {
+    /// Number of triangles in all objects.
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.triangles().len()).sum()
+    }
+}
