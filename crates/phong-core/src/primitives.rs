@@ -402,7 +402,7 @@ mod tests {
     #[test]
     fn teapot_is_outward_and_glut_sized() {
         let m = teapot(8);
-        assert_eq!(m.triangles().len() >= 32 * 8 * 8 * 2 - 4 * 8 * 4, true);
+        assert!(m.triangles().len() >= 32 * 8 * 8 * 2 - 4 * 8 * 4);
         let (lo, hi) = m.bounds().unwrap();
         // glutSolidTeapot(1): x from the handle (−3·0.5 = −1.5) to the spout tip (3.525·0.5 = 1.7625);
         // y from (0 − 1.5)·0.5 = −0.75 to (3.15 − 1.5)·0.5 = 0.825.
