@@ -1,0 +1,156 @@
+//! Clipping in homogeneous clip space (OpenGL's volume `−w <= x, y, z <= w`).
+//!
+//! Triangles are clipped against the near and far planes, which the
+//! projection needs (no division by `w <= 0`), and against a guard band
+//! `|x|, |y| <= G·w` instead of the viewport: triangles that only cross the
+//! viewport's sides, the common case, are not clipped at all, and the pixel
+//! coordinates of what is left stay within `G` half-viewports of the centre.
+
+use glam::{Vec3, Vec4};
+use phong_core::limits::GUARD_BAND;
+
+/// A vertex in clip space with the attributes the rasteriser interpolates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipVertex {
+    /// Clip-space position.
+    pub clip: Vec4,
+    /// World-space position.
+    pub world: Vec3,
+    /// World-space normal (not renormalised).
+    pub normal: Vec3,
+    /// Colour lit at the vertex (Gouraud), else unused.
+    pub color: Vec3,
+}
+
+impl ClipVertex {
+    /// `a + t·(b − a)` for every attribute (linear in clip space, which is
+    /// what perspective-correct interpolation needs).
+    #[inline]
+    pub fn lerp(&self, b: &ClipVertex, t: f32) -> ClipVertex {
+        ClipVertex {
+            clip: self.clip.lerp(b.clip, t),
+            world: self.world.lerp(b.world, t),
+            normal: self.normal.lerp(b.normal, t),
+            color: self.color.lerp(b.color, t),
+        }
+    }
+}
+
+/// The planes clipped against, as `d(v) = dot(plane, v) >= 0` inside.
+const CLIP_PLANES: [Vec4; 6] = [
+    Vec4::new(0.0, 0.0, 1.0, 1.0),         // near: z + w >= 0
+    Vec4::new(0.0, 0.0, -1.0, 1.0),        // far: w − z >= 0
+    Vec4::new(1.0, 0.0, 0.0, GUARD_BAND),  // G·w + x >= 0
+    Vec4::new(-1.0, 0.0, 0.0, GUARD_BAND), // G·w − x >= 0
+    Vec4::new(0.0, 1.0, 0.0, GUARD_BAND),  // G·w + y >= 0
+    Vec4::new(0.0, -1.0, 0.0, GUARD_BAND), // G·w − y >= 0
+];
+
+/// The view volume's planes, for trivial rejection.
+const VIEW_PLANES: [Vec4; 6] = [
+    Vec4::new(0.0, 0.0, 1.0, 1.0),
+    Vec4::new(0.0, 0.0, -1.0, 1.0),
+    Vec4::new(1.0, 0.0, 0.0, 1.0),
+    Vec4::new(-1.0, 0.0, 0.0, 1.0),
+    Vec4::new(0.0, 1.0, 0.0, 1.0),
+    Vec4::new(0.0, -1.0, 0.0, 1.0),
+];
+
+/// What to do with a triangle.
+#[derive(Debug, PartialEq)]
+pub enum Clipped {
+    /// Entirely outside the view volume (or not finite).
+    Rejected,
+    /// Inside every clipping plane: draw as is.
+    Inside,
+    /// Clipped: draw this convex polygon (as a fan), 3 to 9 vertices.
+    Polygon(Vec<ClipVertex>),
+}
+
+/// Clips triangle `t`.
+pub fn clip_triangle(t: &[ClipVertex; 3]) -> Clipped {
+    if !t.iter().all(|v| v.clip.is_finite()) {
+        return Clipped::Rejected;
+    }
+    if VIEW_PLANES.iter().any(|p| t.iter().all(|v| p.dot(v.clip) < 0.0)) {
+        return Clipped::Rejected;
+    }
+    if CLIP_PLANES.iter().all(|p| t.iter().all(|v| p.dot(v.clip) >= 0.0)) {
+        return Clipped::Inside;
+    }
+    let mut poly: Vec<ClipVertex> = t.to_vec();
+    let mut next = Vec::with_capacity(9);
+    for p in &CLIP_PLANES {
+        next.clear();
+        for i in 0..poly.len() {
+            let (a, b) = (&poly[i], &poly[(i + 1) % poly.len()]);
+            let (da, db) = (p.dot(a.clip), p.dot(b.clip));
+            if da >= 0.0 {
+                next.push(*a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                next.push(a.lerp(b, da / (da - db)));
+            }
+        }
+        std::mem::swap(&mut poly, &mut next);
+        if poly.len() < 3 {
+            return Clipped::Rejected;
+        }
+    }
+    Clipped::Polygon(poly)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f32, y: f32, z: f32, w: f32) -> ClipVertex {
+        ClipVertex {
+            clip: Vec4::new(x, y, z, w),
+            world: Vec3::new(x, y, z),
+            normal: Vec3::Z,
+            color: Vec3::new(w, 0.0, 0.0),
+        }
+    }
+
+    #[test]
+    fn inside_and_rejected() {
+        let t = [v(0.0, 0.0, 0.0, 1.0), v(0.5, 0.0, 0.0, 1.0), v(0.0, 0.5, 0.0, 1.0)];
+        assert_eq!(clip_triangle(&t), Clipped::Inside);
+        let behind = [v(0.0, 0.0, -2.0, 1.0), v(0.5, 0.0, -2.0, 1.0), v(0.0, 0.5, -3.0, 1.0)];
+        assert_eq!(clip_triangle(&behind), Clipped::Rejected);
+        let nan = [v(f32::NAN, 0.0, 0.0, 1.0), v(0.5, 0.0, 0.0, 1.0), v(0.0, 0.5, 0.0, 1.0)];
+        assert_eq!(clip_triangle(&nan), Clipped::Rejected);
+    }
+
+    #[test]
+    fn near_plane_cuts_a_corner() {
+        // One vertex behind the near plane (z = −2 < −w = −1): the triangle becomes a quad whose
+        // new vertices lie exactly on z = −w, with attributes interpolated at the same t.
+        let t = [v(0.0, 0.0, -2.0, 1.0), v(0.5, 0.0, 0.0, 1.0), v(0.0, 0.5, 0.0, 1.0)];
+        let Clipped::Polygon(p) = clip_triangle(&t) else {
+            panic!()
+        };
+        assert_eq!(p.len(), 4);
+        for q in &p {
+            assert!(q.clip.z + q.clip.w >= -1e-6);
+        }
+        // Edge v0 → v1: d0 = −1, d1 = 1, t = 0.5: x = 0.25, z = −1.
+        assert!(
+            p.iter()
+                .any(|q| (q.clip.x - 0.25).abs() < 1e-6 && (q.clip.z + 1.0).abs() < 1e-6)
+        );
+    }
+
+    #[test]
+    fn guard_band_only_beyond_g() {
+        // Crosses the viewport's right side (x = w) but not the guard band: not clipped.
+        let t = [v(0.0, 0.0, 0.0, 1.0), v(3.0, 0.0, 0.0, 1.0), v(0.0, 0.5, 0.0, 1.0)];
+        assert_eq!(clip_triangle(&t), Clipped::Inside);
+        let t = [v(0.0, 0.0, 0.0, 1.0), v(100.0, 0.0, 0.0, 1.0), v(0.0, 0.5, 0.0, 1.0)];
+        let Clipped::Polygon(p) = clip_triangle(&t) else {
+            panic!()
+        };
+        assert!(p.iter().all(|q| q.clip.x <= GUARD_BAND * q.clip.w + 1e-4));
+    }
+}

@@ -1,0 +1,121 @@
+//! # phong-raster
+//!
+//! The CPU renderer: `render(&Scene, &RenderOptions) -> Result<Image, Error>`.
+//!
+//! ## Pipeline
+//!
+//! 1. **Setup** (per object): vertices to clip space with `clip_from_world`;
+//!    for Gouraud, the lighting of [`phong_core::shade`] at each vertex; for
+//!    flat, at each triangle's centroid with its facet normal.
+//! 2. **Clipping** ([`clip`]): trivial reject against the view volume, then
+//!    Sutherland–Hodgman in homogeneous space against the near and far planes
+//!    and a guard band ([`GUARD_BAND`](phong_core::limits::GUARD_BAND)) in x and y, so
+//!    that screen coordinates stay bounded for the fixed-point stage.
+//! 3. **Triangle setup** ([`raster`]): viewport transform with pixel centres
+//!    at +0.5, snapping to 1/256 pixel, back-face culling (counter-clockwise in
+//!    NDC is front, as OpenGL) unless two-sided, integer edge functions with
+//!    the top-left fill rule, binning into 64×64 tiles.
+//! 4. **Tiles, in parallel** (rayon): per sample, exact integer coverage and
+//!    a `GL_LESS` depth test; per pixel and triangle, one shading at the pixel
+//!    centre (as MSAA), perspective-correct; written to the covered samples.
+//! 5. **Resolve**: the samples' average (straight alpha) into the [`Image`].
+//!
+//! Every pixel of a tile is processed by one thread in triangle order, so the
+//! image is the same whatever the number of threads.
+
+pub mod clip;
+pub mod raster;
+
+use phong_core::{Image, Scene};
+use std::time::Duration;
+use thiserror::Error;
+
+/// Why a render failed.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Samples per pixel other than 1, 4 or 16.
+    #[error("antialias must be 1, 4 or 16 samples per pixel, got {0}")]
+    Samples(u32),
+    /// The image (times its samples) is larger than the renderer accepts.
+    #[error("image {width}x{height} with {samples} samples per pixel is too large (limit: 16384 on a side)")]
+    TooLarge {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Samples per pixel.
+        samples: u32,
+    },
+    /// The thread pool could not be built.
+    #[error("could not start {threads} rendering threads: {source}")]
+    Threads {
+        /// Threads asked for.
+        threads: usize,
+        /// The cause.
+        source: rayon::ThreadPoolBuildError,
+    },
+    /// An invalid image (from the core crate).
+    #[error(transparent)]
+    Core(#[from] phong_core::Error),
+}
+
+/// How to render (what the scene does not say).
+#[derive(Default)]
+pub struct RenderOptions<'a> {
+    /// Worker threads; `None`: all cores (rayon's global pool).
+    pub threads: Option<usize>,
+    /// Called with (tiles done, tiles in all) as tiles finish, from any thread.
+    pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+}
+
+/// Counts and times of one render.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderStats {
+    /// Triangles in the scene.
+    pub triangles: usize,
+    /// Triangles rasterised (after culling and clipping; clipping can add some).
+    pub triangles_drawn: usize,
+    /// Pixels shaded (a pixel counts once per triangle that covers a visible sample of it).
+    pub pixels_shaded: u64,
+    /// Vertex transform, per-vertex lighting, clipping, triangle setup and binning.
+    pub setup: Duration,
+    /// Coverage, depth and shading in the tiles, with the resolve.
+    pub raster: Duration,
+}
+
+/// Renders `scene` into a linear RGBA image.
+pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Image, Error> {
+    render_with_stats(scene, options).map(|(img, _)| img)
+}
+
+/// [`render`], with counts and stage times.
+pub fn render_with_stats(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
+    let s = scene.image.samples;
+    if !phong_core::limits::SAMPLE_COUNTS.contains(&s) {
+        return Err(Error::Samples(s));
+    }
+    let (w, h) = (scene.image.width, scene.image.height);
+    if w == 0
+        || h == 0
+        || w > phong_core::limits::MAX_IMAGE_DIMENSION
+        || h > phong_core::limits::MAX_IMAGE_DIMENSION
+        || u64::from(w) * u64::from(h) * u64::from(s) > phong_core::limits::MAX_SAMPLES_TOTAL
+    {
+        return Err(Error::TooLarge {
+            width: w,
+            height: h,
+            samples: s,
+        });
+    }
+    match options.threads {
+        None => raster::render(scene, options),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|source| Error::Threads { threads: n, source })?;
+            pool.install(|| raster::render(scene, options))
+        }
+    }
+}

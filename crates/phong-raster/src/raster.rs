@@ -1,0 +1,400 @@
+//! Triangle setup, binning, tiles: coverage, depth, shading, resolve.
+//!
+//! Coverage is exact: vertices are snapped to 1/256 pixel
+//! ([`SUBPIXEL_BITS`]) and edge functions are evaluated in `i64`, with the
+//! top-left rule deciding samples exactly on an edge, so triangles that share
+//! an edge cover each sample once. This is the scalar reference path, kept
+//! simple: each sample evaluates its three edge functions directly.
+
+use crate::clip::{ClipVertex, Clipped, clip_triangle};
+use crate::{Error, RenderOptions, RenderStats};
+use glam::{Vec3, Vec4};
+use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
+use phong_core::mesh::facet_normal;
+use phong_core::{Color, Image, Interpolation, Material, Output, Scene, Shading, SurfacePoint, View, shade};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+const ONE: f32 = (1u32 << SUBPIXEL_BITS) as f32;
+const HALF: i64 = 1 << (SUBPIXEL_BITS - 1);
+
+/// Sample positions within a pixel, in [0, 1)², for 1, 4 and 16 samples.
+/// 1: the centre. 4: the D3D/Vulkan standard rotated grid. 16: a 4×4 grid.
+pub fn sample_pattern(samples: u32) -> Vec<(f32, f32)> {
+    match samples {
+        4 => [(-2.0, -6.0), (6.0, -2.0), (-6.0, 2.0), (2.0, 6.0)]
+            .iter()
+            .map(|&(x, y)| (0.5 + x / 16.0, 0.5 + y / 16.0))
+            .collect(),
+        16 => (0..16)
+            .map(|i| ((i % 4) as f32 * 0.25 + 0.125, (i / 4) as f32 * 0.25 + 0.125))
+            .collect(),
+        _ => vec![(0.5, 0.5)],
+    }
+}
+
+/// The term of `s` that `output` shows (normal and depth are not terms).
+#[inline]
+fn term(output: Output, s: &Shading) -> Color {
+    match output {
+        Output::Ambient => s.ambient,
+        Output::Diffuse => s.diffuse,
+        Output::Specular => s.specular,
+        _ => s.color,
+    }
+}
+
+/// A triangle ready for the tiles.
+struct Tri {
+    /// Edge functions `E_i(X, Y) = a·X + b·Y + c` (edge i opposite vertex i), in 1/256 pixel.
+    a: [i64; 3],
+    b: [i64; 3],
+    c: [i64; 3],
+    /// 0 for top-left edges, 1 for others: inside is `E − bias >= 0`.
+    bias: [i64; 3],
+    /// Twice the signed area, > 0.
+    area: f64,
+    /// Window depth in [0, 1] per vertex.
+    z: [f32; 3],
+    /// 1/w per vertex.
+    inv_w: [f32; 3],
+    v: [ClipVertex; 3],
+    /// Flat: the triangle's colour and facet normal.
+    flat: Option<(Color, Vec3)>,
+    object: u32,
+    /// Pixel bounds, inclusive min, exclusive max.
+    bbox: [u32; 4],
+}
+
+struct Frame<'a> {
+    scene: &'a Scene,
+    view: View,
+    w: u32,
+    h: u32,
+    pattern: Vec<(i64, i64)>,
+    tris: Vec<Tri>,
+    tiles_x: u32,
+    bins: Vec<Vec<u32>>,
+}
+
+pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
+    let t0 = Instant::now();
+    let (w, h) = (scene.image.width, scene.image.height);
+    let aspect = w as f32 / h as f32;
+    let clip_from_world = scene.camera.clip_from_world(aspect);
+    let view = scene.camera.view(scene.shading.viewer);
+    let pattern = sample_pattern(scene.image.samples)
+        .into_iter()
+        .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
+        .collect();
+
+    let mut frame = Frame {
+        scene,
+        view,
+        w,
+        h,
+        pattern,
+        tris: Vec::new(),
+        tiles_x: w.div_ceil(TILE_SIZE),
+        bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
+    };
+
+    for (oi, obj) in scene.objects.iter().enumerate() {
+        let mesh = &obj.mesh;
+        let gouraud = scene.shading.interpolation == Interpolation::Gouraud;
+        let verts: Vec<ClipVertex> = mesh
+            .positions()
+            .par_iter()
+            .zip(mesh.normals().par_iter())
+            .map(|(&p, &n)| ClipVertex {
+                clip: clip_from_world * Vec4::from((p, 1.0)),
+                world: p,
+                normal: n,
+                color: if gouraud {
+                    let s = shade_at(scene, &view, &obj.material, p, n);
+                    Vec3::from(term(scene.shading.output, &s).to_array())
+                } else {
+                    Vec3::ZERO
+                },
+            })
+            .collect();
+        for tri in mesh.triangles() {
+            let t = tri.map(|i| verts[i as usize]);
+            let flat = (scene.shading.interpolation == Interpolation::Flat).then(|| {
+                let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
+                let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
+                let s = shade_at(scene, &view, &obj.material, centroid, fnorm);
+                (term(scene.shading.output, &s), fnorm)
+            });
+            match clip_triangle(&t) {
+                Clipped::Rejected => {}
+                Clipped::Inside => frame.setup(t, flat, oi as u32),
+                Clipped::Polygon(p) => {
+                    for i in 1..p.len() - 1 {
+                        frame.setup([p[0], p[i], p[i + 1]], flat, oi as u32);
+                    }
+                }
+            }
+        }
+    }
+    let setup = t0.elapsed();
+
+    let t1 = Instant::now();
+    let tiles_y = h.div_ceil(TILE_SIZE);
+    let total = u64::from(frame.tiles_x * tiles_y);
+    let done = AtomicU64::new(0);
+    let shaded = AtomicU64::new(0);
+    let bg = scene.image.background;
+    let results: Vec<(u32, Vec<[f32; 4]>)> = (0..frame.tiles_x * tiles_y)
+        .into_par_iter()
+        .map(|tile| {
+            let (pixels, n) = frame.tile(tile, bg);
+            shaded.fetch_add(n, Ordering::Relaxed);
+            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(p) = options.progress {
+                p(d, total);
+            }
+            (tile, pixels)
+        })
+        .collect();
+    let mut image = Image::new(w, h, bg)?;
+    let out = image.pixels_mut();
+    for (tile, pixels) in results {
+        let (x0, y0, x1, y1) = frame.tile_rect(tile);
+        let tw = (x1 - x0) as usize;
+        for (row, y) in (y0..y1).enumerate() {
+            let dst = y as usize * w as usize + x0 as usize;
+            out[dst..dst + tw].copy_from_slice(&pixels[row * tw..(row + 1) * tw]);
+        }
+    }
+    let stats = RenderStats {
+        triangles: scene.triangle_count(),
+        triangles_drawn: frame.tris.len(),
+        pixels_shaded: shaded.into_inner(),
+        setup,
+        raster: t1.elapsed(),
+    };
+    Ok((image, stats))
+}
+
+#[inline]
+fn shade_at(scene: &Scene, view: &View, m: &Material, position: Vec3, normal: Vec3) -> Shading {
+    shade(
+        &SurfacePoint { position, normal },
+        view,
+        m,
+        &scene.lighting,
+        &scene.shading.options,
+    )
+}
+
+impl Frame<'_> {
+    fn tile_rect(&self, tile: u32) -> (u32, u32, u32, u32) {
+        let (tx, ty) = (tile % self.tiles_x, tile / self.tiles_x);
+        let (x0, y0) = (tx * TILE_SIZE, ty * TILE_SIZE);
+        (x0, y0, (x0 + TILE_SIZE).min(self.w), (y0 + TILE_SIZE).min(self.h))
+    }
+
+    /// Projects, snaps, culls, sets up edges and bins one clipped triangle.
+    fn setup(&mut self, mut v: [ClipVertex; 3], flat: Option<(Color, Vec3)>, object: u32) {
+        let (wf, hf) = (self.w as f32, self.h as f32);
+        let mut xy = [(0i64, 0i64); 3];
+        let mut z = [0f32; 3];
+        let mut inv_w = [0f32; 3];
+        let project = |c: Vec4| {
+            let iw = 1.0 / c.w;
+            let sx = (c.x * iw * 0.5 + 0.5) * wf;
+            let sy = (0.5 - c.y * iw * 0.5) * hf;
+            (
+                (sx * ONE).round() as i64,
+                (sy * ONE).round() as i64,
+                c.z * iw * 0.5 + 0.5,
+                iw,
+            )
+        };
+        for i in 0..3 {
+            let (x, y, zz, iw) = project(v[i].clip);
+            xy[i] = (x, y);
+            z[i] = zz;
+            inv_w[i] = iw;
+        }
+        let area = (xy[1].0 - xy[0].0) * (xy[2].1 - xy[0].1) - (xy[2].0 - xy[0].0) * (xy[1].1 - xy[0].1);
+        if area == 0 {
+            return;
+        }
+        // Counter-clockwise in NDC (y up) is clockwise on screen (y down): area < 0 is front-facing.
+        let front = area < 0;
+        if !front && !self.scene.shading.options.two_sided {
+            return;
+        }
+        if area < 0 {
+            v.swap(1, 2);
+            xy.swap(1, 2);
+            z.swap(1, 2);
+            inv_w.swap(1, 2);
+        }
+        let mut a = [0i64; 3];
+        let mut b = [0i64; 3];
+        let mut c = [0i64; 3];
+        let mut bias = [0i64; 3];
+        for i in 0..3 {
+            // Edge opposite vertex i, from vertex j to vertex k.
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let ((xa, ya), (xb, yb)) = (xy[j], xy[k]);
+            // E(X, Y) = (xb − xa)(Y − ya) − (yb − ya)(X − xa), positive inside.
+            a[i] = -(yb - ya);
+            b[i] = xb - xa;
+            c[i] = -(a[i] * xa + b[i] * ya);
+            // Top edge: horizontal, going right; left edge: going up (y down). Both inclusive.
+            let top_left = (ya == yb && xb > xa) || yb < ya;
+            bias[i] = if top_left { 0 } else { 1 };
+        }
+        let (min_x, max_x) = (
+            xy.iter().map(|p| p.0).min().unwrap(),
+            xy.iter().map(|p| p.0).max().unwrap(),
+        );
+        let (min_y, max_y) = (
+            xy.iter().map(|p| p.1).min().unwrap(),
+            xy.iter().map(|p| p.1).max().unwrap(),
+        );
+        let px0 = (min_x >> SUBPIXEL_BITS).max(0);
+        let py0 = (min_y >> SUBPIXEL_BITS).max(0);
+        let px1 = ((max_x >> SUBPIXEL_BITS) + 1).min(i64::from(self.w));
+        let py1 = ((max_y >> SUBPIXEL_BITS) + 1).min(i64::from(self.h));
+        if px0 >= px1 || py0 >= py1 {
+            return;
+        }
+        let idx = self.tris.len() as u32;
+        self.tris.push(Tri {
+            a,
+            b,
+            c,
+            bias,
+            area: area.unsigned_abs() as f64,
+            z,
+            inv_w,
+            v,
+            flat,
+            object,
+            bbox: [px0 as u32, py0 as u32, px1 as u32, py1 as u32],
+        });
+        let t = TILE_SIZE as i64;
+        for ty in py0 / t..=(py1 - 1) / t {
+            for tx in px0 / t..=(px1 - 1) / t {
+                self.bins[(ty as u32 * self.tiles_x + tx as u32) as usize].push(idx);
+            }
+        }
+    }
+
+    /// Renders one tile and resolves it; returns its pixels and the number of pixel shadings.
+    fn tile(&self, tile: u32, bg: [f32; 4]) -> (Vec<[f32; 4]>, u64) {
+        let (x0, y0, x1, y1) = self.tile_rect(tile);
+        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let ns = self.pattern.len();
+        let mut color = vec![bg; tw * th * ns];
+        let mut depth = vec![f32::INFINITY; tw * th * ns];
+        let mut shaded = 0u64;
+        let mut zs = [0f32; 16];
+        for &ti in &self.bins[tile as usize] {
+            let t = &self.tris[ti as usize];
+            let bx0 = t.bbox[0].max(x0);
+            let by0 = t.bbox[1].max(y0);
+            let bx1 = t.bbox[2].min(x1);
+            let by1 = t.bbox[3].min(y1);
+            for py in by0..by1 {
+                for px in bx0..bx1 {
+                    let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
+                    let mut mask = 0u32;
+                    for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
+                        let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
+                        let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
+                        let e = [0, 1, 2].map(|i| t.a[i] * sx + t.b[i] * sy + t.c[i]);
+                        if (0..3).any(|i| e[i] - t.bias[i] < 0) {
+                            continue;
+                        }
+                        let l = e.map(|x| (x as f64 / t.area) as f32);
+                        let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                        if zz < depth[base + s] {
+                            zs[s] = zz;
+                            mask |= 1 << s;
+                        }
+                    }
+                    if mask == 0 {
+                        continue;
+                    }
+                    shaded += 1;
+                    let c = self.shade_pixel(t, px, py);
+                    for s in 0..ns {
+                        if mask & (1 << s) != 0 {
+                            depth[base + s] = zs[s];
+                            color[base + s] = c;
+                        }
+                    }
+                }
+            }
+        }
+        // Resolve: straight-alpha average of the samples.
+        let mut out = Vec::with_capacity(tw * th);
+        for px in color.chunks_exact(ns) {
+            let mut acc = [0f32; 4];
+            for s in px {
+                for k in 0..3 {
+                    acc[k] += s[k] * s[3];
+                }
+                acc[3] += s[3];
+            }
+            out.push(if acc[3] > 0.0 {
+                [acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3], acc[3] / ns as f32]
+            } else {
+                [bg[0], bg[1], bg[2], 0.0]
+            });
+        }
+        (out, shaded)
+    }
+
+    /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
+    fn shade_pixel(&self, t: &Tri, px: u32, py: u32) -> [f32; 4] {
+        let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
+        let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
+        let e = [0, 1, 2].map(|i| (t.a[i] * sx + t.b[i] * sy + t.c[i]) as f64 / t.area);
+        // Perspective-correct weights: (λ_i / w_i) / Σ (λ_j / w_j).
+        let q = [0, 1, 2].map(|i| e[i] as f32 * t.inv_w[i]);
+        let sum = q[0] + q[1] + q[2];
+        let q = q.map(|x| x / sum);
+        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
+        let scene = self.scene;
+        let output = scene.shading.output;
+        let c = match output {
+            Output::Normal => {
+                let n = match t.flat {
+                    Some((_, n)) => n,
+                    None => lerp3(|v| v.normal).normalize_or_zero(),
+                };
+                if n == Vec3::ZERO {
+                    Color::BLACK
+                } else {
+                    Color::new(n.x * 0.5 + 0.5, n.y * 0.5 + 0.5, n.z * 0.5 + 0.5)
+                }
+            }
+            Output::Depth => {
+                let cam = &scene.camera;
+                let d = cam.depth_of(lerp3(|v| v.world));
+                Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
+            }
+            _ => match (t.flat, scene.shading.interpolation) {
+                (Some((c, _)), _) => c,
+                (None, Interpolation::Gouraud) => {
+                    let c = lerp3(|v| v.color);
+                    Color::new(c.x, c.y, c.z)
+                }
+                _ => {
+                    let m = &scene.objects[t.object as usize].material;
+                    let s = shade_at(scene, &self.view, m, lerp3(|v| v.world), lerp3(|v| v.normal));
+                    term(output, &s)
+                }
+            },
+        };
+        [c.r, c.g, c.b, 1.0]
+    }
+}

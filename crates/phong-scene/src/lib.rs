@@ -1,0 +1,43 @@
+//! # phong-scene
+//!
+//! Scene files (TOML), OBJ/MTL import and PNG output: everything between a
+//! file on disk and a [`phong_core::Scene`], and between an
+//! [`Image`](phong_core::Image) and a PNG.
+//!
+//! Every error names the file, and for parse and validation errors the line,
+//! column and key (`scene.toml:12:13: \`shininess\`: must be >= 0, got -1`).
+
+mod error;
+mod obj;
+mod png_out;
+mod toml_scene;
+
+pub use error::Error;
+pub use obj::{ObjPart, load_obj};
+pub use png_out::write_png;
+pub use toml_scene::{INTERPOLATIONS, MODELS, Model, OUTPUTS, apply_model, parse_choice, parse_scene};
+
+use std::path::Path;
+
+/// A loaded scene and the warnings met on the way (unsupported MTL `illum`, ...).
+#[derive(Debug)]
+pub struct Loaded {
+    /// The scene.
+    pub scene: phong_core::Scene,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Loads a scene file (`.toml`) or a model (`.obj`, framed by a default camera and lights).
+pub fn load(path: &Path) -> Result<Loaded, Error> {
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        toml_scene::scene_for_model(path)
+    } else {
+        let src = std::fs::read_to_string(path).map_err(|source| Error::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        parse_scene(&src, path)
+    }
+}

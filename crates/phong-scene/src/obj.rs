@@ -1,0 +1,440 @@
+//! Wavefront OBJ and MTL import, with tobj.
+//!
+//! tobj parses; before it, a line-by-line check of the OBJ (vertex records,
+//! face indices) and of each MTL (colours, `Ns`, `d`, `illum`) finds
+//! malformed input and reports its file, line and column, which tobj's
+//! errors do not carry.
+//!
+//! MTL mapping: `Ka`, `Kd`, `Ks`, `Ke` → ambient, diffuse, specular,
+//! emission; `Ns` → shininess (the exponent itself, 0..1000); `d` → alpha;
+//! `illum` 0 → a constant colour `Kd` (as emission, nothing lit), 1 →
+//! Lambert (no specular), 2 → Blinn-Phong; other models are rendered as 2
+//! with a warning. Missing `Ka`/`Kd`/`Ks` take OpenGL's default material's values.
+
+use crate::Error;
+use glam::Vec3;
+use phong_core::{Color, Material, Mesh};
+use std::collections::HashMap;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+/// One group of an OBJ file with one material.
+#[derive(Debug, Clone)]
+pub struct ObjPart {
+    /// `file:group`.
+    pub name: String,
+    /// Object-space geometry (normals from the file, or zero when it has none).
+    pub mesh: Mesh,
+    /// Its MTL material, if any.
+    pub material: Option<Material>,
+    /// True when the file gave normals for every vertex of this part.
+    pub has_normals: bool,
+}
+
+fn read(path: &Path) -> Result<String, Error> {
+    std::fs::read_to_string(path).map_err(|source| Error::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Offset of the `n`th whitespace-separated field of `line` (0 = keyword), for columns.
+fn field_offset(line: &str, n: usize) -> usize {
+    let mut count = 0;
+    let mut in_field = false;
+    for (i, ch) in line.char_indices() {
+        if ch.is_whitespace() {
+            in_field = false;
+        } else if !in_field {
+            if count == n {
+                return i;
+            }
+            count += 1;
+            in_field = true;
+        }
+    }
+    line.len()
+}
+
+struct Checker<'a> {
+    path: &'a Path,
+    src: &'a str,
+}
+
+impl Checker<'_> {
+    fn err(&self, line_start: usize, line: &str, field: usize, key: &str, msg: String) -> Error {
+        Error::at(
+            self.path,
+            self.src,
+            line_start + field_offset(line, field),
+            Some(key),
+            msg,
+        )
+    }
+}
+
+fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut off = 0;
+    src.split_inclusive('\n').map(move |l| {
+        let start = off;
+        off += l.len();
+        (start, l.trim_end_matches(['\n', '\r']))
+    })
+}
+
+/// Checks the OBJ records tobj would accept or reject without a location.
+fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
+    let c = Checker { path, src };
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    for (start, line) in lines(src) {
+        let content = line.split('#').next().unwrap_or("");
+        let mut it = content.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let rest: Vec<&str> = it.collect();
+        match kw {
+            "v" | "vn" | "vt" => {
+                let need = if kw == "vt" { 1 } else { 3 };
+                if rest.len() < need {
+                    return Err(c.err(
+                        start,
+                        line,
+                        0,
+                        kw,
+                        format!("needs {need} numbers, found {}", rest.len()),
+                    ));
+                }
+                for (i, f) in rest.iter().enumerate().take(3) {
+                    match f.parse::<f32>() {
+                        Ok(x) if x.is_finite() => {}
+                        _ => return Err(c.err(start, line, i + 1, kw, format!("{f:?} is not a finite number"))),
+                    }
+                }
+                match kw {
+                    "v" => nv += 1,
+                    "vt" => nt += 1,
+                    _ => nn += 1,
+                }
+            }
+            "f" => {
+                if rest.len() < 3 {
+                    return Err(c.err(
+                        start,
+                        line,
+                        0,
+                        "f",
+                        format!("a face needs at least 3 vertices, found {}", rest.len()),
+                    ));
+                }
+                for (i, r) in rest.iter().enumerate() {
+                    let parts: Vec<&str> = r.split('/').collect();
+                    if parts.len() > 3 {
+                        return Err(c.err(
+                            start,
+                            line,
+                            i + 1,
+                            "f",
+                            format!("{r:?} is not v, v/vt, v//vn or v/vt/vn"),
+                        ));
+                    }
+                    for (k, (p, count, what)) in parts
+                        .iter()
+                        .zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")])
+                        .map(|(p, (n, w))| (p, n, w))
+                        .enumerate()
+                    {
+                        if p.is_empty() && k > 0 {
+                            continue;
+                        }
+                        let idx: i64 = p
+                            .parse()
+                            .map_err(|_| c.err(start, line, i + 1, "f", format!("{r:?}: {p:?} is not an index")))?;
+                        let resolved = if idx < 0 { count + idx + 1 } else { idx };
+                        if idx == 0 || resolved < 1 || resolved > count {
+                            return Err(c.err(
+                                start,
+                                line,
+                                i + 1,
+                                "f",
+                                format!("{what} index {idx} is out of range: {count} defined so far"),
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Checks an MTL file's values; returns the warnings (unsupported `illum`).
+fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), Error> {
+    let c = Checker { path, src };
+    for (start, line) in lines(src) {
+        let content = line.split('#').next().unwrap_or("");
+        let mut it = content.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let rest: Vec<&str> = it.collect();
+        let num = |i: usize| -> Result<f32, Error> {
+            let f = rest
+                .get(i)
+                .ok_or_else(|| c.err(start, line, 0, kw, "is missing a number".into()))?;
+            f.parse::<f32>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| c.err(start, line, i + 1, kw, format!("{f:?} is not a finite number")))
+        };
+        match kw {
+            "Ka" | "Kd" | "Ks" | "Ke" => {
+                if rest.first() == Some(&"spectral") || rest.first() == Some(&"xyz") {
+                    return Err(c.err(start, line, 1, kw, "only RGB colours are supported".into()));
+                }
+                for i in 0..3 {
+                    // "Kd r" alone means r = g = b.
+                    if i > 0 && rest.len() == 1 {
+                        break;
+                    }
+                    let x = num(i)?;
+                    if x < 0.0 {
+                        return Err(c.err(start, line, i + 1, kw, format!("must be >= 0, got {x}")));
+                    }
+                }
+            }
+            "Ns" => {
+                let x = num(0)?;
+                if x < 0.0 {
+                    return Err(c.err(start, line, 1, kw, format!("shininess must be >= 0, got {x}")));
+                }
+            }
+            "d" => {
+                let x = num(0)?;
+                if !(0.0..=1.0).contains(&x) {
+                    return Err(c.err(start, line, 1, kw, format!("must be in [0, 1], got {x}")));
+                }
+            }
+            "illum" => {
+                let x = num(0)?;
+                if x != x.trunc() || x < 0.0 {
+                    return Err(c.err(start, line, 1, kw, format!("must be an integer >= 0, got {x}")));
+                }
+                if x > 2.0 {
+                    let (l, _) = crate::error::line_col(src, start);
+                    warnings.push(format!(
+                        "{}:{l}: illum {x} is not supported; rendered as illum 2 (Blinn-Phong)",
+                        path.display()
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+fn to_material(m: &tobj::Material) -> Material {
+    let def = Material::default();
+    let c = |v: Option<[f32; 3]>, d: Color| v.map(Color::from_array).unwrap_or(d);
+    let kd = c(m.diffuse, def.diffuse());
+    let (ka, ks, ke) = (
+        c(m.ambient, def.ambient()),
+        c(m.specular, def.specular()),
+        c(m.emissive, Color::BLACK),
+    );
+    let ns = m.shininess.unwrap_or(0.0);
+    let built = match m.illumination_model.unwrap_or(2) {
+        0 => Material::new(Color::BLACK, Color::BLACK, Color::BLACK, kd, 0.0),
+        1 => Material::new(ka, kd, Color::BLACK, ke, ns),
+        _ => Material::new(ka, kd, ks, ke, ns),
+    };
+    // Values were checked line by line before tobj parsed them.
+    let built = built.unwrap_or_default();
+    built.with_alpha(m.dissolve.unwrap_or(1.0)).unwrap_or(built)
+}
+
+/// Loads an OBJ file and its MTL materials: one part per group and material.
+pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
+    let src = read(path)?;
+    check_obj(path, &src)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
+    let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let loaded = tobj::load_obj_buf(&mut BufReader::new(src.as_bytes()), &opts, |mtl: &Path| {
+        let p: PathBuf = dir.join(mtl);
+        let text = match read(&p) {
+            Ok(t) => t,
+            Err(e) => {
+                // Locate the mtllib line for the message.
+                let name = mtl.to_string_lossy();
+                let at = src.find(&*name).unwrap_or(0);
+                let msg = format!("material library {} cannot be read: {e}", p.display());
+                *mtl_error.borrow_mut() = Some(Error::at(path, &src, at, Some("mtllib"), msg));
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
+        if let Err(e) = check_mtl(&p, &text, &mut mtl_warnings.borrow_mut()) {
+            *mtl_error.borrow_mut() = Some(e);
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl_buf(&mut BufReader::new(text.as_bytes()))
+    });
+    if let Some(e) = mtl_error.into_inner() {
+        return Err(e);
+    }
+    warnings.extend(mtl_warnings.into_inner());
+    let (models, materials) = loaded.map_err(|e| Error::at(path, &src, 0, None, format!("malformed OBJ: {e}")))?;
+    let materials: Vec<tobj::Material> = materials.unwrap_or_default();
+    let materials: Vec<Material> = materials.iter().map(to_material).collect();
+    let file = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut parts = Vec::new();
+    for model in models {
+        let m = &model.mesh;
+        if m.indices.is_empty() {
+            continue;
+        }
+        let positions: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect();
+        let has_normals = m.normals.len() == m.positions.len();
+        let normals = if has_normals {
+            m.normals
+                .chunks_exact(3)
+                .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
+                .collect()
+        } else {
+            vec![Vec3::ZERO; positions.len()]
+        };
+        let tris = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let mesh = Mesh::new(positions, normals, tris)
+            .map_err(|e| Error::at(path, &src, 0, None, format!("group {}: {e}", model.name)))?;
+        parts.push(ObjPart {
+            name: format!("{file}:{}", model.name),
+            mesh,
+            material: m.material_id.and_then(|i| materials.get(i).copied()),
+            has_normals,
+        });
+    }
+    // Merge parts that share a material within the same group name.
+    let mut merged: Vec<ObjPart> = Vec::new();
+    let mut index: HashMap<(String, Option<[u32; 4]>), usize> = HashMap::new();
+    for p in parts {
+        let key = (
+            p.name.clone(),
+            p.material.map(|m| {
+                [
+                    m.diffuse().r.to_bits(),
+                    m.diffuse().g.to_bits(),
+                    m.specular().r.to_bits(),
+                    m.shininess().to_bits(),
+                ]
+            }),
+        );
+        match index.get(&key) {
+            Some(&i) if merged[i].has_normals == p.has_normals => merged[i].mesh.append(&p.mesh),
+            _ => {
+                index.insert(key, merged.len());
+                merged.push(p);
+            }
+        }
+    }
+    Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    fn tmpdir(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("phong-obj-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn quad_with_two_materials() {
+        let d = tmpdir("quad");
+        write(
+            &d,
+            "m.mtl",
+            "newmtl red\nKa 0.1 0 0\nKd 0.8 0 0\nKs 0.5 0.5 0.5\nNs 20\nillum 2\n\
+             newmtl glow\nKd 0 1 0\nillum 0\nnewmtl odd\nKd 1 1 1\nillum 5\n",
+        );
+        let obj = write(
+            &d,
+            "m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\n\
+             g a\nusemtl red\nf 1//1 2//1 3//1 4//1\ng b\nusemtl glow\nf 1 2 3\nusemtl odd\nf 1 3 4\n",
+        );
+        let mut warnings = Vec::new();
+        let parts = load_obj(&obj, &mut warnings).unwrap();
+        assert_eq!(parts.len(), 3, "{parts:?}");
+        // The quad is triangulated into 2 triangles with the file's normals.
+        assert_eq!(parts[0].mesh.triangles().len(), 2);
+        assert!(parts[0].has_normals);
+        let red = parts[0].material.unwrap();
+        assert_eq!(red.diffuse(), Color::new(0.8, 0.0, 0.0));
+        assert_eq!(red.shininess(), 20.0);
+        // illum 0: constant colour Kd, carried as emission.
+        let glow = parts[1].material.unwrap();
+        assert_eq!(glow.emission(), Color::new(0.0, 1.0, 0.0));
+        assert_eq!(glow.diffuse(), Color::BLACK);
+        assert!(!parts[1].has_normals);
+        assert!(warnings.iter().any(|w| w.contains("illum 5")), "{warnings:?}");
+    }
+
+    #[test]
+    fn malformed_obj_names_line_and_column() {
+        let d = tmpdir("bad");
+        let obj = write(&d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("bad.obj:3:5: `v`"), "{e}");
+        let obj = write(&d, "range.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(
+            e.contains("range.obj:4:7: `f`: vertex index 9 is out of range: 3 defined"),
+            "{e}"
+        );
+        let obj = write(&d, "short.obj", "v 0 0\n");
+        assert!(
+            load_obj(&obj, &mut Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("short.obj:1:1")
+        );
+        let obj = write(&d, "mtl.obj", "mtllib nope.mtl\nv 0 0 0\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("mtl.obj:1:8: `mtllib`") && e.contains("nope.mtl"), "{e}");
+        write(&d, "neg.mtl", "newmtl a\nKd 1 1 1\nNs -3\n");
+        let obj = write(&d, "neg.obj", "mtllib neg.mtl\nv 0 0 0\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("neg.mtl:3:4: `Ns`: shininess must be >= 0"), "{e}");
+        assert!(matches!(
+            load_obj(&d.join("missing.obj"), &mut Vec::new()),
+            Err(Error::Read { .. })
+        ));
+    }
+
+    #[test]
+    fn negative_indices_resolve() {
+        let d = tmpdir("neg");
+        let obj = write(&d, "n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n");
+        let parts = load_obj(&obj, &mut Vec::new()).unwrap();
+        assert_eq!(parts[0].mesh.triangles().len(), 1);
+    }
+}

@@ -1,0 +1,55 @@
+//! PNG output, written atomically: to a temporary file beside the target,
+//! then renamed over it, so a failed write never leaves a partial image.
+
+use crate::Error;
+use phong_core::{Encoding, Image};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Writes `image` as an 8-bit PNG: RGB, or RGBA when some pixel is not
+/// opaque; colours encoded with `encoding` (sRGB adds the PNG `sRGB` chunk).
+pub fn write_png(path: &Path, image: &Image, encoding: Encoding) -> Result<(), Error> {
+    let err = |source: std::io::Error| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let alpha = image.has_transparency();
+    let bytes = image.to_bytes(encoding, alpha);
+    let mut buf = Vec::with_capacity(bytes.len() / 2);
+    {
+        let mut enc = png::Encoder::new(&mut buf, image.width(), image.height());
+        enc.set_color(if alpha {
+            png::ColorType::Rgba
+        } else {
+            png::ColorType::Rgb
+        });
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_compression(png::Compression::Fast);
+        if encoding == Encoding::Srgb {
+            enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        }
+        let mut w = enc.write_header().map_err(|e| err(std::io::Error::other(e)))?;
+        w.write_image_data(&bytes).map_err(|e| err(std::io::Error::other(e)))?;
+        w.finish().map_err(|e| err(std::io::Error::other(e)))?;
+    }
+    let tmp = temp_path(path);
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(&buf)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(err(e));
+    }
+    Ok(())
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
