@@ -26,6 +26,8 @@
 pub mod clip;
 pub mod raster;
 
+pub use raster::{coverage_counts, sample_pattern};
+
 use phong_core::{Image, Scene};
 use std::time::Duration;
 use thiserror::Error;

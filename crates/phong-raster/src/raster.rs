@@ -78,66 +78,109 @@ struct Frame<'a> {
     bins: Vec<Vec<u32>>,
 }
 
-pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
-    let t0 = Instant::now();
-    let (w, h) = (scene.image.width, scene.image.height);
-    let aspect = w as f32 / h as f32;
-    let clip_from_world = scene.camera.clip_from_world(aspect);
-    let view = scene.camera.view(scene.shading.viewer);
-    let pattern = sample_pattern(scene.image.samples)
-        .into_iter()
-        .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
-        .collect();
-
-    let mut frame = Frame {
-        scene,
-        view,
-        w,
-        h,
-        pattern,
-        tris: Vec::new(),
-        tiles_x: w.div_ceil(TILE_SIZE),
-        bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
-    };
-
-    for (oi, obj) in scene.objects.iter().enumerate() {
-        let mesh = &obj.mesh;
-        let gouraud = scene.shading.interpolation == Interpolation::Gouraud;
-        let verts: Vec<ClipVertex> = mesh
-            .positions()
-            .par_iter()
-            .zip(mesh.normals().par_iter())
-            .map(|(&p, &n)| ClipVertex {
-                clip: clip_from_world * Vec4::from((p, 1.0)),
-                world: p,
-                normal: n,
-                color: if gouraud {
-                    let s = shade_at(scene, &view, &obj.material, p, n);
-                    Vec3::from(term(scene.shading.output, &s).to_array())
-                } else {
-                    Vec3::ZERO
-                },
-            })
+impl<'a> Frame<'a> {
+    /// Transforms, lights (Gouraud, flat), clips, sets up and bins every triangle.
+    fn build(scene: &'a Scene) -> Frame<'a> {
+        let (w, h) = (scene.image.width, scene.image.height);
+        let aspect = w as f32 / h as f32;
+        let clip_from_world = scene.camera.clip_from_world(aspect);
+        let view = scene.camera.view(scene.shading.viewer);
+        let pattern = sample_pattern(scene.image.samples)
+            .into_iter()
+            .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
             .collect();
-        for tri in mesh.triangles() {
-            let t = tri.map(|i| verts[i as usize]);
-            let flat = (scene.shading.interpolation == Interpolation::Flat).then(|| {
-                let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
-                let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                let s = shade_at(scene, &view, &obj.material, centroid, fnorm);
-                (term(scene.shading.output, &s), fnorm)
-            });
-            match clip_triangle(&t) {
-                Clipped::Rejected => {}
-                Clipped::Inside => frame.setup(t, flat, oi as u32),
-                Clipped::Polygon(p) => {
-                    for i in 1..p.len() - 1 {
-                        frame.setup([p[0], p[i], p[i + 1]], flat, oi as u32);
+        let mut frame = Frame {
+            scene,
+            view,
+            w,
+            h,
+            pattern,
+            tris: Vec::new(),
+            tiles_x: w.div_ceil(TILE_SIZE),
+            bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
+        };
+        let interpolation = scene.shading.interpolation;
+        for (oi, obj) in scene.objects.iter().enumerate() {
+            let mesh = &obj.mesh;
+            let gouraud = interpolation == Interpolation::Gouraud;
+            let verts: Vec<ClipVertex> = mesh
+                .positions()
+                .par_iter()
+                .zip(mesh.normals().par_iter())
+                .map(|(&p, &n)| ClipVertex {
+                    clip: clip_from_world * Vec4::from((p, 1.0)),
+                    world: p,
+                    normal: n,
+                    color: if gouraud {
+                        let s = shade_at(scene, &view, &obj.material, p, n);
+                        Vec3::from(term(scene.shading.output, &s).to_array())
+                    } else {
+                        Vec3::ZERO
+                    },
+                })
+                .collect();
+            for tri in mesh.triangles() {
+                let t = tri.map(|i| verts[i as usize]);
+                let flat = (interpolation == Interpolation::Flat).then(|| {
+                    let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
+                    let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
+                    let s = shade_at(scene, &view, &obj.material, centroid, fnorm);
+                    (term(scene.shading.output, &s), fnorm)
+                });
+                match clip_triangle(&t) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => frame.setup(t, flat, oi as u32),
+                    Clipped::Polygon(p) => {
+                        for i in 1..p.len() - 1 {
+                            frame.setup([p[0], p[i], p[i + 1]], flat, oi as u32);
+                        }
+                    }
+                }
+            }
+        }
+        frame
+    }
+
+    /// Evaluates triangle `t`'s three edge functions at sample `(sx, sy)` (1/256 pixel);
+    /// `Some` when the sample is covered (top-left rule).
+    #[inline]
+    fn covers(t: &Tri, sx: i64, sy: i64) -> Option<[i64; 3]> {
+        let e = [0, 1, 2].map(|i| t.a[i] * sx + t.b[i] * sy + t.c[i]);
+        if (0..3).any(|i| e[i] - t.bias[i] < 0) {
+            None
+        } else {
+            Some(e)
+        }
+    }
+}
+
+/// Diagnostic for coverage tests: for each sample of each pixel (row-major,
+/// samples innermost), how many triangles cover it, depth ignored. Culling
+/// and clipping apply as in [`render`](crate::render).
+pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
+    let frame = Frame::build(scene);
+    let ns = frame.pattern.len();
+    let mut counts = vec![0u16; frame.w as usize * frame.h as usize * ns];
+    for t in &frame.tris {
+        for py in t.bbox[1]..t.bbox[3] {
+            for px in t.bbox[0]..t.bbox[2] {
+                for (s, &(ox, oy)) in frame.pattern.iter().enumerate() {
+                    let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
+                    let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
+                    if Frame::covers(t, sx, sy).is_some() {
+                        counts[(py as usize * frame.w as usize + px as usize) * ns + s] += 1;
                     }
                 }
             }
         }
     }
+    counts
+}
+
+pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
+    let t0 = Instant::now();
+    let (w, h) = (scene.image.width, scene.image.height);
+    let frame = Frame::build(scene);
     let setup = t0.elapsed();
 
     let t1 = Instant::now();
@@ -309,10 +352,9 @@ impl Frame<'_> {
                     for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
                         let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
                         let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
-                        let e = [0, 1, 2].map(|i| t.a[i] * sx + t.b[i] * sy + t.c[i]);
-                        if (0..3).any(|i| e[i] - t.bias[i] < 0) {
+                        let Some(e) = Frame::covers(t, sx, sy) else {
                             continue;
-                        }
+                        };
                         let l = e.map(|x| (x as f64 / t.area) as f32);
                         let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
                         if zz < depth[base + s] {

@@ -1,0 +1,591 @@
+//! The rasteriser against closed-form images and the core crate's `shade`.
+
+use glam::{Mat4, Vec3};
+use phong_core::*;
+use phong_raster::{RenderOptions, coverage_counts, render, sample_pattern};
+
+fn ortho_camera(height: f32) -> Camera {
+    Camera::new(
+        Vec3::new(0.0, 0.0, 5.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        Projection::Orthographic { height },
+        0.1,
+        10.0,
+    )
+    .unwrap()
+}
+
+fn scene(w: u32, h: u32, camera: Camera, objects: Vec<Object>, lighting: Lighting, interp: Interpolation) -> Scene {
+    Scene {
+        image: ImageSettings {
+            width: w,
+            height: h,
+            background: [0.0, 0.0, 0.0, 1.0],
+            samples: 1,
+            encoding: Encoding::Linear,
+        },
+        shading: ShadingSettings {
+            options: ShadingOptions::default(),
+            interpolation: interp,
+            viewer: camera.default_viewer(),
+            output: Output::Color,
+        },
+        camera,
+        lighting,
+        objects,
+    }
+}
+
+fn obj(mesh: Mesh, material: Material) -> Object {
+    Object {
+        name: "test".into(),
+        mesh,
+        material,
+    }
+}
+
+fn one_light(dir: Vec3) -> Lighting {
+    Lighting::new(
+        Color::splat(0.2),
+        vec![Light::directional(dir, LightColor::default()).unwrap()],
+    )
+    .unwrap()
+}
+
+fn px(img: &Image, x: u32, y: u32) -> Vec3 {
+    let p = img.get(x, y);
+    Vec3::new(p[0], p[1], p[2])
+}
+
+/// World-space point at pixel centre (x, y) on the z = 0 plane, for `ortho_camera(height)` and a
+/// square image of `n` pixels.
+fn ortho_world(x: u32, y: u32, n: u32, height: f32) -> (f32, f32) {
+    let s = height / n as f32;
+    ((x as f32 + 0.5) * s - height / 2.0, height / 2.0 - (y as f32 + 0.5) * s)
+}
+
+/// An orthographic unit sphere lit by one directional light against the closed-form image:
+/// at pixel centre (x, y) inside the disc the true sphere has P = N = (x, y, √(1 − x² − y²)).
+/// Measured with 256 segments, Phong interpolation, 200×200: largest error 0.00041 per channel
+/// over 24916 pixels (the tessellation: interpolated positions and normals are chords of the
+/// sphere); asserted 0.001.
+#[test]
+fn orthographic_sphere_matches_closed_form() {
+    let (n, height) = (200u32, 2.2f32);
+    let m = Material::named("gold").unwrap();
+    let light = Vec3::new(-1.0, -1.0, -2.0);
+    let s = scene(
+        n,
+        n,
+        ortho_camera(height),
+        vec![obj(primitives::sphere(256), m)],
+        one_light(light),
+        Interpolation::Phong,
+    );
+    let img = render(&s, &RenderOptions::default()).unwrap();
+    let view = s.camera.view(Viewer::Infinite);
+    let mut worst = 0.0f32;
+    let mut inside = 0;
+    for y in 0..n {
+        for x in 0..n {
+            let (wx, wy) = ortho_world(x, y, n, height);
+            let r2 = wx * wx + wy * wy;
+            let got = px(&img, x, y);
+            if r2 > 1.02 * 1.02 {
+                assert_eq!(got, Vec3::ZERO, "background at ({x}, {y})");
+            } else if r2 < 0.98 * 0.98 {
+                let p = Vec3::new(wx, wy, (1.0 - r2).sqrt());
+                let sh = shade(
+                    &SurfacePoint { position: p, normal: p },
+                    &view,
+                    &m,
+                    &s.lighting,
+                    &s.shading.options,
+                );
+                let want = Vec3::from(sh.color.to_array());
+                worst = worst.max((got - want).abs().max_element());
+                inside += 1;
+            }
+        }
+    }
+    eprintln!("sphere: largest error {worst} over {inside} pixels");
+    assert!(inside > 20000);
+    assert!(worst < 0.001, "largest error {worst}");
+}
+
+/// A plane facing a directional light along its normal: N·L = 1, so every pixel is exactly
+/// k_a·I_a + k_d·I (no specular: shininess gives (N·H)^s, so use Lambert), in every mode.
+#[test]
+fn lit_plane_is_exactly_ka_ia_plus_kd_i() {
+    let m = Material::new(
+        Color::new(0.3, 0.2, 0.1),
+        Color::new(0.5, 0.6, 0.7),
+        Color::BLACK,
+        Color::BLACK,
+        10.0,
+    )
+    .unwrap();
+    let plane = primitives::plane(4).transformed(&Mat4::from_rotation_x(90f32.to_radians()));
+    let want = Vec3::new(0.3 * 0.2 + 0.5, 0.2 * 0.2 + 0.6, 0.1 * 0.2 + 0.7);
+    for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
+        let s = scene(
+            64,
+            64,
+            ortho_camera(1.5),
+            vec![obj(plane.clone(), m)],
+            one_light(-Vec3::Z),
+            interp,
+        );
+        let img = render(&s, &RenderOptions::default()).unwrap();
+        for y in 0..64 {
+            for x in 0..64 {
+                let d = (px(&img, x, y) - want).abs().max_element();
+                assert!(d < 1e-6, "{interp:?} ({x},{y}): {:?}", px(&img, x, y));
+            }
+        }
+    }
+}
+
+fn lcg(seed: &mut u64) -> f32 {
+    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    (*seed >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// A grid of jittered triangles covering more than the screen, in the z = 0 plane.
+fn jittered_grid(cells: u32, extent: f32, seed: u64) -> Mesh {
+    let mut s = seed;
+    let mut positions = Vec::new();
+    for i in 0..=cells {
+        for j in 0..=cells {
+            let border = i == 0 || j == 0 || i == cells || j == cells;
+            let (jx, jy) = if border {
+                (0.0, 0.0)
+            } else {
+                (lcg(&mut s) - 0.5, lcg(&mut s) - 0.5)
+            };
+            let step = 2.0 * extent / cells as f32;
+            positions.push(Vec3::new(
+                -extent + (j as f32 + 0.8 * jx) * step,
+                -extent + (i as f32 + 0.8 * jy) * step,
+                0.0,
+            ));
+        }
+    }
+    let k = |i: u32, j: u32| i * (cells + 1) + j;
+    let mut tris = Vec::new();
+    for i in 0..cells {
+        for j in 0..cells {
+            // Alternate the diagonal so both edge orientations occur.
+            if (i + j) % 2 == 0 {
+                tris.push([k(i, j), k(i, j + 1), k(i + 1, j + 1)]);
+                tris.push([k(i, j), k(i + 1, j + 1), k(i + 1, j)]);
+            } else {
+                tris.push([k(i, j), k(i, j + 1), k(i + 1, j)]);
+                tris.push([k(i, j + 1), k(i + 1, j + 1), k(i + 1, j)]);
+            }
+        }
+    }
+    Mesh::new(positions.clone(), vec![Vec3::Z; positions.len()], tris).unwrap()
+}
+
+/// Shared edges cover each sample exactly once: no hole, no overlap (top-left rule), at every
+/// sample count, for grids of 2 to 800 triangles, some vertices exactly on pixel centres.
+#[test]
+fn mesh_covering_the_screen_covers_each_sample_once() {
+    for (cells, seed) in [(1, 1), (5, 2), (20, 3)] {
+        for samples in [1, 4, 16] {
+            let mut s = scene(
+                37,
+                29,
+                ortho_camera(2.0),
+                vec![obj(jittered_grid(cells, 2.0, seed), Material::default())],
+                one_light(-Vec3::Z),
+                Interpolation::Phong,
+            );
+            s.image.samples = samples;
+            let counts = coverage_counts(&s);
+            assert!(
+                counts.iter().all(|&c| c == 1),
+                "cells {cells} samples {samples}: {:?}",
+                {
+                    let bad: Vec<_> = counts.iter().enumerate().filter(|(_, c)| **c != 1).take(5).collect();
+                    bad
+                }
+            );
+        }
+    }
+    // Vertices on pixel centres and edges through them: a 32×32 image, a quad split along the
+    // diagonal that passes exactly through pixel centres.
+    let quad = Mesh::new(
+        vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ],
+        vec![Vec3::Z; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let s = scene(
+        32,
+        32,
+        ortho_camera(2.0),
+        vec![obj(quad, Material::default())],
+        one_light(-Vec3::Z),
+        Interpolation::Phong,
+    );
+    assert!(coverage_counts(&s).iter().all(|&c| c == 1));
+}
+
+/// Two triangles sharing an edge, drawn separately, cover each pixel once; the half-open rule
+/// leaves the quad's own right and bottom edges out: a quad spanning pixel centres 4.5 to 10.5
+/// covers exactly columns 4..=9 (the centre at x = 10.5 on its right edge is excluded).
+#[test]
+fn two_triangles_share_an_edge() {
+    // Ortho camera of height 16 over 16×16 pixels: 1 world unit per pixel, x = px − 8.
+    let (x0, x1, y0, y1) = (4.5 - 8.0, 10.5 - 8.0, 8.0 - 3.5, 8.0 - 12.5);
+    let quad = Mesh::new(
+        vec![
+            Vec3::new(x0, y1, 0.0),
+            Vec3::new(x1, y1, 0.0),
+            Vec3::new(x1, y0, 0.0),
+            Vec3::new(x0, y0, 0.0),
+        ],
+        vec![Vec3::Z; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let s = scene(
+        16,
+        16,
+        ortho_camera(16.0),
+        vec![obj(quad, Material::default())],
+        one_light(-Vec3::Z),
+        Interpolation::Phong,
+    );
+    let counts = coverage_counts(&s);
+    for y in 0..16u32 {
+        for x in 0..16u32 {
+            let inside = (4..10).contains(&x) && (3..12).contains(&y);
+            assert_eq!(counts[(y * 16 + x) as usize], u16::from(inside), "({x},{y})");
+        }
+    }
+}
+
+/// Perspective-correct interpolation: a floor plane seen in perspective; the depth output is the
+/// view depth of the interpolated world position, which must equal the closed-form ray–plane
+/// intersection at each pixel centre (affine interpolation would be off by up to 30%).
+#[test]
+fn perspective_correct_interpolation_and_near_clipping() {
+    let cam = Camera::new(
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 1.0, -1.0),
+        Vec3::Y,
+        Projection::Perspective { fov_y_deg: 60.0 },
+        0.1,
+        50.0,
+    )
+    .unwrap();
+    // A floor y = 0 from z = +10 (behind the camera: crosses the near plane) to z = −40.
+    let floor = Mesh::new(
+        vec![
+            Vec3::new(-40.0, 0.0, 10.0),
+            Vec3::new(40.0, 0.0, 10.0),
+            Vec3::new(40.0, 0.0, -40.0),
+            Vec3::new(-40.0, 0.0, -40.0),
+        ],
+        vec![Vec3::Y; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let (w, h) = (64u32, 48u32);
+    let mut s = scene(
+        w,
+        h,
+        cam,
+        vec![obj(floor, Material::default())],
+        one_light(-Vec3::Y),
+        Interpolation::Phong,
+    );
+    s.shading.output = Output::Depth;
+    let img = render(&s, &RenderOptions::default()).unwrap();
+    let t = (30f32).to_radians().tan();
+    let aspect = w as f32 / h as f32;
+    let mut checked = 0;
+    for y in 0..h {
+        for x in 0..w {
+            // Ray through the pixel centre in view space: (ndc_x·t·aspect, ndc_y·t, −1).
+            let ndc_x = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
+            let ndc_y = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
+            let dir = Vec3::new(ndc_x * t * aspect, ndc_y * t, -1.0);
+            let got = img.get(x, y)[0];
+            if dir.y >= -1e-3 {
+                assert_eq!(got, 0.0, "above the horizon ({x},{y})"); // background
+                continue;
+            }
+            let depth = 1.0 / -dir.y; // camera height 1, forward component of dir is 1
+            let hit = Vec3::new(0.0, 1.0, 0.0) + dir * depth;
+            if hit.z < -40.0 || hit.x.abs() > 40.0 || depth > 50.0 {
+                continue;
+            }
+            let want = 1.0 - (depth - 0.1) / (50.0 - 0.1);
+            assert!((got - want).abs() < 2e-4, "({x},{y}): {got} vs {want}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+}
+
+fn quad_at(z: f32, half: f32) -> Mesh {
+    Mesh::new(
+        vec![
+            Vec3::new(-half, -half, z),
+            Vec3::new(half, -half, z),
+            Vec3::new(half, half, z),
+            Vec3::new(-half, half, z),
+        ],
+        vec![Vec3::Z; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap()
+}
+
+fn emissive(c: Color) -> Material {
+    Material::new(Color::BLACK, Color::BLACK, Color::BLACK, c, 0.0).unwrap()
+}
+
+/// The nearer surface wins whatever the drawing order.
+#[test]
+fn depth_order() {
+    let red = obj(quad_at(0.5, 0.5), emissive(Color::new(1.0, 0.0, 0.0)));
+    let blue = obj(quad_at(-0.5, 1.0), emissive(Color::new(0.0, 0.0, 1.0)));
+    for objects in [vec![red.clone(), blue.clone()], vec![blue, red]] {
+        let s = scene(
+            32,
+            32,
+            ortho_camera(3.0),
+            objects,
+            Lighting::default(),
+            Interpolation::Phong,
+        );
+        let img = render(&s, &RenderOptions::default()).unwrap();
+        assert_eq!(px(&img, 16, 16), Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(px(&img, 16, 6), Vec3::new(0.0, 0.0, 1.0));
+    }
+}
+
+/// One triangle, orthographic: barycentrics of a pixel centre computed here independently.
+fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let area = (b - a).cross(c - a).z;
+    [
+        (b - p).cross(c - p).z / area,
+        (c - p).cross(a - p).z / area,
+        (a - p).cross(b - p).z / area,
+    ]
+}
+
+/// Each interpolation mode and specular model against `shade`: flat is the centroid's shading
+/// with the facet normal; Gouraud the barycentric blend of the vertices' shadings; Phong the
+/// shading of the blended position and renormalised normal. Tolerance 2e-5: f32 rounding of the
+/// blended vectors, amplified by the exponent 51.2 (measured: 8.8e-6).
+#[test]
+fn interpolation_modes_against_core() {
+    // Vertices on multiples of 1/8 world unit = 3 pixels, so snapping to 1/256 pixel moves nothing.
+    let (a, b, c) = (
+        Vec3::new(-0.875, -0.75, 0.0),
+        Vec3::new(0.875, -0.625, 0.25),
+        Vec3::new(0.0, 0.875, -0.25),
+    );
+    let na = Vec3::new(-0.5, -0.3, 1.0).normalize();
+    let nb = Vec3::new(0.6, -0.2, 1.0).normalize();
+    let nc = Vec3::new(0.0, 0.7, 1.0).normalize();
+    let mesh = Mesh::new(vec![a, b, c], vec![na, nb, nc], vec![[0, 1, 2]]).unwrap();
+    let m = Material::named("polished copper").unwrap();
+    let lighting = Lighting::new(
+        Color::splat(0.1),
+        vec![
+            Light::directional(Vec3::new(-0.3, -0.5, -1.0), LightColor::default()).unwrap(),
+            Light::point(
+                Vec3::new(1.0, 1.0, 2.0),
+                LightColor::uniform(Color::new(0.6, 0.5, 0.4)).unwrap(),
+                Attenuation::new(1.0, 0.2, 0.0).unwrap(),
+            )
+            .unwrap(),
+        ],
+    )
+    .unwrap();
+    let models = [
+        SpecularModel::None,
+        SpecularModel::Phong,
+        SpecularModel::BlinnPhong,
+        SpecularModel::Lyon {
+            squarings: 3,
+            lambda: LyonLambda::Dot,
+        },
+    ];
+    let n = 48u32;
+    for model in models {
+        for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
+            let mut s = scene(
+                n,
+                n,
+                ortho_camera(2.0),
+                vec![obj(mesh.clone(), m)],
+                lighting.clone(),
+                interp,
+            );
+            s.shading.options.specular = model;
+            s.shading.viewer = Viewer::Local; // per-point V, to exercise positions too
+            let img = render(&s, &RenderOptions::default()).unwrap();
+            let view = s.camera.view(Viewer::Local);
+            let sh = |p: Vec3, nrm: Vec3| {
+                let r = shade(
+                    &SurfacePoint {
+                        position: p,
+                        normal: nrm,
+                    },
+                    &view,
+                    &m,
+                    &lighting,
+                    &s.shading.options,
+                );
+                Vec3::from(r.color.to_array())
+            };
+            let mut checked = 0;
+            for y in 0..n {
+                for x in 0..n {
+                    let (wx, wy) = ortho_world(x, y, n, 2.0);
+                    let l = barycentric(Vec3::new(wx, wy, 0.0), a, b, c);
+                    if l.iter().any(|&v| v < 0.02) {
+                        continue;
+                    }
+                    let p = a * l[0] + b * l[1] + c * l[2];
+                    let want = match interp {
+                        Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+                        Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
+                        Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),
+                    };
+                    let got = px(&img, x, y);
+                    assert!(
+                        (got - want).abs().max_element() < 2e-5,
+                        "{model:?} {interp:?} ({x},{y}): {got} vs {want}"
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 300);
+        }
+    }
+}
+
+/// 4 samples: an edge at x = 10.5 pixels covers the 2 of the 4 standard sample positions
+/// (x offsets 0.375, 0.875, 0.125, 0.625) left of it in pixel 10: half white.
+#[test]
+fn antialiasing_averages_samples() {
+    assert_eq!(sample_pattern(4).iter().filter(|(x, _)| *x < 0.5).count(), 2);
+    let (x0, x1) = (-8.0, 10.5 - 8.0);
+    let quad = Mesh::new(
+        vec![
+            Vec3::new(x0, -8.0, 0.0),
+            Vec3::new(x1, -8.0, 0.0),
+            Vec3::new(x1, 8.0, 0.0),
+            Vec3::new(x0, 8.0, 0.0),
+        ],
+        vec![Vec3::Z; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let mut s = scene(
+        16,
+        16,
+        ortho_camera(16.0),
+        vec![obj(quad, emissive(Color::WHITE))],
+        Lighting::default(),
+        Interpolation::Phong,
+    );
+    s.image.samples = 4;
+    let img = render(&s, &RenderOptions::default()).unwrap();
+    assert_eq!(px(&img, 9, 5), Vec3::ONE);
+    assert!(
+        (px(&img, 10, 5) - Vec3::splat(0.5)).abs().max_element() < 1e-6,
+        "{}",
+        px(&img, 10, 5)
+    );
+    assert_eq!(px(&img, 11, 5), Vec3::ZERO);
+    // A transparent background gives partial alpha with the covered colour (straight alpha).
+    s.image.background = [0.0, 0.0, 0.0, 0.0];
+    let img = render(&s, &RenderOptions::default()).unwrap();
+    assert_eq!(img.get(10, 5), [1.0, 1.0, 1.0, 0.5]);
+    assert_eq!(img.get(12, 5)[3], 0.0);
+}
+
+/// Back faces are culled unless two-sided lighting is on.
+#[test]
+fn back_face_culling() {
+    let back = quad_at(0.0, 1.0).transformed(&Mat4::from_rotation_y(180f32.to_radians()));
+    let mut s = scene(
+        8,
+        8,
+        ortho_camera(3.0),
+        vec![obj(back, emissive(Color::WHITE))],
+        Lighting::default(),
+        Interpolation::Phong,
+    );
+    assert_eq!(px(&render(&s, &RenderOptions::default()).unwrap(), 4, 4), Vec3::ZERO);
+    s.shading.options.two_sided = true;
+    assert_eq!(px(&render(&s, &RenderOptions::default()).unwrap(), 4, 4), Vec3::ONE);
+}
+
+/// The same image whatever the number of threads.
+#[test]
+fn deterministic_across_thread_counts() {
+    let s = scene(
+        150,
+        110,
+        ortho_camera(2.0),
+        vec![obj(primitives::teapot(6), Material::named("ruby").unwrap())],
+        one_light(Vec3::new(-1.0, -1.0, -1.0)),
+        Interpolation::Phong,
+    );
+    let one = render(
+        &s,
+        &RenderOptions {
+            threads: Some(1),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let three = render(
+        &s,
+        &RenderOptions {
+            threads: Some(3),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(one, three);
+}
+
+#[test]
+fn rejects_bad_settings() {
+    let mut s = scene(
+        8,
+        8,
+        ortho_camera(3.0),
+        vec![],
+        Lighting::default(),
+        Interpolation::Phong,
+    );
+    s.image.samples = 3;
+    assert!(
+        render(&s, &RenderOptions::default())
+            .unwrap_err()
+            .to_string()
+            .contains("1, 4 or 16")
+    );
+    s.image.samples = 1;
+    s.image.width = 1_000_000;
+    assert!(render(&s, &RenderOptions::default()).is_err());
+}
