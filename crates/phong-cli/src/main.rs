@@ -132,19 +132,36 @@ fn render(a: RenderArgs) -> Result<()> {
         }
         scene.image.samples = s;
     }
-    if let Some(m) = &a.model {
-        let model = input(parse_choice("--model", m, MODELS))?;
-        let lyon = match scene.shading.options.specular {
-            phong_core::SpecularModel::Lyon { squarings, lambda } => (squarings, lambda),
-            _ => (3, phong_core::LyonLambda::Dot),
-        };
-        apply_model(&mut scene.shading.options, model, lyon);
-    }
-    if let Some(i) = &a.interpolation {
-        scene.shading.interpolation = input(parse_choice("--interpolation", i, INTERPOLATIONS))?;
-    }
-    if let Some(t) = &a.term {
-        scene.shading.output = input(parse_choice("--output", t, OUTPUTS))?;
+    // Flags override the file, for the scene's defaults and every object.
+    let model = a
+        .model
+        .as_deref()
+        .map(|m| input(parse_choice("--model", m, MODELS)))
+        .transpose()?;
+    let interpolation = a
+        .interpolation
+        .as_deref()
+        .map(|i| input(parse_choice("--interpolation", i, INTERPOLATIONS)))
+        .transpose()?;
+    let term = a
+        .term
+        .as_deref()
+        .map(|t| input(parse_choice("--output", t, OUTPUTS)))
+        .transpose()?;
+    for sh in std::iter::once(&mut scene.shading).chain(scene.objects.iter_mut().map(|o| &mut o.shading)) {
+        if let Some(model) = model {
+            let lyon = match sh.options.specular {
+                phong_core::SpecularModel::Lyon { squarings, lambda } => (squarings, lambda),
+                _ => (3, phong_core::LyonLambda::Dot),
+            };
+            apply_model(&mut sh.options, model, lyon);
+        }
+        if let Some(i) = interpolation {
+            sh.interpolation = i;
+        }
+        if let Some(t) = term {
+            sh.output = t;
+        }
     }
     if a.threads == Some(0) {
         bail!(InputError("--threads must be at least 1".into()));
@@ -168,9 +185,10 @@ fn render(a: RenderArgs) -> Result<()> {
         threads: a.threads,
         progress: Some(&progress),
     };
-    let (image, stats) =
+    let (mut image, stats) =
         render_with_stats(&scene, &options).with_context(|| format!("rendering {}", a.input.display()))?;
     bar.finish_and_clear();
+    phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
     let t_write = Instant::now();
     phong_scene::write_png(&a.output, &image, scene.image.encoding)?;
     let t_write = t_write.elapsed();

@@ -38,6 +38,7 @@ pub mod mesh;
 pub mod primitives;
 mod scene;
 mod shading;
+pub mod text;
 
 pub use camera::{Camera, Projection, Viewer};
 pub use color::Color;
@@ -46,7 +47,7 @@ pub use image::{Encoding, Image};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names};
 pub use mesh::Mesh;
-pub use scene::{ImageSettings, Interpolation, Object, Output, Scene, ShadingSettings};
+pub use scene::{ImageSettings, Interpolation, Label, Object, Output, Scene, ShadingSettings};
 pub use shading::{
     Lighting, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, lyon,
     pow_positive, shade, specular_factor,

@@ -2,7 +2,7 @@
 //! validated (world space, linear RGB). File formats build it; renderers
 //! read it.
 
-use crate::{Camera, Encoding, Lighting, Material, Mesh, ShadingOptions, Viewer};
+use crate::{Camera, Color, Encoding, Lighting, Material, Mesh, ShadingOptions, Viewer};
 
 /// Where lighting is computed (seed 001: per-vertex vs per-fragment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -74,7 +74,9 @@ pub struct ShadingSettings {
     pub output: Output,
 }
 
-/// A mesh in world space with its material.
+/// A mesh in world space with its material and how it is shaded (the
+/// scene's settings, or the object's own overrides, so that one image can
+/// compare models, interpolations or terms side by side).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     /// A name for messages (the shape, or the file and group).
@@ -83,6 +85,22 @@ pub struct Object {
     pub mesh: Mesh,
     /// Its material.
     pub material: Material,
+    /// How it is shaded.
+    pub shading: ShadingSettings,
+}
+
+/// Text drawn over the image, centred at the projection of a world point
+/// (e.g. a material's name under its teapot).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// The text (ASCII; other characters are drawn as `?`).
+    pub text: String,
+    /// World-space anchor: the text's centre.
+    pub position: glam::Vec3,
+    /// Linear RGB colour.
+    pub color: Color,
+    /// Pixels per font pixel (the font is 5×7).
+    pub size: u32,
 }
 
 /// Everything a renderer needs.
@@ -98,6 +116,8 @@ pub struct Scene {
     pub shading: ShadingSettings,
     /// The objects.
     pub objects: Vec<Object>,
+    /// Text over the image.
+    pub labels: Vec<Label>,
 }
 
 impl Scene {

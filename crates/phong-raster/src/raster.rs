@@ -11,7 +11,7 @@ use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
 use phong_core::mesh::facet_normal;
-use phong_core::{Color, Image, Interpolation, Material, Output, Scene, Shading, SurfacePoint, View, shade};
+use phong_core::{Color, Image, Interpolation, Object, Output, Scene, Shading, SurfacePoint, View, shade};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -69,7 +69,8 @@ struct Tri {
 
 struct Frame<'a> {
     scene: &'a Scene,
-    view: View,
+    /// Per object: its view vector rule.
+    views: Vec<View>,
     w: u32,
     h: u32,
     pattern: Vec<(i64, i64)>,
@@ -84,14 +85,18 @@ impl<'a> Frame<'a> {
         let (w, h) = (scene.image.width, scene.image.height);
         let aspect = w as f32 / h as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);
-        let view = scene.camera.view(scene.shading.viewer);
+        let views = scene
+            .objects
+            .iter()
+            .map(|o| scene.camera.view(o.shading.viewer))
+            .collect();
         let pattern = sample_pattern(scene.image.samples)
             .into_iter()
             .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
             .collect();
         let mut frame = Frame {
             scene,
-            view,
+            views,
             w,
             h,
             pattern,
@@ -99,8 +104,10 @@ impl<'a> Frame<'a> {
             tiles_x: w.div_ceil(TILE_SIZE),
             bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
         };
-        let interpolation = scene.shading.interpolation;
         for (oi, obj) in scene.objects.iter().enumerate() {
+            let interpolation = obj.shading.interpolation;
+            let output = obj.shading.output;
+            let view = frame.views[oi];
             let mesh = &obj.mesh;
             let gouraud = interpolation == Interpolation::Gouraud;
             let verts: Vec<ClipVertex> = mesh
@@ -112,8 +119,8 @@ impl<'a> Frame<'a> {
                     world: p,
                     normal: n,
                     color: if gouraud {
-                        let s = shade_at(scene, &view, &obj.material, p, n);
-                        Vec3::from(term(scene.shading.output, &s).to_array())
+                        let s = shade_at(scene, obj, &view, p, n);
+                        Vec3::from(term(output, &s).to_array())
                     } else {
                         Vec3::ZERO
                     },
@@ -124,8 +131,8 @@ impl<'a> Frame<'a> {
                 let flat = (interpolation == Interpolation::Flat).then(|| {
                     let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
                     let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                    let s = shade_at(scene, &view, &obj.material, centroid, fnorm);
-                    (term(scene.shading.output, &s), fnorm)
+                    let s = shade_at(scene, obj, &view, centroid, fnorm);
+                    (term(output, &s), fnorm)
                 });
                 match clip_triangle(&t) {
                     Clipped::Rejected => {}
@@ -222,13 +229,13 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
 }
 
 #[inline]
-fn shade_at(scene: &Scene, view: &View, m: &Material, position: Vec3, normal: Vec3) -> Shading {
+fn shade_at(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3) -> Shading {
     shade(
         &SurfacePoint { position, normal },
         view,
-        m,
+        &obj.material,
         &scene.lighting,
-        &scene.shading.options,
+        &obj.shading.options,
     )
 }
 
@@ -268,7 +275,7 @@ impl Frame<'_> {
         }
         // Counter-clockwise in NDC (y up) is clockwise on screen (y down): area < 0 is front-facing.
         let front = area < 0;
-        if !front && !self.scene.shading.options.two_sided {
+        if !front && !self.scene.objects[object as usize].shading.options.two_sided {
             return;
         }
         if area < 0 {
@@ -406,7 +413,8 @@ impl Frame<'_> {
         let q = q.map(|x| x / sum);
         let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
         let scene = self.scene;
-        let output = scene.shading.output;
+        let obj = &scene.objects[t.object as usize];
+        let output = obj.shading.output;
         let c = match output {
             Output::Normal => {
                 let n = match t.flat {
@@ -424,15 +432,20 @@ impl Frame<'_> {
                 let d = cam.depth_of(lerp3(|v| v.world));
                 Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
             }
-            _ => match (t.flat, scene.shading.interpolation) {
+            _ => match (t.flat, obj.shading.interpolation) {
                 (Some((c, _)), _) => c,
                 (None, Interpolation::Gouraud) => {
                     let c = lerp3(|v| v.color);
                     Color::new(c.x, c.y, c.z)
                 }
                 _ => {
-                    let m = &scene.objects[t.object as usize].material;
-                    let s = shade_at(scene, &self.view, m, lerp3(|v| v.world), lerp3(|v| v.normal));
+                    let s = shade_at(
+                        scene,
+                        obj,
+                        &self.views[t.object as usize],
+                        lerp3(|v| v.world),
+                        lerp3(|v| v.normal),
+                    );
                     term(output, &s)
                 }
             },

@@ -2,7 +2,7 @@
 
 use glam::{Mat4, Vec3};
 use phong_core::*;
-use phong_raster::{RenderOptions, coverage_counts, render, sample_pattern};
+use phong_raster::{RenderOptions, coverage_counts, sample_pattern};
 
 fn ortho_camera(height: f32) -> Camera {
     Camera::new(
@@ -34,6 +34,7 @@ fn scene(w: u32, h: u32, camera: Camera, objects: Vec<Object>, lighting: Lightin
         camera,
         lighting,
         objects,
+        labels: Vec::new(),
     }
 }
 
@@ -42,7 +43,22 @@ fn obj(mesh: Mesh, material: Material) -> Object {
         name: "test".into(),
         mesh,
         material,
+        shading: ShadingSettings {
+            options: ShadingOptions::default(),
+            interpolation: Interpolation::Phong,
+            viewer: Viewer::Local,
+            output: Output::Color,
+        },
     }
+}
+
+/// Renders with the scene's shading settings given to every object (the tests set `s.shading`).
+fn render(s: &Scene, o: &RenderOptions) -> Result<Image, phong_raster::Error> {
+    let mut s = s.clone();
+    for ob in &mut s.objects {
+        ob.shading = s.shading;
+    }
+    phong_raster::render(&s, o)
 }
 
 fn one_light(dir: Vec3) -> Lighting {

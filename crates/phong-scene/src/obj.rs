@@ -266,7 +266,7 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
     };
     let loaded = tobj::load_obj_buf(&mut BufReader::new(src.as_bytes()), &opts, |mtl: &Path| {
         let p: PathBuf = dir.join(mtl);
-        let text = match read(&p) {
+        let text = match std::fs::read_to_string(&p) {
             Ok(t) => t,
             Err(e) => {
                 // Locate the mtllib line for the message.

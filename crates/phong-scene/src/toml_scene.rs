@@ -8,7 +8,7 @@ use crate::{Error, Loaded, load_obj};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS, SAMPLE_COUNTS};
 use phong_core::{
-    Attenuation, Camera, Color, Encoding, ImageSettings, Interpolation, Light, LightColor, Lighting, LyonLambda,
+    Attenuation, Camera, Color, Encoding, ImageSettings, Interpolation, Label, Light, LightColor, Lighting, LyonLambda,
     Material, Mesh, Normalization, Object, Output, Projection, Scene, ShadingOptions, ShadingSettings, SpecularModel,
     Viewer, nearest_names, primitives,
 };
@@ -31,6 +31,17 @@ struct RawScene {
     materials: BTreeMap<String, S<RawMaterial>>,
     #[serde(default)]
     object: Vec<S<RawObject>>,
+    #[serde(default)]
+    label: Vec<S<RawLabel>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLabel {
+    text: S<String>,
+    position: S<Vec<f32>>,
+    color: Option<S<Vec<f32>>>,
+    size: Option<S<i64>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -144,6 +155,9 @@ struct RawObject {
     scale: Option<S<Scale>>,
     normals: Option<S<String>>,
     crease: Option<S<f32>>,
+    model: Option<S<String>>,
+    interpolation: Option<S<String>>,
+    output: Option<S<String>>,
 }
 
 /// The shading models of the `model` key and `--model`.
@@ -308,7 +322,13 @@ pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
             .split_once('=')
             .map(|(k, _)| k.trim().to_string())
             .filter(|k| !k.is_empty());
-        Error::at(path, src, offset, key.as_deref(), e.message().trim().to_string())
+        let message = e
+            .message()
+            .trim()
+            .replace("expected i64", "expected an integer")
+            .replace("expected f32", "expected a number")
+            .replace("expected a sequence", "expected an array");
+        Error::at(path, src, offset, key.as_deref(), message)
     })?;
     let mut ctx = Ctx {
         path,
@@ -352,9 +372,38 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
         let mat = material(ctx, m.get_ref(), &key, &named)?;
         named.insert(phong_core_name(name), mat);
     }
+    let lyon = match shading.options.specular {
+        SpecularModel::Lyon { squarings, lambda } => (squarings, lambda),
+        _ => (3, LyonLambda::Dot),
+    };
     let mut objects = Vec::new();
     for o in &raw.object {
-        objects.extend(object(ctx, o, &named)?);
+        let mut sh = shading;
+        let r = o.get_ref();
+        if let Some(m) = &r.model {
+            apply_model(&mut sh.options, ctx.choice(m, "model", MODELS)?, lyon);
+        }
+        if let Some(i) = &r.interpolation {
+            sh.interpolation = ctx.choice(i, "interpolation", INTERPOLATIONS)?;
+        }
+        if let Some(out) = &r.output {
+            sh.output = ctx.choice(out, "output", OUTPUTS)?;
+        }
+        objects.extend(object(ctx, o, &named, sh)?);
+    }
+    let mut labels = Vec::new();
+    for l in &raw.label {
+        let l = l.get_ref();
+        let size = match &l.size {
+            Some(sz) => ctx.int(sz, "size", 1, 64)? as u32,
+            None => 2,
+        };
+        labels.push(Label {
+            text: l.text.get_ref().clone(),
+            position: ctx.vec3(&l.position, "position")?,
+            color: ctx.opt_color(&l.color, "color")?.unwrap_or(Color::WHITE),
+            size,
+        });
     }
     Ok(Scene {
         image,
@@ -362,6 +411,7 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
         lighting,
         shading,
         objects,
+        labels,
     })
 }
 
@@ -649,7 +699,12 @@ fn lookup_material(ctx: &Ctx, name: &S<String>, named: &BTreeMap<String, Materia
     })
 }
 
-fn object(ctx: &mut Ctx, o: &S<RawObject>, named: &BTreeMap<String, Material>) -> Result<Vec<Object>, Error> {
+fn object(
+    ctx: &mut Ctx,
+    o: &S<RawObject>,
+    named: &BTreeMap<String, Material>,
+    shading: ShadingSettings,
+) -> Result<Vec<Object>, Error> {
     let span = o.span();
     let o = o.get_ref();
     let material = match &o.material {
@@ -738,6 +793,7 @@ fn object(ctx: &mut Ctx, o: &S<RawObject>, named: &BTreeMap<String, Material>) -
                 name: kind.to_string(),
                 mesh: mesh.transformed(&world_from_object),
                 material: material.unwrap_or_default(),
+                shading,
             }])
         }
         (None, Some(m)) => {
@@ -762,6 +818,7 @@ fn object(ctx: &mut Ctx, o: &S<RawObject>, named: &BTreeMap<String, Material>) -
                     name: p.name,
                     mesh: mesh.transformed(&world_from_object),
                     material: material.or(p.material).unwrap_or_default(),
+                    shading,
                 });
             }
             ctx.warnings.extend(warnings);
@@ -809,6 +866,12 @@ fn transform(ctx: &Ctx, o: &RawObject) -> Result<Mat4, Error> {
 pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
     let mut warnings = Vec::new();
     let parts = load_obj(path, &mut warnings)?;
+    let shading = ShadingSettings {
+        options: ShadingOptions::default(),
+        interpolation: Interpolation::Phong,
+        viewer: Viewer::Local,
+        output: Output::Color,
+    };
     let mut objects = Vec::new();
     for p in parts {
         let mesh = if p.has_normals {
@@ -820,6 +883,7 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
             name: p.name,
             mesh,
             material: p.material.unwrap_or_default(),
+            shading,
         });
     }
     let bounds = objects
@@ -859,13 +923,9 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
         },
         camera,
         lighting,
-        shading: ShadingSettings {
-            options: ShadingOptions::default(),
-            interpolation: Interpolation::Phong,
-            viewer: Viewer::Local,
-            output: Output::Color,
-        },
+        shading,
         objects,
+        labels: Vec::new(),
     };
     Ok(Loaded { scene, warnings })
 }

@@ -1,0 +1,139 @@
+//! Labels: 5×7 bitmap text stamped over a rendered image (the names under
+//! the teapots of the gallery, the terms of a decomposition). Backend
+//! independent: applied to the [`Image`] after rendering.
+
+use crate::{Camera, Color, Image, Label};
+use glam::Vec4;
+
+/// Rows of a glyph, top first; bit 4 is the leftmost pixel.
+fn glyph(c: char) -> [u8; 7] {
+    match c.to_ascii_uppercase() {
+        'A' => [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
+        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
+        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
+        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
+        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
+        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
+        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
+        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
+        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
+        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
+        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
+        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
+        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
+        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
+        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
+        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
+        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
+        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
+        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
+        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
+        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
+        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
+        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
+        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
+        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
+        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
+        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
+        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
+        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
+        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
+        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
+        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
+        ' ' => [0; 7],
+        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
+        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
+        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
+        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
+        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
+        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
+        '*' => [0, 0x04, 0x15, 0x0E, 0x15, 0x04, 0],
+        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
+        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
+        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
+        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
+        '^' => [0x04, 0x0A, 0x11, 0, 0, 0, 0],
+        _ => [0x0E, 0x11, 0x01, 0x02, 0x04, 0, 0x04], // '?'
+    }
+}
+
+/// Draws `text` with its top-left corner at pixel `(x, y)`, `size` pixels
+/// per font pixel, 6 font pixels per character; clipped to the image.
+pub fn draw_text(image: &mut Image, x: i64, y: i64, text: &str, color: Color, size: u32) {
+    let size = i64::from(size.max(1));
+    let (w, h) = (i64::from(image.width()), i64::from(image.height()));
+    for (i, ch) in text.chars().enumerate() {
+        let rows = glyph(ch);
+        let gx = x + i as i64 * 6 * size;
+        for (r, bits) in rows.iter().enumerate() {
+            for col in 0..5 {
+                if bits & (0x10 >> col) == 0 {
+                    continue;
+                }
+                for dy in 0..size {
+                    for dx in 0..size {
+                        let px = gx + col * size + dx;
+                        let py = y + r as i64 * size + dy;
+                        if (0..w).contains(&px) && (0..h).contains(&py) {
+                            image.pixels_mut()[(py * w + px) as usize] = [color.r, color.g, color.b, 1.0];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Width and height in pixels of `text` drawn at `size`.
+pub fn text_size(text: &str, size: u32) -> (u32, u32) {
+    let n = text.chars().count() as u32;
+    ((n * 6).saturating_sub(1) * size, 7 * size)
+}
+
+/// Draws each label centred on the projection of its world position; labels
+/// behind the camera are skipped.
+pub fn draw_labels(image: &mut Image, camera: &Camera, labels: &[Label]) {
+    let (w, h) = (image.width() as f32, image.height() as f32);
+    let m = camera.clip_from_world(w / h);
+    for l in labels {
+        let c = m * Vec4::from((l.position, 1.0));
+        if c.w <= 0.0 || !c.is_finite() {
+            continue;
+        }
+        let sx = (c.x / c.w * 0.5 + 0.5) * w;
+        let sy = (0.5 - c.y / c.w * 0.5) * h;
+        let (tw, th) = text_size(&l.text, l.size);
+        draw_text(
+            image,
+            (sx - tw as f32 / 2.0).round() as i64,
+            (sy - th as f32 / 2.0).round() as i64,
+            &l.text,
+            l.color,
+            l.size,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draws_glyph_bits() {
+        let mut img = Image::new(20, 10, [0.0; 4]).unwrap();
+        draw_text(&mut img, 1, 1, "L", Color::WHITE, 1);
+        // 'L': the left column (x = 1) lit on all 7 rows, the bottom row (y = 7) lit on 5 pixels.
+        for y in 1..8 {
+            assert_eq!(img.get(1, y), [1.0; 4]);
+            assert_eq!(img.get(2, y)[0], if y == 7 { 1.0 } else { 0.0 });
+        }
+        assert_eq!(img.get(6, 7)[0], 0.0);
+        assert_eq!(text_size("abc", 2), (34, 14));
+        // Off-image text is clipped, not a panic.
+        draw_text(&mut img, -100, 5, "OFF IMAGE", Color::WHITE, 3);
+    }
+}

@@ -1,0 +1,301 @@
+//! Scene files: what they build, and every error path with its message and location.
+
+use phong_core::*;
+use phong_scene::{Error, parse_scene};
+use std::path::Path;
+
+fn parse(src: &str) -> Result<Scene, Error> {
+    parse_scene(src, Path::new("scene.toml")).map(|l| l.scene)
+}
+
+/// The error message for `src`, which must fail.
+fn err(src: &str) -> String {
+    match parse(src) {
+        Ok(_) => panic!("expected an error for:\n{src}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_err(src: &str, want: &[&str]) {
+    let e = err(src);
+    for w in want {
+        assert!(e.contains(w), "error {e:?} lacks {w:?}");
+    }
+}
+
+#[test]
+fn empty_scene_has_opengl_defaults() {
+    let s = parse("").unwrap();
+    assert_eq!((s.image.width, s.image.height, s.image.samples), (800, 600, 1));
+    assert_eq!(s.lighting.ambient(), Color::splat(0.2));
+    // No light: one white directional light from the camera (travelling along its view direction).
+    assert_eq!(s.lighting.lights().len(), 1);
+    assert_eq!(s.lighting.lights()[0].to_light(), Some(-s.camera.forward()));
+    assert_eq!(s.shading.options, ShadingOptions::default());
+    assert_eq!(s.shading.viewer, Viewer::Local);
+    assert!(s.objects.is_empty());
+}
+
+#[test]
+fn objects_materials_and_transforms() {
+    let s = parse(
+        r#"
+[camera]
+projection = "orthographic"
+height = 4
+[materials.clay]
+paint = [0.8, 0.5, 0.3]
+shininess = 8
+[materials.shiny]
+base = "gold"
+shininess = 100
+[[object]]
+shape = "sphere"
+segments = 16
+material = "clay"
+position = [1, 2, 3]
+scale = 2
+[[object]]
+shape = "cube"
+material = { diffuse = [0.1, 0.2, 0.3] }
+rotation = [0, 90, 0]
+[[object]]
+shape = "torus"
+radius = 2
+tube = 0.5
+material = "Shiny"
+"#,
+    )
+    .unwrap();
+    assert_eq!(s.shading.viewer, Viewer::Infinite);
+    let clay = s.objects[0].material;
+    assert_eq!(clay.ambient(), Color::new(0.8, 0.5, 0.3));
+    assert_eq!(clay.specular(), Color::WHITE);
+    // Sphere of radius 2 at (1, 2, 3): every vertex at distance 2.
+    for p in s.objects[0].mesh.positions() {
+        assert!(((*p - glam::Vec3::new(1.0, 2.0, 3.0)).length() - 2.0).abs() < 1e-5);
+    }
+    // Inline material: the rest from OpenGL's default material.
+    assert_eq!(s.objects[1].material.diffuse(), Color::new(0.1, 0.2, 0.3));
+    assert_eq!(s.objects[1].material.ambient(), Color::splat(0.2));
+    // base = "gold" with shininess overridden.
+    let gold = Material::named("gold").unwrap();
+    assert_eq!(s.objects[2].material.diffuse(), gold.diffuse());
+    assert_eq!(s.objects[2].material.shininess(), 100.0);
+    // Torus radius 2, tube 0.5: x extent 2.5.
+    let (lo, hi) = s.objects[2].mesh.bounds().unwrap();
+    assert!((hi.x - 2.5).abs() < 1e-4 && (lo.x + 2.5).abs() < 1e-4);
+}
+
+#[test]
+fn models_and_options() {
+    let s = parse("[shading]\nmodel = \"phong-lyon\"\nlyon_squarings = 4\nlyon_lambda = \"difference\"\n").unwrap();
+    assert_eq!(
+        s.shading.options.specular,
+        SpecularModel::Lyon {
+            squarings: 4,
+            lambda: LyonLambda::Difference
+        }
+    );
+    let s = parse("[shading]\nmodel = \"opengl\"\ntwo_sided = true\n").unwrap();
+    assert_eq!(s.shading.options, ShadingOptions::opengl(true));
+    let s = parse("[shading]\nmodel = \"lambert\"\nnormalization = \"blinn-phong-exact\"\nclamp = false\n").unwrap();
+    assert_eq!(s.shading.options.specular, SpecularModel::None);
+    assert_eq!(s.shading.options.normalization, Normalization::BlinnPhongExact);
+    assert!(!s.shading.options.clamp);
+}
+
+#[test]
+fn lights() {
+    let s = parse(
+        r#"
+[[light]]
+type = "point"
+position = [0, 1, 0]
+attenuation = [1, 0.5, 0.25]
+ambient = [0.1, 0.1, 0.1]
+[[light]]
+type = "spot"
+position = [0, 4, 0]
+direction = [0, -1, 0]
+cutoff = 25
+exponent = 8
+color = [1, 0, 0]
+"#,
+    )
+    .unwrap();
+    let l = s.lighting.lights();
+    assert_eq!(l.len(), 2);
+    assert_eq!(l[0].attenuation().unwrap().coefficients(), [1.0, 0.5, 0.25]);
+    assert_eq!(l[0].color().ambient(), Color::splat(0.1));
+    assert_eq!(l[1].color().diffuse(), Color::new(1.0, 0.0, 0.0));
+    assert_eq!(l[1].spot_cone().unwrap().1, 25.0);
+}
+
+#[test]
+fn syntax_and_type_errors_have_line_column_and_key() {
+    assert_err(
+        "[image]\nwidth = 800\nheight = \"tall\"\n",
+        &["scene.toml:3:10", "`height`", "invalid type"],
+    );
+    assert_err("[image\nwidth = 1\n", &["scene.toml:1:"]);
+    assert_err("[image]\nwidht = 800\n", &["scene.toml:2:1", "unknown field `widht`"]);
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\ncolour = [1, 0, 0]\n",
+        &["scene.toml:3:1", "unknown field `colour`"],
+    );
+    assert_err("[camara]\n", &["scene.toml:1:", "unknown field `camara`"]);
+}
+
+#[test]
+fn value_errors_have_line_column_and_key() {
+    assert_err(
+        "[image]\nwidth = 1000000\n",
+        &["scene.toml:2:9", "`width`", "from 1 to 16384", "1000000"],
+    );
+    assert_err("[image]\nheight = 0\n", &["scene.toml:2:10", "`height`"]);
+    assert_err(
+        "[image]\nantialias = 3\n",
+        &["scene.toml:2:13", "`antialias`", "1, 4 or 16"],
+    );
+    assert_err("[image]\nbackground = [1, 2]\n", &["scene.toml:2:14", "`background`"]);
+    assert_err("[camera]\nfov = 200\n", &["scene.toml:2:7", "`fov`", "(0, 180)"]);
+    assert_err("[camera]\nnear = -1\n", &["scene.toml:2:8", "`near`"]);
+    assert_err("[camera]\nnear = 5\nfar = 1\n", &["scene.toml:3:7", "`far`"]);
+    assert_err("[camera]\nposition = [0, 0, 0]\n", &["scene.toml:2:12", "`camera`"]);
+    assert_err(
+        "[camera]\nposition = [0, 0]\n",
+        &["scene.toml:2:12", "`position`", "3 numbers"],
+    );
+    assert_err(
+        "[materials.bad]\nshininess = -1\n",
+        &["scene.toml:2:13", "`shininess`", ">= 0", "-1"],
+    );
+    assert_err(
+        "[materials.bad]\ndiffuse = [0.5, -0.1, 0]\n",
+        &["scene.toml:2:11", "`diffuse`", ">= 0"],
+    );
+    assert_err("[materials.bad]\nalpha = 2\n", &["scene.toml:2:9", "`alpha`"]);
+    assert_err(
+        "[shading]\nambient = [nan, 0, 0]\n",
+        &["scene.toml:2:11", "`ambient`", "finite"],
+    );
+    assert_err(
+        "[shading]\nmodel = \"opengl\"\nnormalization = \"phong\"\n",
+        &["scene.toml:3:17", "`normalization`"],
+    );
+}
+
+#[test]
+fn misspelled_choices_get_did_you_mean() {
+    assert_err(
+        "[shading]\nmodel = \"blin-phong\"\n",
+        &["scene.toml:2:9", "`model`", "did you mean \"blinn-phong\""],
+    );
+    assert_err("[shading]\ninterpolation = \"gourad\"\n", &["did you mean \"gouraud\""]);
+    assert_err("[shading]\noutput = \"specullar\"\n", &["did you mean \"specular\""]);
+    assert_err(
+        "[camera]\nprojection = \"ortho\"\n",
+        &["`projection`", "\"orthographic\""],
+    );
+    assert_err(
+        "[[light]]\ntype = \"spotlight\"\n",
+        &["scene.toml:2:8", "`type`", "\"spot\""],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphear\"\n",
+        &["scene.toml:2:9", "did you mean \"sphere\""],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nmaterial = \"emrald\"\n",
+        &["scene.toml:3:12", "`material`", "did you mean emerald"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nnormals = \"smoth\"\n",
+        &["`normals`", "\"smooth\""],
+    );
+}
+
+#[test]
+fn light_errors() {
+    assert_err(
+        "[[light]]\ntype = \"directional\"\n",
+        &["scene.toml:1:1", "`direction`", "needs"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"directional\"\ndirection = [0, 0, 0]\n",
+        &["scene.toml:3:13", "`direction`", "non-zero"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nattenuation = [0, 0, 1]\n",
+        &["scene.toml:4:15", "`attenuation`", "never reaches 0"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\ncutoff = 10\n",
+        &["`cutoff`", "has no"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n",
+        &["`cutoff`", "needs"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\ncutoff = 120\n",
+        &["scene.toml:5:10", "[0, 90]"],
+    );
+    assert_err(
+        "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\ncolor = [1, 1, -1]\n",
+        &["scene.toml:4:9", "`color`"],
+    );
+}
+
+#[test]
+fn object_errors() {
+    assert_err(
+        "[[object]]\nmaterial = \"gold\"\n",
+        &["scene.toml:1:1", "`object`", "needs `shape`"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nsegments = 2\n",
+        &["scene.toml:3:12", "`segments`", "from 3"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nsegments = 100000\n",
+        &["`segments`", "4096"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nradius = 2\n",
+        &["scene.toml:3:10", "only a torus"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nscale = 0\n",
+        &["scene.toml:3:9", "`scale`", "non-zero"],
+    );
+    assert_err("[[object]]\nshape = \"sphere\"\nscale = [1, 2]\n", &["`scale`"]);
+    assert_err(
+        "[[object]]\nmesh = \"missing.obj\"\n",
+        &["scene.toml:2:8", "`mesh`", "file not found", "missing.obj"],
+    );
+    assert_err(
+        "[[object]]\nshape = \"cube\"\nmesh = \"x.obj\"\n",
+        &["`mesh`", "not both"],
+    );
+}
+
+#[test]
+fn meshes_load_relative_to_the_scene() {
+    let dir = std::env::temp_dir().join(format!("phong-scene-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    let path = dir.join("s.toml");
+    let l = parse_scene("[[object]]\nmesh = \"tri.obj\"\nnormals = \"flat\"\n", &path).unwrap();
+    assert_eq!(l.scene.objects.len(), 1);
+    assert_eq!(l.scene.objects[0].mesh.normals()[0], glam::Vec3::Z);
+    let e = parse_scene("[[object]]\nmesh = \"bad.obj\"\n", &path)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.obj:3:7: `f`: vertex index 7 is out of range"), "{e}");
+    // Through `load`, a missing file is named.
+    let e = phong_scene::load(&dir.join("nope.toml")).unwrap_err();
+    assert!(e.is_input() && e.to_string().contains("nope.toml"), "{e}");
+}
