@@ -1,0 +1,288 @@
+//! The real `phong` binary, as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn phong(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_phong"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run phong")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("phong-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Decodes a PNG: (width, height, channels, bytes).
+fn read_png(p: &Path) -> (u32, u32, usize, Vec<u8>) {
+    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(p).unwrap()));
+    let mut r = dec.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size().unwrap()];
+    let info = r.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, info.color_type.samples(), buf)
+}
+
+fn examples() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_example_scene_renders() {
+    let scenes = examples();
+    assert!(scenes.len() >= 7, "{scenes:?}");
+    for s in scenes {
+        let out = tmp(&format!("{}.png", s.file_stem().unwrap().to_string_lossy()));
+        let o = phong(&[
+            "render",
+            s.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "240",
+            "--height",
+            "160",
+        ]);
+        assert!(o.status.success(), "{}: {}", s.display(), stderr(&o));
+        let (w, h, _, bytes) = read_png(&out);
+        assert_eq!((w, h), (240, 160));
+        // Something was drawn: not a single colour.
+        assert!(bytes.chunks(3).any(|p| p != &bytes[..3]), "{} is blank", s.display());
+    }
+}
+
+/// The README's quick-start render command, exactly as written there.
+#[test]
+fn readme_render_command_works() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let line = readme
+        .lines()
+        .find(|l| l.starts_with("cargo run --release -- render "))
+        .expect("README has a render command");
+    let args: Vec<&str> = line
+        .trim_start_matches("cargo run --release -- ")
+        .split_whitespace()
+        .collect();
+    let out_pos = args.iter().position(|a| *a == "-o").unwrap() + 1;
+    let out = tmp("readme.png");
+    let mut args = args.clone();
+    args[out_pos] = out.to_str().unwrap();
+    let o = phong(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.is_file());
+    assert!(readme.contains("cargo test --workspace"));
+}
+
+#[test]
+fn obj_model_renders_alone() {
+    let out = tmp("knot.png");
+    let o = phong(&[
+        "render",
+        "examples/scenes/assets/knot.obj",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "200",
+        "--height",
+        "150",
+        "-v",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("triangles=5120") && e.contains("png="), "{e}");
+    assert_eq!(read_png(&out).0, 200);
+}
+
+#[test]
+fn bad_input_exits_2_with_location() {
+    let scene = tmp("bad.toml");
+    std::fs::write(
+        &scene,
+        "[image]\nwidth = 800\n\n[[object]]\nshape = \"sphere\"\nmaterial = \"emrald\"\n",
+    )
+    .unwrap();
+    let out = tmp("bad.png");
+    std::fs::write(&out, b"previous").unwrap();
+    let o = phong(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.contains("bad.toml:6:12: `material`: unknown material \"emrald\"; did you mean emerald?"),
+        "{e}"
+    );
+    assert!(!e.contains("panicked"));
+    // The previous file is untouched: never a partial output.
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+
+    let o = phong(&["render", "does/not/exist.toml", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("cannot read does/not/exist.toml"), "{}", stderr(&o));
+
+    let o = phong(&["render", "examples/scenes/tour.toml", "-o", "x.jpg"]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = phong(&[
+        "render",
+        "examples/scenes/tour.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "1000000",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--width must be from 1 to 16384"));
+    let o = phong(&[
+        "render",
+        "examples/scenes/tour.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--model",
+        "blin",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("did you mean \"blinn-phong\""), "{}", stderr(&o));
+    let o = phong(&[
+        "render",
+        "examples/scenes/tour.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--antialias",
+        "8",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn unwritable_output_exits_1_and_leaves_nothing() {
+    let dir = tmp("no-such-dir");
+    let out = dir.join("x.png");
+    let o = phong(&[
+        "render",
+        "examples/scenes/terms.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "32",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot write"), "{}", stderr(&o));
+    assert!(!dir.exists());
+}
+
+/// `--model lambert --output specular`: no specular anywhere, so the objects are black.
+#[test]
+fn flags_override_the_file() {
+    let out = tmp("spec.png");
+    let args = [
+        "render",
+        "examples/scenes/tour.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "80",
+        "--height",
+        "60",
+    ];
+    let mut with = args.to_vec();
+    with.extend(["--model", "lambert", "--output", "specular", "--antialias", "1"]);
+    assert!(phong(&with).status.success());
+    let (_, _, _, bytes) = read_png(&out);
+    let bg = [13u8, 13, 20]; // [0.05, 0.05, 0.08] · 255, rounded
+    assert!(
+        bytes.chunks(3).all(|p| p == bg || p == [0, 0, 0]),
+        "specular without a specular term"
+    );
+    assert!(bytes.chunks(3).any(|p| p == [0, 0, 0]));
+    let mut normal = args.to_vec();
+    normal.extend(["--output", "normal", "--interpolation", "flat"]);
+    assert!(phong(&normal).status.success());
+}
+
+#[test]
+fn materials_lists_29_and_shows_one() {
+    let o = phong(&["materials"]);
+    assert!(o.status.success());
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(s.lines().count(), 30, "{s}");
+    assert!(s.contains("polished_bronze"));
+    let o = phong(&["materials", "Polished Bronze"]);
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        s.contains("shininess 76.8") && s.contains("0.774597 0.458561 0.200621"),
+        "{s}"
+    );
+    let o = phong(&["materials", "bronz"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("did you mean bronze"));
+}
+
+/// Golden images: small renders compared with tests/golden/*.png within 1/255 (float
+/// differences across compilers); on failure the actual image and a difference image are
+/// written beside them. Re-bless with `PHONG_BLESS=1 cargo test -p phong-cli --test cli golden`.
+#[test]
+fn golden_images() {
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let bless = std::env::var_os("PHONG_BLESS").is_some();
+    let mut failures = Vec::new();
+    for name in ["terms", "gouraud_vs_phong", "teapots", "tour"] {
+        let scene = format!("examples/scenes/{name}.toml");
+        let out = tmp(&format!("golden-{name}.png"));
+        let o = phong(&[
+            "render",
+            &scene,
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "300",
+            "--height",
+            "150",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let want_path = golden.join(format!("{name}.png"));
+        if bless {
+            std::fs::copy(&out, &want_path).unwrap();
+            continue;
+        }
+        let (_, _, ch, got) = read_png(&out);
+        let (_, _, ch2, want) = read_png(&want_path);
+        assert_eq!((ch, got.len()), (ch2, want.len()), "{name}: size");
+        let worst = got.iter().zip(&want).map(|(a, b)| a.abs_diff(*b)).max().unwrap_or(0);
+        if worst > 1 {
+            std::fs::copy(&out, golden.join(format!("{name}.actual.png"))).unwrap();
+            let diff: Vec<u8> = got
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| a.abs_diff(*b).saturating_mul(16))
+                .collect();
+            let f = std::fs::File::create(golden.join(format!("{name}.diff.png"))).unwrap();
+            let mut enc = png::Encoder::new(f, 300, 150);
+            enc.set_color(if ch == 4 {
+                png::ColorType::Rgba
+            } else {
+                png::ColorType::Rgb
+            });
+            enc.write_header().unwrap().write_image_data(&diff).unwrap();
+            failures.push(format!("{name}: largest difference {worst}/255"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}
