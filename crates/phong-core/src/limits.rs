@@ -33,3 +33,8 @@ pub const MAX_LIGHTS: usize = 1024;
 
 /// Most segments for a tessellated primitive (4096² quads is already 33M triangles).
 pub const MAX_SEGMENTS: u32 = 4096;
+
+/// Most triangles one tessellated primitive may have (16M: about 1.5 GiB of
+/// mesh and transformed vertices), so that a large `segments` is an error,
+/// not an out-of-memory abort.
+pub const MAX_PRIMITIVE_TRIANGLES: u64 = 1 << 24;

@@ -762,6 +762,24 @@ fn object(
                 Some(s) => ctx.int(s, "segments", min, i64::from(MAX_SEGMENTS))? as u32,
                 None => default_segments,
             };
+            let n = u64::from(segments);
+            let triangles = match kind {
+                "teapot" => 64 * n * n,
+                "plane" => 2 * n * n,
+                "cube" => 12,
+                _ => n * n + 4 * n,
+            };
+            if triangles > phong_core::limits::MAX_PRIMITIVE_TRIANGLES {
+                let span = o.segments.as_ref().map_or(span.clone(), |s| s.span());
+                return ctx.err(
+                    &span,
+                    "segments",
+                    format!(
+                        "a {kind} with {segments} segments has about {triangles} triangles; the limit is {}",
+                        phong_core::limits::MAX_PRIMITIVE_TRIANGLES
+                    ),
+                );
+            }
             if kind != "torus" {
                 for (v, key) in [(&o.radius, "radius"), (&o.tube, "tube")] {
                     if let Some(v) = v {
