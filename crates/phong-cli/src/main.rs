@@ -23,11 +23,23 @@ struct Cli {
 enum Command {
     /// Render a scene file (.toml) or an OBJ model (.obj) to a PNG.
     Render(RenderArgs),
+    /// Render a scene repeatedly and print the time per frame.
+    Bench(BenchArgs),
     /// List the built-in materials, or show one.
     Materials {
         /// A material name (case, spaces, '-' and '_' ignored).
         name: Option<String>,
     },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Backend {
+    /// The multi-core CPU rasteriser.
+    Cpu,
+    /// The wgpu renderer (an error when no adapter is found).
+    Gpu,
+    /// The GPU when an adapter is found, else the CPU.
+    Auto,
 }
 
 #[derive(clap::Args)]
@@ -55,15 +67,41 @@ struct RenderArgs {
     /// What to show: color, ambient, diffuse, specular, normal, depth.
     #[arg(long = "output", value_name = "TERM")]
     term: Option<String>,
-    /// Rendering threads (default: all cores).
+    /// Rendering threads for the CPU backend (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Print counts and the time of each stage.
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    backend: Backend,
+    /// Print counts, the backend and the time of each stage.
     #[arg(short, long)]
     verbose: bool,
 }
 
-/// An error in what the user gave (exit code 2).
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scene file (.toml) or model (.obj).
+    input: PathBuf,
+    /// Frames to time, after one warm-up frame.
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Rendering threads for the CPU backend (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Image width (overrides the scene).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (overrides the scene).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    backend: Backend,
+    /// Print the time of each stage.
+    #[arg(short, long)]
+    verbose: bool,
+}
+
 #[derive(Debug)]
 struct InputError(String);
 impl std::fmt::Display for InputError {
@@ -81,6 +119,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(args),
+        Command::Bench(args) => bench(args),
         Command::Materials { name } => materials(name.as_deref()),
     };
     match result {
@@ -92,6 +131,10 @@ fn main() -> ExitCode {
                     || c.downcast_ref::<phong_scene::Error>().is_some_and(|e| e.is_input())
                     || c.downcast_ref::<phong_core::Error>().is_some()
                     || matches!(
+                        c.downcast_ref::<phong_gpu::Error>(),
+                        Some(phong_gpu::Error::Samples(_) | phong_gpu::Error::Limit { .. } | phong_gpu::Error::Core(_))
+                    )
+                    || matches!(
                         c.downcast_ref::<phong_raster::Error>(),
                         Some(phong_raster::Error::Samples(_) | phong_raster::Error::TooLarge { .. })
                     )
@@ -101,25 +144,65 @@ fn main() -> ExitCode {
     }
 }
 
-fn render(a: RenderArgs) -> Result<()> {
-    let t0 = Instant::now();
-    let is_png = a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !is_png {
-        bail!(InputError(format!("output {} must be a .png file", a.output.display())));
+/// The GPU when asked for (an error if there is none), or for `auto` when one is found.
+fn open_gpu(backend: Backend) -> Result<Option<phong_gpu::Gpu>> {
+    match backend {
+        Backend::Cpu => Ok(None),
+        Backend::Gpu => Ok(Some(phong_gpu::Gpu::new().context("--backend gpu")?)),
+        Backend::Auto => Ok(phong_gpu::Gpu::new().ok()),
     }
-    let loaded = phong_scene::load(&a.input)?;
-    for w in &loaded.warnings {
-        eprintln!("warning: {w}");
-    }
-    let mut scene = loaded.scene;
+}
+
+/// Times of one render: (setup or upload, raster or GPU render pass, read-back).
+fn render_once(
+    scene: &phong_core::Scene,
+    gpu: Option<&phong_gpu::Gpu>,
+    options: &RenderOptions,
+) -> Result<(phong_core::Image, [Duration; 3], usize, u64)> {
+    Ok(match gpu {
+        Some(g) => {
+            let (img, st) = g.render(scene)?;
+            (img, [st.upload, st.render, st.readback], st.triangles, 0)
+        }
+        None => {
+            let (img, st) = render_with_stats(scene, options)?;
+            (
+                img,
+                [st.setup, st.raster, Duration::ZERO],
+                st.triangles_drawn,
+                st.pixels_shaded,
+            )
+        }
+    })
+}
+
+fn check_size(width: Option<u32>, height: Option<u32>) -> Result<()> {
     let max = phong_core::limits::MAX_IMAGE_DIMENSION;
-    for (flag, v) in [("--width", a.width), ("--height", a.height)] {
+    for (flag, v) in [("--width", width), ("--height", height)] {
         if let Some(v) = v
             && !(1..=max).contains(&v)
         {
             bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
         }
     }
+    Ok(())
+}
+
+fn render(a: RenderArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let is_png = a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        bail!(InputError(format!("output {} must be a .png file", a.output.display())));
+    }
+    check_size(a.width, a.height)?;
+    if a.threads == Some(0) {
+        bail!(InputError("--threads must be at least 1".into()));
+    }
+    let loaded = phong_scene::load(&a.input)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let mut scene = loaded.scene;
     if let Some(w) = a.width {
         scene.image.width = w;
     }
@@ -163,11 +246,9 @@ fn render(a: RenderArgs) -> Result<()> {
             sh.output = t;
         }
     }
-    if a.threads == Some(0) {
-        bail!(InputError("--threads must be at least 1".into()));
-    }
     let t_load = t0.elapsed();
 
+    let gpu = open_gpu(a.backend)?;
     let bar = ProgressBar::hidden();
     bar.set_style(ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed}").expect("valid template"));
     let tty = std::io::stderr().is_terminal();
@@ -185,19 +266,25 @@ fn render(a: RenderArgs) -> Result<()> {
         threads: a.threads,
         progress: Some(&progress),
     };
-    let (mut image, stats) =
-        render_with_stats(&scene, &options).with_context(|| format!("rendering {}", a.input.display()))?;
+    let (mut image, times, triangles, shaded) =
+        render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.input.display()))?;
     bar.finish_and_clear();
     phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
     let t_write = Instant::now();
     phong_scene::write_png(&a.output, &image, scene.image.encoding)?;
     let t_write = t_write.elapsed();
     if a.verbose {
-        let threads = a
-            .threads
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let backend = match &gpu {
+            Some(g) => format!("gpu, {}", g.adapter_name()),
+            None => {
+                let n = a
+                    .threads
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+                format!("cpu, {n} threads")
+            }
+        };
         eprintln!(
-            "phong: {} -> {}: {}x{} x{} samples, backend cpu ({threads} threads)",
+            "phong: {} -> {}: {}x{} x{} samples, backend {backend}",
             a.input.display(),
             a.output.display(),
             scene.image.width,
@@ -205,18 +292,84 @@ fn render(a: RenderArgs) -> Result<()> {
             scene.image.samples
         );
         eprintln!(
-            "phong: triangles={} drawn={} pixels_shaded={}",
-            stats.triangles, stats.triangles_drawn, stats.pixels_shaded
+            "phong: triangles={} drawn={triangles} pixels_shaded={shaded}",
+            scene.triangle_count()
         );
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let (first, second) = if gpu.is_some() {
+            ("upload", "render")
+        } else {
+            ("setup", "raster+shade+resolve")
+        };
         eprintln!(
-            "phong: load={:.1}ms setup={:.1}ms raster+shade+resolve={:.1}ms png={:.1}ms total={:.1}ms",
+            "phong: load={:.1}ms {first}={:.1}ms {second}={:.1}ms readback={:.1}ms png={:.1}ms total={:.1}ms",
             ms(t_load),
-            ms(stats.setup),
-            ms(stats.raster),
+            ms(times[0]),
+            ms(times[1]),
+            ms(times[2]),
             ms(t_write),
             ms(t0.elapsed())
         );
+    }
+    Ok(())
+}
+
+/// `phong bench`: one warm-up render, then `frames` timed renders, reported as the mean per
+/// frame of the rendering alone: setup and raster on the CPU; the render pass on the GPU, with
+/// upload and read-back printed separately by -v.
+fn bench(a: BenchArgs) -> Result<()> {
+    if a.frames == 0 || a.threads == Some(0) {
+        bail!(InputError("--frames and --threads must be at least 1".into()));
+    }
+    check_size(a.width, a.height)?;
+    let mut scene = phong_scene::load(&a.input)?.scene;
+    if let Some(w) = a.width {
+        scene.image.width = w;
+    }
+    if let Some(h) = a.height {
+        scene.image.height = h;
+    }
+    let options = RenderOptions {
+        threads: a.threads,
+        progress: None,
+    };
+    let gpu = open_gpu(a.backend)?;
+    render_once(&scene, gpu.as_ref(), &options)?;
+    let mut sum = [Duration::ZERO; 3];
+    for _ in 0..a.frames {
+        let (_, t, _, _) = render_once(&scene, gpu.as_ref(), &options)?;
+        for k in 0..3 {
+            sum[k] += t[k];
+        }
+    }
+    let timed = if gpu.is_some() { sum[1] } else { sum[0] + sum[1] };
+    let per = timed.as_secs_f64() / f64::from(a.frames);
+    let pixels = f64::from(scene.image.width) * f64::from(scene.image.height);
+    println!(
+        "phong: {}x{} tris={} frames={} ms_per_frame={:.1} mpix_per_s={:.1}",
+        scene.image.width,
+        scene.image.height,
+        scene.triangle_count(),
+        a.frames,
+        per * 1e3,
+        pixels / per / 1e6
+    );
+    if a.verbose {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3 / f64::from(a.frames);
+        match &gpu {
+            Some(g) => eprintln!(
+                "phong: gpu ({}) per frame: upload={:.2}ms render={:.2}ms readback={:.2}ms",
+                g.adapter_name(),
+                ms(sum[0]),
+                ms(sum[1]),
+                ms(sum[2])
+            ),
+            None => eprintln!(
+                "phong: cpu per frame: setup+binning={:.2}ms raster+shade+resolve={:.2}ms",
+                ms(sum[0]),
+                ms(sum[1])
+            ),
+        }
     }
     Ok(())
 }

@@ -286,3 +286,50 @@ fn golden_images() {
     }
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// `--backend gpu` with no Vulkan driver: a clear error and exit code 1; `auto` falls back to
+/// the CPU. With a driver (lavapipe in CI), `--backend gpu` renders.
+#[test]
+fn gpu_backend_selection() {
+    let out = tmp("gpu.png");
+    let args = [
+        "render",
+        "examples/scenes/terms.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "120",
+        "--height",
+        "40",
+        "-v",
+    ];
+    let no_driver = |backend: &str| {
+        let mut a = args.to_vec();
+        a.extend(["--backend", backend]);
+        Command::new(env!("CARGO_BIN_EXE_phong"))
+            .args(&a)
+            .current_dir(root())
+            .env("VK_DRIVER_FILES", "/nonexistent")
+            .env("VK_ICD_FILENAMES", "/nonexistent")
+            .output()
+            .unwrap()
+    };
+    let o = no_driver("gpu");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no GPU adapter found"), "{}", stderr(&o));
+    let o = no_driver("auto");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("backend cpu"), "{}", stderr(&o));
+
+    let mut a = args.to_vec();
+    a.extend(["--backend", "gpu"]);
+    let o = phong(&a);
+    if o.status.success() {
+        assert!(stderr(&o).contains("backend gpu"), "{}", stderr(&o));
+        assert_eq!(read_png(&out).0, 120);
+    } else if std::env::var_os("PHONG_REQUIRE_GPU").is_some() {
+        panic!("PHONG_REQUIRE_GPU is set but: {}", stderr(&o));
+    } else {
+        eprintln!("skipped --backend gpu render: {}", stderr(&o));
+    }
+}

@@ -1,0 +1,222 @@
+//! The GPU backend against the core crate and the CPU renderer.
+//!
+//! Without a GPU adapter these tests print why they were skipped and pass; with
+//! `PHONG_REQUIRE_GPU=1` (CI, on Mesa's lavapipe) a missing adapter is a failure.
+
+use glam::Vec3;
+use phong_core::*;
+use phong_gpu::Gpu;
+use std::path::Path;
+
+fn gpu() -> Option<Gpu> {
+    match Gpu::new() {
+        Ok(g) => {
+            eprintln!("GPU adapter: {}", g.adapter_name());
+            Some(g)
+        }
+        Err(e) if std::env::var_os("PHONG_REQUIRE_GPU").is_some() => {
+            panic!("PHONG_REQUIRE_GPU is set but: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipped: {e}");
+            None
+        }
+    }
+}
+
+struct Rng(u64);
+impl Rng {
+    fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn range(&mut self, a: f32, b: f32) -> f32 {
+        a + (b - a) * self.f()
+    }
+    fn vec(&mut self, r: f32) -> Vec3 {
+        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
+    }
+    fn color(&mut self) -> Color {
+        Color::new(self.f(), self.f(), self.f())
+    }
+    fn pick<T: Copy>(&mut self, v: &[T]) -> T {
+        v[((self.f() * v.len() as f32) as usize).min(v.len() - 1)]
+    }
+}
+
+/// The WGSL port of `shade` against `phong_core::shade` on 4000 random cases: every model,
+/// normalization, option and light type. Tolerance: 1e-4 absolute, or 1e-4 relative for
+/// unclamped values above 1 (f32 `pow`, `sqrt` and division may differ by a few ulps on a
+/// GPU; the specular power amplifies that near grazing angles).
+#[test]
+fn wgsl_shade_matches_core() {
+    let Some(gpu) = gpu() else { return };
+    let mut r = Rng(7);
+    let models = [
+        SpecularModel::None,
+        SpecularModel::Phong,
+        SpecularModel::BlinnPhong,
+        SpecularModel::Lyon {
+            squarings: 3,
+            lambda: LyonLambda::Dot,
+        },
+        SpecularModel::Lyon {
+            squarings: 5,
+            lambda: LyonLambda::Difference,
+        },
+    ];
+    let norms = [
+        Normalization::None,
+        Normalization::Phong,
+        Normalization::BlinnPhong,
+        Normalization::BlinnPhongExact,
+    ];
+    let mut worst = 0.0f32;
+    for set in 0..8 {
+        let mut lights = Vec::new();
+        for _ in 0..(1 + set % 4) {
+            let color = LightColor::new(r.color() * 0.3, r.color(), r.color()).unwrap();
+            let att = Attenuation::new(r.range(0.5, 2.0), r.range(0.0, 0.5), r.range(0.0, 0.2)).unwrap();
+            lights.push(match r.pick(&[0, 1, 2]) {
+                0 => Light::directional(r.vec(1.0) + Vec3::splat(0.01), color).unwrap(),
+                1 => Light::point(r.vec(4.0), color, att).unwrap(),
+                _ => Light::spot(
+                    r.vec(4.0),
+                    r.vec(1.0) + Vec3::splat(0.01),
+                    r.range(5.0, 90.0),
+                    r.range(0.0, 20.0),
+                    color,
+                    att,
+                )
+                .unwrap(),
+            });
+        }
+        let lighting = Lighting::new(r.color() * 0.3, lights).unwrap();
+        let mut cases = Vec::new();
+        for _ in 0..500 {
+            let m = Material::new(r.color(), r.color(), r.color(), r.color() * 0.2, r.range(0.0, 200.0)).unwrap();
+            let options = ShadingOptions {
+                specular: r.pick(&models),
+                gate_specular: r.f() < 0.7,
+                clamp: r.f() < 0.5,
+                normalization: r.pick(&norms),
+                two_sided: r.f() < 0.3,
+            };
+            let settings = ShadingSettings {
+                options,
+                interpolation: Interpolation::Phong,
+                viewer: Viewer::Local,
+                output: Output::Color,
+            };
+            let view = if r.f() < 0.5 {
+                View::Local { eye: r.vec(6.0) }
+            } else {
+                View::Infinite { to_viewer: r.vec(1.0) }
+            };
+            let p = SurfacePoint {
+                position: r.vec(2.0),
+                normal: if r.f() < 0.02 { Vec3::ZERO } else { r.vec(1.0) },
+            };
+            cases.push((p, m, settings, view));
+        }
+        let got = gpu.shade_cases(&lighting, &cases).unwrap();
+        for ((p, m, s, v), g) in cases.iter().zip(&got) {
+            let want = shade(p, v, m, &lighting, &s.options);
+            for (a, b) in [
+                (g.ambient, want.ambient),
+                (g.diffuse, want.diffuse),
+                (g.specular, want.specular),
+                (g.color, want.color),
+            ] {
+                for (x, y) in a.to_array().into_iter().zip(b.to_array()) {
+                    let err = (x - y).abs() / y.abs().max(1.0);
+                    worst = worst.max(err);
+                    assert!(err < 1e-4, "case {p:?} {m:?} {s:?} {v:?}: gpu {g:?} core {want:?}");
+                }
+            }
+        }
+    }
+    eprintln!("largest WGSL vs core difference: {worst:e}");
+}
+
+fn load(name: &str) -> Scene {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/scenes")
+        .join(name);
+    phong_scene::load(&p).unwrap().scene
+}
+
+/// Every example scene on both backends: at least 99.5% of pixels within 2/255 per channel
+/// (8-bit encoded), the rest on silhouettes and edges. On failure the GPU image and a
+/// difference image are written to the temporary directory.
+#[test]
+fn example_scenes_match_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| {
+            let n = e.unwrap().file_name().to_string_lossy().into_owned();
+            n.ends_with(".toml").then_some(n)
+        })
+        .collect();
+    names.sort();
+    assert!(names.len() >= 7);
+    for name in names {
+        let mut scene = load(&name);
+        scene.image.width = 320;
+        scene.image.height = 200;
+        let cpu = phong_raster::render(&scene, &Default::default()).unwrap();
+        let (gimg, _) = gpu.render(&scene).unwrap();
+        let enc = scene.image.encoding;
+        let alpha = cpu.has_transparency();
+        let (a, b) = (cpu.to_bytes(enc, alpha), gimg.to_bytes(enc, alpha));
+        let ch = if alpha { 4 } else { 3 };
+        let bad = a
+            .chunks(ch)
+            .zip(b.chunks(ch))
+            .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 2))
+            .count();
+        let total = (scene.image.width * scene.image.height) as usize;
+        let frac = bad as f64 / total as f64;
+        eprintln!(
+            "{name}: {bad} of {total} pixels differ by more than 2/255 ({:.3}%)",
+            frac * 100.0
+        );
+        if frac > 0.005 {
+            let out = std::env::temp_dir();
+            let write = |file: &str, data: &[u8]| {
+                let f = std::fs::File::create(out.join(file)).unwrap();
+                let mut e = png::Encoder::new(f, scene.image.width, scene.image.height);
+                e.set_color(if alpha {
+                    png::ColorType::Rgba
+                } else {
+                    png::ColorType::Rgb
+                });
+                e.write_header().unwrap().write_image_data(data).unwrap();
+            };
+            write(&format!("{name}.gpu.png"), &b);
+            let diff: Vec<u8> = a
+                .iter()
+                .zip(&b)
+                .map(|(p, q)| p.abs_diff(*q).saturating_mul(32))
+                .collect();
+            write(&format!("{name}.diff.png"), &diff);
+            panic!("{name}: {bad} pixels differ; images in {}", out.display());
+        }
+    }
+}
+
+#[test]
+fn bad_requests_are_errors_not_panics() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("terms.toml");
+    scene.image.samples = 8;
+    assert!(gpu.render(&scene).unwrap_err().to_string().contains("1, 4 or 16"));
+    scene.image.samples = 1;
+    scene.image.width = 1_000_000;
+    assert!(gpu.render(&scene).is_err());
+}
