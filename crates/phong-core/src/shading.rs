@@ -136,8 +136,10 @@ pub struct ShadingOptions {
     pub clamp: bool,
     /// Energy normalisation. Default: none.
     pub normalization: Normalization,
-    /// Two-sided lighting: where `N·V < 0` the normal is flipped before
-    /// lighting. Default: off.
+    /// Two-sided lighting. Default: off. For a lone point, [`shade`] flips the
+    /// normal where `N·V < 0`; the renderers apply OpenGL's rule instead, which
+    /// decides by polygon facing (a back-facing triangle is lit with its normals
+    /// flipped, a front-facing one never), and call `shade` with this off.
     pub two_sided: bool,
 }
 

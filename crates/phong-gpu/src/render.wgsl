@@ -30,6 +30,17 @@ struct VsOut {
     @location(2) color: vec3<f32>,
     @location(3) @interpolate(flat) flat_color: vec3<f32>,
     @location(4) @interpolate(flat) object: u32,
+    // Two-sided lighting, as OpenGL: colours lit with the flipped normal, for back faces.
+    @location(5) color_back: vec3<f32>,
+    @location(6) @interpolate(flat) flat_back: vec3<f32>,
+}
+
+// The object's options with the per-point two-sided flip off: the renderer flips by polygon
+// facing instead, as OpenGL.
+fn raster_options(o: ObjectParams) -> Options {
+    var opt = o.options;
+    opt.flags.z = 0u;
+    return opt;
 }
 
 @vertex
@@ -44,24 +55,42 @@ fn vs_main(v: VsIn, @builtin(instance_index) object: u32) -> VsOut {
     out.object = object;
     out.color = vec3<f32>(0.0);
     out.flat_color = vec3<f32>(0.0);
+    out.color_back = vec3<f32>(0.0);
+    out.flat_back = vec3<f32>(0.0);
     let interpolation = o.options.mode.x;
     let output = o.options.mode.y;
+    let two_sided = o.options.flags.z != 0u;
+    let opt = raster_options(o);
+    let amb = frame.ambient.xyz;
+    let nl = frame.counts.x;
     if (interpolation == 1u && output < 4u) {
-        out.color = term(output, shade(v.position, v.normal, o.material, o.options, frame.ambient.xyz, frame.counts.x));
+        out.color = term(output, shade(v.position, v.normal, o.material, opt, amb, nl));
+        if (two_sided) {
+            out.color_back = term(output, shade(v.position, -v.normal, o.material, opt, amb, nl));
+        }
     } else if (interpolation == 0u && output < 4u) {
-        out.flat_color = term(output, shade(v.centroid, v.normal, o.material, o.options, frame.ambient.xyz, frame.counts.x));
+        out.flat_color = term(output, shade(v.centroid, v.normal, o.material, opt, amb, nl));
+        if (two_sided) {
+            out.flat_back = term(output, shade(v.centroid, -v.normal, o.material, opt, amb, nl));
+        }
     }
     return out;
 }
 
 @fragment
-fn fs_main(f: VsOut) -> @location(0) vec4<f32> {
+fn fs_main(f: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let o = objects[f.object];
+    // Back faces are drawn only for two-sided objects (culled otherwise).
+    let back = !front;
+    var normal = f.normal;
+    if (back) {
+        normal = -normal;
+    }
     let interpolation = o.options.mode.x;
     let output = o.options.mode.y;
     var c: vec3<f32>;
     if (output == 4u) {
-        let n = normalize_or_zero(f.normal);
+        let n = normalize_or_zero(normal);
         if (all(n == vec3<f32>(0.0))) {
             c = vec3<f32>(0.0);
         } else {
@@ -73,11 +102,11 @@ fn fs_main(f: VsOut) -> @location(0) vec4<f32> {
         let far = frame.forward.w;
         c = vec3<f32>(clamp(1.0 - (d - near) / (far - near), 0.0, 1.0));
     } else if (interpolation == 0u) {
-        c = f.flat_color;
+        c = select(f.flat_color, f.flat_back, back);
     } else if (interpolation == 1u) {
-        c = f.color;
+        c = select(f.color, f.color_back, back);
     } else {
-        c = term(output, shade(f.world, f.normal, o.material, o.options, frame.ambient.xyz, frame.counts.x));
+        c = term(output, shade(f.world, normal, o.material, raster_options(o), frame.ambient.xyz, frame.counts.x));
     }
     // Premultiplied by alpha 1; the read-back divides by the resolved alpha (straight alpha).
     return vec4<f32>(c, 1.0);

@@ -220,3 +220,40 @@ fn bad_requests_are_errors_not_panics() {
     scene.image.width = 1_000_000;
     assert!(gpu.render(&scene).is_err());
 }
+
+/// Two-sided lighting by polygon facing on the GPU too: the example tour with two-sided
+/// lighting and the camera under the floor plane (its back face in view) matches the CPU.
+#[test]
+fn two_sided_back_faces_match_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("tour.toml");
+    scene.image.width = 200;
+    scene.image.height = 150;
+    scene.camera = Camera::new(
+        Vec3::new(0.5, -3.0, 3.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        Projection::Perspective { fov_y_deg: 50.0 },
+        0.1,
+        50.0,
+    )
+    .unwrap();
+    for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
+        for o in &mut scene.objects {
+            o.shading.options.two_sided = true;
+            o.shading.interpolation = interp;
+        }
+        let cpu = phong_raster::render(&scene, &Default::default()).unwrap();
+        let (g, _) = gpu.render(&scene).unwrap();
+        let (a, b) = (
+            cpu.to_bytes(Encoding::Linear, false),
+            g.to_bytes(Encoding::Linear, false),
+        );
+        let bad = a
+            .chunks(3)
+            .zip(b.chunks(3))
+            .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 2))
+            .count();
+        assert!(bad * 200 < 200 * 150, "{interp:?}: {bad} pixels differ");
+    }
+}

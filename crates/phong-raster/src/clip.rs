@@ -20,6 +20,8 @@ pub struct ClipVertex {
     pub normal: Vec3,
     /// Colour lit at the vertex (Gouraud), else unused.
     pub color: Vec3,
+    /// Gouraud with two-sided lighting: the colour lit with the flipped normal, for back faces.
+    pub color_back: Vec3,
 }
 
 impl ClipVertex {
@@ -32,6 +34,7 @@ impl ClipVertex {
             world: self.world.lerp(b.world, t),
             normal: self.normal.lerp(b.normal, t),
             color: self.color.lerp(b.color, t),
+            color_back: self.color_back.lerp(b.color_back, t),
         }
     }
 }
@@ -110,6 +113,7 @@ mod tests {
             world: Vec3::new(x, y, z),
             normal: Vec3::Z,
             color: Vec3::new(w, 0.0, 0.0),
+            color_back: Vec3::ZERO,
         }
     }
 

@@ -60,8 +60,10 @@ struct Tri {
     /// 1/w per vertex.
     inv_w: [f32; 3],
     v: [ClipVertex; 3],
-    /// Flat: the triangle's colour and facet normal.
+    /// Flat: the triangle's colour and facet normal (as seen: flipped on a two-sided back face).
     flat: Option<(Color, Vec3)>,
+    /// A back face of a two-sided object: lit with flipped normals (OpenGL's two-sided lighting).
+    back: bool,
     object: u32,
     /// Pixel bounds, inclusive min, exclusive max.
     bbox: [u32; 4],
@@ -107,6 +109,7 @@ impl<'a> Frame<'a> {
         for (oi, obj) in scene.objects.iter().enumerate() {
             let interpolation = obj.shading.interpolation;
             let output = obj.shading.output;
+            let two_sided = obj.shading.options.two_sided;
             let view = frame.views[oi];
             let mesh = &obj.mesh;
             let gouraud = interpolation == Interpolation::Gouraud;
@@ -124,15 +127,27 @@ impl<'a> Frame<'a> {
                     } else {
                         Vec3::ZERO
                     },
+                    color_back: if gouraud && two_sided {
+                        let s = shade_at(scene, obj, &view, p, -n);
+                        Vec3::from(term(output, &s).to_array())
+                    } else {
+                        Vec3::ZERO
+                    },
                 })
                 .collect();
             for tri in mesh.triangles() {
                 let t = tri.map(|i| verts[i as usize]);
+                // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
                 let flat = (interpolation == Interpolation::Flat).then(|| {
                     let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
                     let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                    let s = shade_at(scene, obj, &view, centroid, fnorm);
-                    (term(output, &s), fnorm)
+                    let front = term(output, &shade_at(scene, obj, &view, centroid, fnorm));
+                    let back = if two_sided {
+                        term(output, &shade_at(scene, obj, &view, centroid, -fnorm))
+                    } else {
+                        front
+                    };
+                    [(front, fnorm), (back, -fnorm)]
                 });
                 match clip_triangle(&t) {
                     Clipped::Rejected => {}
@@ -228,14 +243,20 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     Ok((image, stats))
 }
 
+/// Lights a point of `obj`. Two-sided lighting is the renderer's: OpenGL decides by polygon
+/// facing (a back face is lit with its normals flipped), so the core's per-point flip is off.
 #[inline]
 fn shade_at(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3) -> Shading {
+    let options = phong_core::ShadingOptions {
+        two_sided: false,
+        ..obj.shading.options
+    };
     shade(
         &SurfacePoint { position, normal },
         view,
         &obj.material,
         &scene.lighting,
-        &obj.shading.options,
+        &options,
     )
 }
 
@@ -247,7 +268,7 @@ impl Frame<'_> {
     }
 
     /// Projects, snaps, culls, sets up edges and bins one clipped triangle.
-    fn setup(&mut self, mut v: [ClipVertex; 3], flat: Option<(Color, Vec3)>, object: u32) {
+    fn setup(&mut self, mut v: [ClipVertex; 3], flat: Option<[(Color, Vec3); 2]>, object: u32) {
         let (wf, hf) = (self.w as f32, self.h as f32);
         let mut xy = [(0i64, 0i64); 3];
         let mut z = [0f32; 3];
@@ -325,7 +346,8 @@ impl Frame<'_> {
             z,
             inv_w,
             v,
-            flat,
+            flat: flat.map(|f| f[usize::from(!front)]),
+            back: !front,
             object,
             bbox: [px0 as u32, py0 as u32, px1 as u32, py1 as u32],
         });
@@ -419,6 +441,7 @@ impl Frame<'_> {
             Output::Normal => {
                 let n = match t.flat {
                     Some((_, n)) => n,
+                    None if t.back => -lerp3(|v| v.normal).normalize_or_zero(),
                     None => lerp3(|v| v.normal).normalize_or_zero(),
                 };
                 if n == Vec3::ZERO {
@@ -435,18 +458,18 @@ impl Frame<'_> {
             _ => match (t.flat, obj.shading.interpolation) {
                 (Some((c, _)), _) => c,
                 (None, Interpolation::Gouraud) => {
-                    let c = lerp3(|v| v.color);
+                    let c = if t.back {
+                        lerp3(|v| v.color_back)
+                    } else {
+                        lerp3(|v| v.color)
+                    };
                     Color::new(c.x, c.y, c.z)
                 }
                 _ => {
-                    let s = shade_at(
-                        scene,
-                        obj,
-                        &self.views[t.object as usize],
-                        lerp3(|v| v.world),
-                        lerp3(|v| v.normal),
-                    );
-                    term(output, &s)
+                    let n = lerp3(|v| v.normal);
+                    let n = if t.back { -n } else { n };
+                    let view = &self.views[t.object as usize];
+                    term(output, &shade_at(scene, obj, view, lerp3(|v| v.world), n))
                 }
             },
         };

@@ -605,3 +605,88 @@ fn rejects_bad_settings() {
     s.image.width = 1_000_000;
     assert!(render(&s, &RenderOptions::default()).is_err());
 }
+
+/// OpenGL's two-sided lighting decides by polygon facing, not by the sign of N·V: a back-facing
+/// triangle whose vertex normals point towards the viewer is lit with those normals flipped
+/// (so, lit from the front, it shows only its ambient term), in every interpolation mode.
+#[test]
+fn two_sided_lighting_follows_polygon_facing() {
+    let (a, b, c) = (
+        Vec3::new(-0.875, -0.75, 0.0),
+        Vec3::new(0.875, -0.625, 0.25),
+        Vec3::new(0.0, 0.875, -0.25),
+    );
+    let (na, nb, nc) = (
+        Vec3::new(-0.2, 0.1, 1.0).normalize(),
+        Vec3::new(0.3, 0.0, 1.0).normalize(),
+        Vec3::new(0.0, 0.2, 1.0).normalize(),
+    );
+    // Wound a, c, b: clockwise on screen seen from +z, a back face.
+    let mesh = Mesh::new(vec![a, b, c], vec![na, nb, nc], vec![[0, 2, 1]]).unwrap();
+    let m = Material::named("red plastic").unwrap();
+    let lighting = Lighting::new(
+        Color::splat(0.3),
+        vec![Light::directional(Vec3::new(0.2, -0.3, -1.0), LightColor::default()).unwrap()],
+    )
+    .unwrap();
+    let n = 48u32;
+    for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
+        let mut s = scene(
+            n,
+            n,
+            ortho_camera(2.0),
+            vec![obj(mesh.clone(), m)],
+            lighting.clone(),
+            interp,
+        );
+        s.shading.options.two_sided = true;
+        let img = render(&s, &RenderOptions::default()).unwrap();
+        let view = s.camera.view(Viewer::Infinite);
+        let one_sided = ShadingOptions::default();
+        let sh = |p: Vec3, nrm: Vec3| {
+            let r = shade(
+                &SurfacePoint {
+                    position: p,
+                    normal: nrm,
+                },
+                &view,
+                &m,
+                &lighting,
+                &one_sided,
+            );
+            Vec3::from(r.color.to_array())
+        };
+        let mut checked = 0;
+        for y in 0..n {
+            for x in 0..n {
+                let (wx, wy) = ortho_world(x, y, n, 2.0);
+                let l = barycentric(Vec3::new(wx, wy, 0.0), a, b, c);
+                if l.iter().any(|&v| v < 0.02) {
+                    continue;
+                }
+                let p = a * l[0] + b * l[1] + c * l[2];
+                // The back face's facet normal (a, c, b winding) points away; flipped, towards +z.
+                let want = match interp {
+                    Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+                    Interpolation::Gouraud => sh(a, -na) * l[0] + sh(b, -nb) * l[1] + sh(c, -nc) * l[2],
+                    Interpolation::Phong => sh(p, -(na * l[0] + nb * l[1] + nc * l[2])),
+                };
+                let got = px(&img, x, y);
+                assert!(
+                    (got - want).abs().max_element() < 2e-5,
+                    "{interp:?} ({x},{y}): {got} vs {want}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 300);
+        // Gouraud and Phong with flipped normals see only the ambient light: 0.3 · a_m (= 0).
+        if interp != Interpolation::Flat {
+            assert!(
+                px(&img, 24, 24).max_element() < 0.05,
+                "{interp:?}: {}",
+                px(&img, 24, 24)
+            );
+        }
+    }
+}
