@@ -228,6 +228,11 @@ pub struct Shading {
 /// `(x⁺)^s`, with `0^s = 0` even for `s = 0`: OpenGL implementations give a
 /// specular factor of 1 where the dot product is > 0 and 0 elsewhere when the
 /// shininess is 0, and so does this. `x` is clamped to 1 against rounding.
+///
+/// (Mesa's fixed-function lighting deviates at `s = 0` under an attenuated or spot light:
+/// its program overwrites the exponent with `N·L` and computes `(N·L)^(N·L)`; phong
+/// follows the OpenGL 2.1 equation. Everywhere else phong's `opengl` model matches Mesa
+/// within 1/255, tested in `crates/phong-raster/tests/mesa.rs`.)
 #[inline]
 pub fn pow_positive(x: f32, s: f32) -> f32 {
     if x > 0.0 { x.min(1.0).powf(s) } else { 0.0 }

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Builds the llvmpipe harness and runs it on the benchmark scenes beside `phong bench`, in the
+# same run, printing each pair and the ratio.
+#   benches/llvmpipe/run.sh [WIDTHxHEIGHT] [FRAMES] [THREADS]
+# Needs Debian's libosmesa6-dev, libgl-dev and libglu1-mesa-dev (see BENCHMARKS.md).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+size=${1:-1920x1080}; frames=${2:-10}; threads=${3:-$(nproc)}
+w=${size%x*}; h=${size#*x}
+mkdir -p target/llvmpipe
+cc -O2 -o target/llvmpipe/harness benches/llvmpipe/harness.c -lOSMesa -lGLU -lGL -lm
+cargo build --release -q -p phong-cli
+export LP_NUM_THREADS=$threads
+run() { # name, harness args, scene file
+  local ours theirs
+  theirs=$(target/llvmpipe/harness $2 "$w" "$h" "$frames" | sed -n 's/.*ms_per_frame=\([0-9.]*\).*/\1/p')
+  ours=$(target/release/phong bench "benches/scenes/$3.toml" --width "$w" --height "$h" --frames "$frames" --threads "$threads" \
+         | sed -n 's/.*ms_per_frame=\([0-9.]*\).*/\1/p')
+  printf '%-24s phong %8.1f ms   llvmpipe %8.1f ms   speed-up %5.2fx\n' "$1" "$ours" "$theirs" "$(echo "$theirs / $ours" | bc -l)"
+}
+run fill_4lights "fill 1 phong 4" fill_4lights
+for t in 100k 1m; do
+  seg=$([ $t = 100k ] && echo 317 || echo 1000)
+  for i in gouraud phong; do
+    for n in 1 4; do run "sphere_${t}_${i}_${n}" "sphere $seg $i $n" "sphere_${t}_${i}_${n}"; done
+  done
+done

@@ -1,0 +1,97 @@
+/* OpenGL 2.1 fixed-function lighting on Mesa (OSMesa, llvmpipe), driven by a scene that
+ * phong-raster's tests write to stdin; writes the image (RGB, top row first) to stdout.
+ * The reference that phong's `opengl` model is checked against (tests/mesa.rs).
+ *
+ * Input, whitespace-separated:
+ *   W H  local_viewer two_sided
+ *   projection[16] view[16]          (column-major, as glLoadMatrixf)
+ *   global_ambient[3]
+ *   material: ambient[3] diffuse[3] specular[3] emission[3] shininess
+ *   NLIGHTS, then per light: position[4] (world; w = 0: direction towards the light)
+ *     ambient[3] diffuse[3] specular[3] k0 k1 k2 spot_direction[3] cutoff exponent
+ *   NVERTS, then per vertex: position[3] normal[3]
+ *   NTRIS, then per triangle: 3 indices
+ */
+#define GL_GLEXT_PROTOTYPES
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static float rd(void) {
+    float x;
+    if (scanf("%f", &x) != 1) { fprintf(stderr, "ffp: bad input\n"); exit(2); }
+    return x;
+}
+static void rdv(float *v, int n) { for (int i = 0; i < n; i++) v[i] = rd(); }
+
+int main(void) {
+    int w = (int)rd(), h = (int)rd(), local = (int)rd(), two = (int)rd();
+    float proj[16], view[16], amb[4] = {0, 0, 0, 1};
+    rdv(proj, 16); rdv(view, 16); rdv(amb, 3);
+    float ma[4] = {0, 0, 0, 1}, md[4] = {0, 0, 0, 1}, ms[4] = {0, 0, 0, 1}, me[4] = {0, 0, 0, 1};
+    rdv(ma, 3); rdv(md, 3); rdv(ms, 3); rdv(me, 3);
+    float shin = rd();
+
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, NULL);
+    unsigned char *buf = calloc((size_t)w * h, 4);
+    if (!ctx || !OSMesaMakeCurrent(ctx, buf, GL_UNSIGNED_BYTE, w, h)) { fprintf(stderr, "ffp: no OSMesa context\n"); return 1; }
+    glViewport(0, 0, w, h);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixf(proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixf(view); /* lights are given in world space: transformed by the view, as OpenGL does */
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    if (!two) glEnable(GL_CULL_FACE);
+    glEnable(GL_LIGHTING);
+    glEnable(GL_NORMALIZE);
+    glShadeModel(GL_SMOOTH);
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, amb);
+    glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, local);
+    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, two);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT, ma);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_DIFFUSE, md);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, ms);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_EMISSION, me);
+    glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, shin);
+    int nl = (int)rd();
+    for (int i = 0; i < nl && i < 8; i++) {
+        float pos[4], a[4] = {0, 0, 0, 1}, d[4] = {0, 0, 0, 1}, s[4] = {0, 0, 0, 1}, sd[3];
+        rdv(pos, 4); rdv(a, 3); rdv(d, 3); rdv(s, 3);
+        float k0 = rd(), k1 = rd(), k2 = rd();
+        rdv(sd, 3);
+        float cutoff = rd(), expo = rd();
+        GLenum L = GL_LIGHT0 + i;
+        glEnable(L);
+        glLightfv(L, GL_POSITION, pos);
+        glLightfv(L, GL_AMBIENT, a);
+        glLightfv(L, GL_DIFFUSE, d);
+        glLightfv(L, GL_SPECULAR, s);
+        glLightf(L, GL_CONSTANT_ATTENUATION, k0);
+        glLightf(L, GL_LINEAR_ATTENUATION, k1);
+        glLightf(L, GL_QUADRATIC_ATTENUATION, k2);
+        glLightfv(L, GL_SPOT_DIRECTION, sd);
+        glLightf(L, GL_SPOT_CUTOFF, cutoff);
+        glLightf(L, GL_SPOT_EXPONENT, expo);
+    }
+    int nv = (int)rd();
+    float *v = malloc(sizeof(float) * 6 * (nv > 0 ? nv : 1));
+    rdv(v, 6 * nv);
+    int nt = (int)rd();
+    glBegin(GL_TRIANGLES);
+    for (int t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++) {
+            int i = (int)rd();
+            glNormal3fv(v + 6 * i + 3);
+            glVertex3fv(v + 6 * i);
+        }
+    glEnd();
+    glFinish();
+    for (int y = h - 1; y >= 0; y--)
+        for (int x = 0; x < w; x++) fwrite(buf + 4 * ((size_t)y * w + x), 1, 3, stdout);
+    OSMesaDestroyContext(ctx);
+    return 0;
+}
