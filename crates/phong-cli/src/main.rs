@@ -73,6 +73,9 @@ struct RenderArgs {
     /// Renderer.
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     backend: Backend,
+    /// CPU: the scalar reference path instead of the fast path.
+    #[arg(long)]
+    reference: bool,
     /// Print counts, the backend and the time of each stage.
     #[arg(short, long)]
     verbose: bool,
@@ -97,6 +100,9 @@ struct BenchArgs {
     /// Renderer.
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     backend: Backend,
+    /// CPU: the scalar reference path instead of the fast path.
+    #[arg(long)]
+    reference: bool,
     /// Print the time of each stage.
     #[arg(short, long)]
     verbose: bool,
@@ -265,6 +271,7 @@ fn render(a: RenderArgs) -> Result<()> {
     let options = RenderOptions {
         threads: a.threads,
         progress: Some(&progress),
+        reference: a.reference,
     };
     let (mut image, times, triangles, shaded) =
         render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.input.display()))?;
@@ -332,6 +339,7 @@ fn bench(a: BenchArgs) -> Result<()> {
     let options = RenderOptions {
         threads: a.threads,
         progress: None,
+        reference: a.reference,
     };
     let gpu = open_gpu(a.backend)?;
     render_once(&scene, gpu.as_ref(), &options)?;

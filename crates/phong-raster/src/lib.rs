@@ -24,6 +24,7 @@
 //! image is the same whatever the number of threads.
 
 pub mod clip;
+pub mod kernel;
 pub mod raster;
 
 pub use raster::{coverage_counts, sample_pattern};
@@ -69,6 +70,9 @@ pub struct RenderOptions<'a> {
     pub threads: Option<usize>,
     /// Called with (tiles done, tiles in all) as tiles finish, from any thread.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+    /// Use the scalar reference path (one `shade` per pixel and covering triangle, in
+    /// drawing order) instead of the fast path (visibility first, 8-lane shading kernel).
+    pub reference: bool,
 }
 
 /// Counts and times of one render.

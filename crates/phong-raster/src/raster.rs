@@ -7,6 +7,7 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, clip_triangle};
+use crate::kernel::{LANES, Prepared, shade8};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -71,6 +72,9 @@ struct Tri {
 
 struct Frame<'a> {
     scene: &'a Scene,
+    /// Per object: the fast path's shading constants, for objects it shades with the kernel
+    /// (Phong interpolation, a lit output term).
+    prepared: Vec<Option<Prepared>>,
     /// Per object: its view vector rule.
     views: Vec<View>,
     w: u32,
@@ -96,8 +100,27 @@ impl<'a> Frame<'a> {
             .into_iter()
             .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
             .collect();
+        let prepared = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let lit = matches!(
+                    o.shading.output,
+                    Output::Color | Output::Ambient | Output::Diffuse | Output::Specular
+                );
+                (lit && o.shading.interpolation == Interpolation::Phong).then(|| {
+                    Prepared::new(
+                        &scene.lighting,
+                        &o.material,
+                        &o.shading.options,
+                        scene.camera.view(o.shading.viewer),
+                    )
+                })
+            })
+            .collect();
         let mut frame = Frame {
             scene,
+            prepared,
             views,
             w,
             h,
@@ -214,7 +237,11 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     let results: Vec<(u32, Vec<[f32; 4]>)> = (0..frame.tiles_x * tiles_y)
         .into_par_iter()
         .map(|tile| {
-            let (pixels, n) = frame.tile(tile, bg);
+            let (pixels, n) = if options.reference {
+                frame.tile(tile, bg)
+            } else {
+                frame.tile_visible(tile, bg)
+            };
             shaded.fetch_add(n, Ordering::Relaxed);
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(p) = options.progress {
@@ -424,15 +451,134 @@ impl Frame<'_> {
         (out, shaded)
     }
 
-    /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
-    fn shade_pixel(&self, t: &Tri, px: u32, py: u32) -> [f32; 4] {
+    /// Perspective-correct weights of triangle `t`'s vertices at the centre of pixel
+    /// `(px, py)`: `(λ_i / w_i) / Σ (λ_j / w_j)`.
+    #[inline]
+    fn weights(t: &Tri, px: u32, py: u32) -> [f32; 3] {
         let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
         let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
         let e = [0, 1, 2].map(|i| (t.a[i] * sx + t.b[i] * sy + t.c[i]) as f64 / t.area);
-        // Perspective-correct weights: (λ_i / w_i) / Σ (λ_j / w_j).
         let q = [0, 1, 2].map(|i| e[i] as f32 * t.inv_w[i]);
         let sum = q[0] + q[1] + q[2];
-        let q = q.map(|x| x / sum);
+        q.map(|x| x / sum)
+    }
+
+    /// Interpolated world position and normal (flipped on a back face) of `t` at pixel `(px, py)`.
+    #[inline]
+    fn position_normal(t: &Tri, px: u32, py: u32) -> (Vec3, Vec3) {
+        let q = Self::weights(t, px, py);
+        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
+        let n = lerp3(|v| v.normal);
+        (lerp3(|v| v.world), if t.back { -n } else { n })
+    }
+
+    /// Visibility first (the fast path): per sample the nearest triangle, with the reference's
+    /// coverage and depth arithmetic; then each visible (pixel, triangle) pair is shaded once,
+    /// Phong-interpolated objects 8 at a time by [`shade8`]; then the reference's resolve.
+    fn tile_visible(&self, tile: u32, bg: [f32; 4]) -> (Vec<[f32; 4]>, u64) {
+        let (x0, y0, x1, y1) = self.tile_rect(tile);
+        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let ns = self.pattern.len();
+        let mut depth = vec![f32::INFINITY; tw * th * ns];
+        let mut ids = vec![u32::MAX; tw * th * ns];
+        for &ti in &self.bins[tile as usize] {
+            let t = &self.tris[ti as usize];
+            for py in t.bbox[1].max(y0)..t.bbox[3].min(y1) {
+                for px in t.bbox[0].max(x0)..t.bbox[2].min(x1) {
+                    let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
+                    for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
+                        let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
+                        let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
+                        let Some(e) = Frame::covers(t, sx, sy) else {
+                            continue;
+                        };
+                        let l = e.map(|x| (x as f64 / t.area) as f32);
+                        let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                        if zz < depth[base + s] {
+                            depth[base + s] = zz;
+                            ids[base + s] = ti;
+                        }
+                    }
+                }
+            }
+        }
+        // One job per visible (pixel, triangle); a pixel's jobs are contiguous.
+        let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
+        let mut starts = Vec::with_capacity(tw * th + 1);
+        for pixel in 0..tw * th {
+            starts.push(jobs.len());
+            let first = jobs.len();
+            for &id in &ids[pixel * ns..(pixel + 1) * ns] {
+                if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
+                    jobs.push((pixel as u32, id));
+                }
+            }
+        }
+        starts.push(jobs.len());
+        let at = |pixel: u32| (x0 + pixel % tw as u32, y0 + pixel / tw as u32);
+        let mut colors = vec![[0f32; 4]; jobs.len()];
+        let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
+        for (k, &(pixel, ti)) in jobs.iter().enumerate() {
+            let t = &self.tris[ti as usize];
+            if self.prepared[t.object as usize].is_some() {
+                batches[t.object as usize].push(k as u32);
+            } else {
+                let (px, py) = at(pixel);
+                colors[k] = self.shade_pixel(t, px, py);
+            }
+        }
+        for (object, batch) in batches.iter().enumerate() {
+            let Some(prep) = &self.prepared[object] else { continue };
+            let output = self.scene.objects[object].shading.output;
+            for chunk in batch.chunks(LANES) {
+                let mut position = [Vec3::ZERO; LANES];
+                let mut normal = [Vec3::ZERO; LANES];
+                for lane in 0..LANES {
+                    let (pixel, ti) = jobs[chunk[lane.min(chunk.len() - 1)] as usize];
+                    let (px, py) = at(pixel);
+                    (position[lane], normal[lane]) = Self::position_normal(&self.tris[ti as usize], px, py);
+                }
+                let sh = shade8(prep, &position, &normal);
+                let term = match output {
+                    Output::Ambient => sh.ambient,
+                    Output::Diffuse => sh.diffuse,
+                    Output::Specular => sh.specular,
+                    _ => sh.color,
+                };
+                for (lane, &k) in chunk.iter().enumerate() {
+                    colors[k as usize] = [term[0][lane], term[1][lane], term[2][lane], 1.0];
+                }
+            }
+        }
+        // The reference's resolve, sample by sample.
+        let mut out = Vec::with_capacity(tw * th);
+        for pixel in 0..tw * th {
+            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+            let mut acc = [0f32; 4];
+            for &id in &ids[pixel * ns..(pixel + 1) * ns] {
+                let s = if id == u32::MAX {
+                    bg
+                } else {
+                    let j = mine.iter().position(|j| j.1 == id).unwrap_or(0);
+                    colors[starts[pixel] + j]
+                };
+                for k in 0..3 {
+                    acc[k] += s[k] * s[3];
+                }
+                acc[3] += s[3];
+            }
+            out.push(if acc[3] > 0.0 {
+                [acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3], acc[3] / ns as f32]
+            } else {
+                [bg[0], bg[1], bg[2], 0.0]
+            });
+        }
+        (out, jobs.len() as u64)
+    }
+
+    /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
+    fn shade_pixel(&self, t: &Tri, px: u32, py: u32) -> [f32; 4] {
+        let q = Self::weights(t, px, py);
         let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
         let scene = self.scene;
         let obj = &scene.objects[t.object as usize];
