@@ -272,6 +272,7 @@ fn render(a: RenderArgs) -> Result<()> {
         threads: a.threads,
         progress: Some(&progress),
         reference: a.reference,
+        no_avx2: false,
     };
     let (mut image, times, triangles, shaded) =
         render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.input.display()))?;
@@ -340,6 +341,7 @@ fn bench(a: BenchArgs) -> Result<()> {
         threads: a.threads,
         progress: None,
         reference: a.reference,
+        no_avx2: false,
     };
     let gpu = open_gpu(a.backend)?;
     render_once(&scene, gpu.as_ref(), &options)?;

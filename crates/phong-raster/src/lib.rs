@@ -24,8 +24,8 @@
 //! image is the same whatever the number of threads.
 
 pub mod clip;
-pub mod kernel;
 pub mod raster;
+pub mod simd;
 
 pub use raster::{coverage_counts, sample_pattern};
 
@@ -73,6 +73,9 @@ pub struct RenderOptions<'a> {
     /// Use the scalar reference path (one `shade` per pixel and covering triangle, in
     /// drawing order) instead of the fast path (visibility first, 8-lane shading kernel).
     pub reference: bool,
+    /// Fast path: do not use the AVX2 build of the kernel even where the CPU has AVX2 (for
+    /// tests; the images are the same).
+    pub no_avx2: bool,
 }
 
 /// Counts and times of one render.

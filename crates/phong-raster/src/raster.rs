@@ -7,7 +7,7 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::kernel::{LANES, Prepared, shade8};
+use crate::simd::{LANES, Prepared, avx2_available, shade8};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -94,6 +94,8 @@ struct Tri {
 
 struct Frame<'a> {
     scene: &'a Scene,
+    /// Use the AVX2 build of the kernel (decided once per frame).
+    avx2: bool,
     /// Per object: the fast path's shading constants, for objects it shades with the kernel
     /// (Phong interpolation, a lit output term).
     prepared: Vec<Option<Prepared>>,
@@ -144,6 +146,7 @@ impl<'a> Frame<'a> {
             .collect();
         let mut frame = Frame {
             scene,
+            avx2: false,
             prepared,
             views,
             w,
@@ -259,7 +262,8 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
     let t0 = Instant::now();
     let (w, h) = (scene.image.width, scene.image.height);
-    let frame = Frame::build(scene);
+    let mut frame = Frame::build(scene);
+    frame.avx2 = !options.no_avx2 && avx2_available();
     let setup = t0.elapsed();
 
     let t1 = Instant::now();
@@ -601,7 +605,7 @@ impl Frame<'_> {
                     let (px, py) = at(pixel);
                     (position[lane], normal[lane]) = Self::position_normal(self.tri(ti), px, py);
                 }
-                let sh = shade8(prep, &position, &normal);
+                let sh = shade8(self.avx2, prep, &position, &normal);
                 let term = match output {
                     Output::Ambient => sh.ambient,
                     Output::Diffuse => sh.diffuse,

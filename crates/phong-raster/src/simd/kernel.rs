@@ -285,7 +285,9 @@ fn acc(c: &mut [F; 3], k: Color, f: F, m: M) {
 }
 
 /// Shades 8 points (positions and normals by lane) of one object: `phong_core::shade` with
-/// `pow` approximated as documented above.
+/// `pow` approximated as documented above. Inlined into each caller so that the AVX2 build
+/// in [`super`] compiles it with those features.
+#[inline(always)]
 pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     let pos = V3 {
         x: lanes(|i| position[i].x),
