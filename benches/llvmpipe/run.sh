@@ -11,13 +11,16 @@ mkdir -p target/llvmpipe
 cc -O2 -o target/llvmpipe/harness benches/llvmpipe/harness.c -lOSMesa -lGLU -lGL -lm
 cargo build --release -q -p phong-cli
 export LP_NUM_THREADS=$threads
+ms() { sed -n 's/.*ms_per_frame=\([0-9.]*\).*/\1/p'; }
 run() { # name, harness args, scene file
-  local ours theirs
-  theirs=$(target/llvmpipe/harness $2 "$w" "$h" "$frames" | sed -n 's/.*ms_per_frame=\([0-9.]*\).*/\1/p')
-  ours=$(target/release/phong bench "benches/scenes/$3.toml" --width "$w" --height "$h" --frames "$frames" --threads "$threads" \
-         | sed -n 's/.*ms_per_frame=\([0-9.]*\).*/\1/p')
-  printf '%-24s phong %8.1f ms   llvmpipe %8.1f ms   speed-up %5.2fx\n' "$1" "$ours" "$theirs" "$(echo "$theirs / $ours" | bc -l)"
+  local ours ref theirs
+  theirs=$(target/llvmpipe/harness $2 "$w" "$h" "$frames" | ms)
+  ours=$(target/release/phong bench "benches/scenes/$3.toml" --width "$w" --height "$h" --frames "$frames" --threads "$threads" | ms)
+  ref=$(target/release/phong bench "benches/scenes/$3.toml" --width "$w" --height "$h" --frames "$frames" --threads "$threads" --reference | ms)
+  printf '| %-22s | %8.1f | %8.1f | %8.1f | %5.2fx |\n' "$1" "$ours" "$ref" "$theirs" "$(echo "$theirs / $ours" | bc -l)"
 }
+echo "| scene | phong fast ms | phong reference ms | llvmpipe ms | fast vs llvmpipe |"
+echo "|---|---:|---:|---:|---:|"
 run fill_4lights "fill 1 phong 4" fill_4lights
 for t in 100k 1m; do
   seg=$([ $t = 100k ] && echo 317 || echo 1000)
