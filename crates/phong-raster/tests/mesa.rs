@@ -1,6 +1,7 @@
 //! phong's `opengl` model against Mesa's OpenGL fixed-function lighting (OSMesa, llvmpipe):
 //! the same scene (matrices, lights, material, mesh) rendered by both with Gouraud shading,
-//! compared pixel by pixel. The reference is `tests/mesa/ffp.c`, compiled here with `cc`;
+//! compared pixel by pixel. The reference is `tests/mesa/ffp.c`, compiled here with `cc` (or
+//! `$PHONG_MESA_CC`);
 //! without OSMesa (Debian's libosmesa6-dev) the test reports that it was skipped, and with
 //! `PHONG_REQUIRE_MESA=1` (CI) that is a failure.
 
@@ -15,7 +16,7 @@ use std::process::{Command, Stdio};
 fn reference() -> Option<PathBuf> {
     let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/mesa/ffp.c");
     let exe = std::env::temp_dir().join(format!("phong-ffp-{}", std::process::id()));
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let cc = std::env::var("PHONG_MESA_CC").unwrap_or_else(|_| "cc".into());
     let out = Command::new(&cc)
         .args(["-O2", "-o"])
         .arg(&exe)
@@ -260,4 +261,5 @@ fn opengl_model_matches_mesa_fixed_function() {
         assert!(max <= 8, "case {case}: a pixel differs by {max}/255");
     }
     eprintln!("worst case: {:.3}% of pixels beyond 1/255", worst_frac * 100.0);
+    let _ = std::fs::remove_file(&exe);
 }

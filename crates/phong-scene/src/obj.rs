@@ -396,6 +396,7 @@ mod tests {
         assert_eq!(glow.diffuse(), Color::BLACK);
         assert!(!parts[1].has_normals);
         assert!(warnings.iter().any(|w| w.contains("illum 5")), "{warnings:?}");
+        let _ = std::fs::remove_dir_all(d);
     }
 
     #[test]
@@ -436,5 +437,6 @@ mod tests {
         let obj = write(&d, "n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n");
         let parts = load_obj(&obj, &mut Vec::new()).unwrap();
         assert_eq!(parts[0].mesh.triangles().len(), 1);
+        let _ = std::fs::remove_dir_all(d);
     }
 }

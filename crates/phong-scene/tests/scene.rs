@@ -298,4 +298,5 @@ fn meshes_load_relative_to_the_scene() {
     // Through `load`, a missing file is named.
     let e = phong_scene::load(&dir.join("nope.toml")).unwrap_err();
     assert!(e.is_input() && e.to_string().contains("nope.toml"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
 }
