@@ -357,6 +357,15 @@ impl Gpu {
             }
             .into());
         }
+        let samples_total = u64::from(w) * u64::from(h) * u64::from(samples);
+        if samples_total > phong_core::limits::MAX_SAMPLES_TOTAL {
+            return Err(Error::Limit {
+                what: "pixels × samples per pixel",
+                asked: samples_total,
+                limit: phong_core::limits::MAX_SAMPLES_TOTAL,
+                adapter: self.info.name.clone(),
+            });
+        }
         let max_tex = u64::from(self.limits.max_texture_dimension_2d);
         self.check_limit("image width", u64::from(w), max_tex)?;
         self.check_limit("image height", u64::from(h), max_tex)?;

@@ -219,6 +219,12 @@ fn bad_requests_are_errors_not_panics() {
     scene.image.samples = 1;
     scene.image.width = 1_000_000;
     assert!(gpu.render(&scene).is_err());
+    // 16384² pixels at 16 samples would need about 50 GB of attachments: refused up front.
+    scene.image.width = 16384;
+    scene.image.height = 16384;
+    scene.image.samples = 16;
+    let e = gpu.render(&scene).unwrap_err().to_string();
+    assert!(e.contains("pixels × samples per pixel"), "{e}");
 }
 
 /// Two-sided lighting by polygon facing on the GPU too: the example tour with two-sided
