@@ -25,6 +25,24 @@ const SETUP_CHUNK: usize = 4096;
 const ID_INDEX_BITS: u32 = 15;
 const HALF: i64 = 1 << (SUBPIXEL_BITS - 1);
 
+/// Resolves one pixel: the straight-alpha average of its `ns` samples, in sample order
+/// (both CPU paths use it, so they sum in the same order).
+#[inline]
+fn resolve(samples: impl Iterator<Item = [f32; 4]>, ns: usize, bg: [f32; 4]) -> [f32; 4] {
+    let mut acc = [0f32; 4];
+    for s in samples {
+        for k in 0..3 {
+            acc[k] += s[k] * s[3];
+        }
+        acc[3] += s[3];
+    }
+    if acc[3] > 0.0 {
+        [acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3], acc[3] / ns as f32]
+    } else {
+        [bg[0], bg[1], bg[2], 0.0]
+    }
+}
+
 /// `v.round() as i64` (half away from zero) without a libm call, exact for `|v| < 2^24`
 /// (the guard band keeps snapped coordinates below that): `v − trunc(v)` is exact there.
 /// Measured: `roundf` was 3% of a 1M-triangle frame.
@@ -495,22 +513,10 @@ impl Frame<'_> {
                 }
             }
         }
-        // Resolve: straight-alpha average of the samples.
-        let mut out = Vec::with_capacity(tw * th);
-        for px in color.chunks_exact(ns) {
-            let mut acc = [0f32; 4];
-            for s in px {
-                for k in 0..3 {
-                    acc[k] += s[k] * s[3];
-                }
-                acc[3] += s[3];
-            }
-            out.push(if acc[3] > 0.0 {
-                [acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3], acc[3] / ns as f32]
-            } else {
-                [bg[0], bg[1], bg[2], 0.0]
-            });
-        }
+        let out = color
+            .chunks_exact(ns)
+            .map(|px| resolve(px.iter().copied(), ns, bg))
+            .collect();
         (out, shaded)
     }
 
@@ -629,28 +635,19 @@ impl Frame<'_> {
             }
         }
         // The reference's resolve, sample by sample.
-        let mut out = Vec::with_capacity(tw * th);
-        for pixel in 0..tw * th {
-            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
-            let mut acc = [0f32; 4];
-            for &id in &ids[pixel * ns..(pixel + 1) * ns] {
-                let s = if id == u32::MAX {
-                    bg
-                } else {
-                    let j = mine.iter().position(|j| j.1 == id).unwrap_or(0);
-                    colors[starts[pixel] + j]
-                };
-                for k in 0..3 {
-                    acc[k] += s[k] * s[3];
-                }
-                acc[3] += s[3];
-            }
-            out.push(if acc[3] > 0.0 {
-                [acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3], acc[3] / ns as f32]
-            } else {
-                [bg[0], bg[1], bg[2], 0.0]
-            });
-        }
+        let out = (0..tw * th)
+            .map(|pixel| {
+                let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+                let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
+                    if id == u32::MAX {
+                        bg
+                    } else {
+                        colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+                    }
+                });
+                resolve(samples, ns, bg)
+            })
+            .collect();
         (out, jobs.len() as u64)
     }
 

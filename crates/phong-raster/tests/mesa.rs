@@ -5,6 +5,9 @@
 //! without OSMesa (Debian's libosmesa6-dev) the test reports that it was skipped, and with
 //! `PHONG_REQUIRE_MESA=1` (CI) that is a failure.
 
+mod common;
+use common::Rng;
+
 use glam::{Mat4, Vec3};
 use phong_core::*;
 use phong_raster::{RenderOptions, render};
@@ -105,23 +108,6 @@ fn mesa(exe: &PathBuf, scene: &Scene) -> Vec<u8> {
     assert!(out.status.success());
     assert_eq!(out.stdout.len(), (w * h * 3) as usize);
     out.stdout
-}
-
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn r(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.f()
-    }
-    fn c(&mut self) -> Color {
-        Color::new(self.f(), self.f(), self.f())
-    }
 }
 
 fn scene_with(

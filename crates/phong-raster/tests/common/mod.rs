@@ -1,0 +1,31 @@
+//! Test support shared by phong-raster's test files.
+
+use glam::Vec3;
+use phong_core::Color;
+
+/// A small deterministic generator (a 64-bit LCG): the tests' random scenes are reproducible.
+pub struct Rng(pub u64);
+
+#[allow(dead_code)] // each test file uses part of it
+impl Rng {
+    /// Uniform in [0, 1).
+    pub fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    /// Uniform in [a, b).
+    pub fn r(&mut self, a: f32, b: f32) -> f32 {
+        a + (b - a) * self.f()
+    }
+    /// Each component uniform in [−k, k).
+    pub fn v(&mut self, k: f32) -> Vec3 {
+        Vec3::new(self.r(-k, k), self.r(-k, k), self.r(-k, k))
+    }
+    /// Each channel uniform in [0, 1).
+    pub fn c(&mut self) -> Color {
+        Color::new(self.f(), self.f(), self.f())
+    }
+}
