@@ -45,7 +45,7 @@ pub use color::Color;
 pub use error::Error;
 pub use image::{Encoding, Image};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
-pub use material::{Material, NamedMaterial, named_materials, nearest_names};
+pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;
 pub use scene::{ImageSettings, Interpolation, Label, Object, Output, Scene, ShadingSettings};
 pub use shading::{

@@ -190,8 +190,9 @@ fn parse_table(tsv: &'static str) -> Vec<NamedMaterial> {
         .collect()
 }
 
-/// Lower case without spaces, `-` or `_`.
-pub(crate) fn normalize_name(s: &str) -> String {
+/// A name as looked up: lower case without spaces, `-` or `_` (`"Polished Bronze"` →
+/// `"polishedbronze"`).
+pub fn normalize_name(s: &str) -> String {
     s.chars()
         .filter(|c| !matches!(c, ' ' | '-' | '_'))
         .flat_map(char::to_lowercase)

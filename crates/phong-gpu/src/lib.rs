@@ -344,7 +344,6 @@ impl Gpu {
             return Err(Error::Samples(samples));
         }
         let (w, h) = (scene.image.width, scene.image.height);
-        Image::new(1, 1, [0.0; 4])?; // the core's size rules, checked below for w, h
         if w == 0
             || h == 0
             || w > phong_core::limits::MAX_IMAGE_DIMENSION

@@ -10,7 +10,7 @@ use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS, SAMPLE_C
 use phong_core::{
     Attenuation, Camera, Color, Encoding, ImageSettings, Interpolation, Label, Light, LightColor, Lighting, LyonLambda,
     Material, Mesh, Normalization, Object, Output, Projection, Scene, ShadingOptions, ShadingSettings, SpecularModel,
-    Viewer, nearest_names, primitives,
+    Viewer, nearest_names, normalize_name, primitives,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -370,7 +370,7 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
     for (name, m) in &raw.materials {
         let key = format!("materials.{name}");
         let mat = material(ctx, m.get_ref(), &key, &named)?;
-        named.insert(phong_core_name(name), mat);
+        named.insert(normalize_name(name), mat);
     }
     let lyon = match shading.options.specular {
         SpecularModel::Lyon { squarings, lambda } => (squarings, lambda),
@@ -413,13 +413,6 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
         objects,
         labels,
     })
-}
-
-fn phong_core_name(s: &str) -> String {
-    s.chars()
-        .filter(|c| !matches!(c, ' ' | '-' | '_'))
-        .flat_map(char::to_lowercase)
-        .collect()
 }
 
 fn image_settings(ctx: &Ctx, r: RawImage) -> Result<ImageSettings, Error> {
@@ -676,7 +669,7 @@ fn material(ctx: &Ctx, m: &RawMaterial, key: &str, named: &BTreeMap<String, Mate
 }
 
 fn lookup_material(ctx: &Ctx, name: &S<String>, named: &BTreeMap<String, Material>) -> Result<Material, Error> {
-    if let Some(m) = named.get(&phong_core_name(name.get_ref())) {
+    if let Some(m) = named.get(&normalize_name(name.get_ref())) {
         return Ok(*m);
     }
     Material::named(name.get_ref()).or_else(|_| {
