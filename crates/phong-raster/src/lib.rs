@@ -17,7 +17,10 @@
 //!    the top-left fill rule, binning into 64×64 tiles.
 //! 4. **Tiles, in parallel** (rayon): per sample, exact integer coverage and
 //!    a `GL_LESS` depth test; per pixel and triangle, one shading at the pixel
-//!    centre (as MSAA), perspective-correct; written to the covered samples.
+//!    centre (as MSAA), perspective-correct; written to the covered samples. The
+//!    reference path shades as it draws; the fast path (the default) first finds
+//!    each sample's visible triangle, then shades each visible (pixel, triangle)
+//!    once, Phong-interpolated pixels 8 at a time ([`simd`]).
 //! 5. **Resolve**: the samples' average (straight alpha) into the [`Image`].
 //!
 //! Every pixel of a tile is processed by one thread in triangle order, so the
@@ -85,7 +88,9 @@ pub struct RenderStats {
     pub triangles: usize,
     /// Triangles rasterised (after culling and clipping; clipping can add some).
     pub triangles_drawn: usize,
-    /// Pixels shaded (a pixel counts once per triangle that covers a visible sample of it).
+    /// Shadings done: on the fast path one per visible (pixel, triangle) pair; on the
+    /// reference path one per pixel and triangle passing the depth test when drawn (overdraw
+    /// included).
     pub pixels_shaded: u64,
     /// Vertex transform, per-vertex lighting, clipping, triangle setup and binning.
     pub setup: Duration,
