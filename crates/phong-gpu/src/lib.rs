@@ -144,6 +144,18 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
     }
 }
 
+/// Bind group entries for `buffers`, bound at 0, 1, 2, … in order.
+fn entries<'a>(buffers: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
+    buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect()
+}
+
 /// Storage buffers may not be empty: pad with one zeroed element.
 fn non_empty<T: bytemuck::Pod + bytemuck::Zeroable>(v: &[T]) -> Vec<u8> {
     if v.is_empty() {
@@ -460,20 +472,7 @@ impl Gpu {
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("phong frame"),
             layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: fb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ob.as_entire_binding(),
-                },
-            ],
+            entries: &entries(&[&fb, &lb, &ob]),
         });
         let size = wgpu::Extent3d {
             width: w,
@@ -698,28 +697,7 @@ impl Gpu {
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
             layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: gb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ob.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: cb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: rb.as_entire_binding(),
-                },
-            ],
+            entries: &entries(&[&gb, &lb, &ob, &cb, &rb]),
         });
         let mut enc = d.create_command_encoder(&Default::default());
         {

@@ -402,6 +402,33 @@ fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     ]
 }
 
+/// Checks every pixel well inside triangle (a, b, c) (barycentrics all above 0.02, computed here
+/// from the pixel centre) against `want(barycentrics, position)`, within `tol`; at least 300 pixels.
+fn check_interior(
+    img: &Image,
+    n: u32,
+    (a, b, c): (Vec3, Vec3, Vec3),
+    tol: f32,
+    label: &str,
+    want: impl Fn([f32; 3], Vec3) -> Vec3,
+) {
+    let mut checked = 0;
+    for y in 0..n {
+        for x in 0..n {
+            let (wx, wy) = ortho_world(x, y, n, 2.0);
+            let l = barycentric(Vec3::new(wx, wy, 0.0), a, b, c);
+            if l.iter().any(|&v| v < 0.02) {
+                continue;
+            }
+            let w = want(l, a * l[0] + b * l[1] + c * l[2]);
+            let got = px(img, x, y);
+            assert!((got - w).abs().max_element() < tol, "{label} ({x},{y}): {got} vs {w}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 300, "{label}: {checked} pixels");
+}
+
 /// Each interpolation mode and specular model against `shade`: flat is the centroid's shading
 /// with the facet normal; Gouraud the barycentric blend of the vertices' shadings; Phong the
 /// shading of the blended position and renormalised normal. Tolerance 2e-5: f32 rounding of the
@@ -469,29 +496,12 @@ fn interpolation_modes_against_core() {
                 );
                 Vec3::from(r.color.to_array())
             };
-            let mut checked = 0;
-            for y in 0..n {
-                for x in 0..n {
-                    let (wx, wy) = ortho_world(x, y, n, 2.0);
-                    let l = barycentric(Vec3::new(wx, wy, 0.0), a, b, c);
-                    if l.iter().any(|&v| v < 0.02) {
-                        continue;
-                    }
-                    let p = a * l[0] + b * l[1] + c * l[2];
-                    let want = match interp {
-                        Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
-                        Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
-                        Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),
-                    };
-                    let got = px(&img, x, y);
-                    assert!(
-                        (got - want).abs().max_element() < 2e-5,
-                        "{model:?} {interp:?} ({x},{y}): {got} vs {want}"
-                    );
-                    checked += 1;
-                }
-            }
-            assert!(checked > 300);
+            let label = format!("{model:?} {interp:?}");
+            check_interior(&img, n, (a, b, c), 2e-5, &label, |l, p| match interp {
+                Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+                Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
+                Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),
+            });
         }
     }
 }
@@ -656,30 +666,12 @@ fn two_sided_lighting_follows_polygon_facing() {
             );
             Vec3::from(r.color.to_array())
         };
-        let mut checked = 0;
-        for y in 0..n {
-            for x in 0..n {
-                let (wx, wy) = ortho_world(x, y, n, 2.0);
-                let l = barycentric(Vec3::new(wx, wy, 0.0), a, b, c);
-                if l.iter().any(|&v| v < 0.02) {
-                    continue;
-                }
-                let p = a * l[0] + b * l[1] + c * l[2];
-                // The back face's facet normal (a, c, b winding) points away; flipped, towards +z.
-                let want = match interp {
-                    Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
-                    Interpolation::Gouraud => sh(a, -na) * l[0] + sh(b, -nb) * l[1] + sh(c, -nc) * l[2],
-                    Interpolation::Phong => sh(p, -(na * l[0] + nb * l[1] + nc * l[2])),
-                };
-                let got = px(&img, x, y);
-                assert!(
-                    (got - want).abs().max_element() < 2e-5,
-                    "{interp:?} ({x},{y}): {got} vs {want}"
-                );
-                checked += 1;
-            }
-        }
-        assert!(checked > 300);
+        // The back face's facet normal (a, c, b winding) points away; flipped, towards +z.
+        check_interior(&img, n, (a, b, c), 2e-5, &format!("{interp:?}"), |l, p| match interp {
+            Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+            Interpolation::Gouraud => sh(a, -na) * l[0] + sh(b, -nb) * l[1] + sh(c, -nc) * l[2],
+            Interpolation::Phong => sh(p, -(na * l[0] + nb * l[1] + nc * l[2])),
+        });
         // Gouraud and Phong with flipped normals see only the ambient light: 0.3 · a_m (= 0).
         if interp != Interpolation::Flat {
             assert!(
