@@ -589,12 +589,21 @@ impl Frame<'_> {
         // One job per visible (pixel, triangle); a pixel's jobs are contiguous.
         let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
         let mut starts = Vec::with_capacity(tw * th + 1);
-        for pixel in 0..tw * th {
-            starts.push(jobs.len());
-            let first = jobs.len();
-            for &id in &ids[pixel * ns..(pixel + 1) * ns] {
-                if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
+        if ns == 1 {
+            for (pixel, &id) in ids.iter().enumerate() {
+                starts.push(jobs.len());
+                if id != u32::MAX {
                     jobs.push((pixel as u32, id));
+                }
+            }
+        } else {
+            for pixel in 0..tw * th {
+                starts.push(jobs.len());
+                let first = jobs.len();
+                for &id in &ids[pixel * ns..(pixel + 1) * ns] {
+                    if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
+                        jobs.push((pixel as u32, id));
+                    }
                 }
             }
         }
@@ -633,6 +642,24 @@ impl Frame<'_> {
                     colors[k as usize] = [term[0][lane], term[1][lane], term[2][lane], 1.0];
                 }
             }
+        }
+        // One sample: the pixel is its job's colour (opaque: the resolve is exact, x·1/1 = x)
+        // or the background as the resolve makes it.
+        if ns == 1 {
+            let background = resolve(std::iter::once(bg), 1, bg);
+            let out = ids
+                .iter()
+                .enumerate()
+                .map(|(pixel, &id)| {
+                    if id == u32::MAX {
+                        background
+                    } else {
+                        let c = colors[starts[pixel]];
+                        resolve(std::iter::once(c), 1, bg)
+                    }
+                })
+                .collect();
+            return (out, jobs.len() as u64);
         }
         // The reference's resolve, sample by sample.
         let out = (0..tw * th)
