@@ -164,17 +164,25 @@ fn render_once(
     scene: &phong_core::Scene,
     gpu: Option<&phong_gpu::Gpu>,
     options: &RenderOptions,
-) -> Result<(phong_core::Image, [Duration; 3], usize, u64)> {
+) -> Result<(phong_core::Image, [Duration; 6], usize, u64)> {
     Ok(match gpu {
         Some(g) => {
             let (img, st) = g.render(scene)?;
-            (img, [st.upload, st.render, st.readback], st.triangles, 0)
+            let z = Duration::ZERO;
+            (img, [st.upload, st.render, st.readback, z, z, z], st.triangles, 0)
         }
         None => {
             let (img, st) = render_with_stats(scene, options)?;
             (
                 img,
-                [st.setup, st.raster, Duration::ZERO],
+                [
+                    st.setup,
+                    st.raster,
+                    Duration::ZERO,
+                    st.tile_raster,
+                    st.tile_shade,
+                    st.tile_resolve,
+                ],
                 st.triangles_drawn,
                 st.pixels_shaded,
             )
@@ -345,10 +353,10 @@ fn bench(a: BenchArgs) -> Result<()> {
     };
     let gpu = open_gpu(a.backend)?;
     render_once(&scene, gpu.as_ref(), &options)?;
-    let mut sum = [Duration::ZERO; 3];
+    let mut sum = [Duration::ZERO; 6];
     for _ in 0..a.frames {
         let (_, t, _, _) = render_once(&scene, gpu.as_ref(), &options)?;
-        for k in 0..3 {
+        for k in 0..6 {
             sum[k] += t[k];
         }
     }
@@ -375,9 +383,13 @@ fn bench(a: BenchArgs) -> Result<()> {
                 ms(sum[2])
             ),
             None => eprintln!(
-                "phong: cpu per frame: setup+binning={:.2}ms raster+shade+resolve={:.2}ms",
+                "phong: cpu per frame: setup+binning={:.2}ms raster+shade+resolve={:.2}ms \
+                 (in the tiles, CPU time over all threads: rasterisation={:.2}ms shading={:.2}ms resolve={:.2}ms)",
                 ms(sum[0]),
-                ms(sum[1])
+                ms(sum[1]),
+                ms(sum[3]),
+                ms(sum[4]),
+                ms(sum[5])
             ),
         }
     }

@@ -333,3 +333,47 @@ fn gpu_backend_selection() {
         eprintln!("skipped --backend gpu render: {}", stderr(&o));
     }
 }
+
+/// `phong bench` prints exactly one line in the documented format, and -v the stages.
+#[test]
+fn bench_line_format() {
+    let o = phong(&[
+        "bench",
+        "examples/scenes/terms.toml",
+        "--frames",
+        "2",
+        "--width",
+        "64",
+        "--height",
+        "32",
+        "-v",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = out.trim();
+    assert_eq!(out.lines().count(), 1, "{out}");
+    let fields: Vec<&str> = line.split(' ').collect();
+    assert_eq!(fields[0], "phong:");
+    assert_eq!(fields[1], "64x32");
+    assert!(
+        fields[2].strip_prefix("tris=").unwrap().parse::<u64>().unwrap() > 1000,
+        "{line}"
+    );
+    assert_eq!(fields[3], "frames=2");
+    assert!(
+        fields[4].strip_prefix("ms_per_frame=").unwrap().parse::<f64>().unwrap() > 0.0,
+        "{line}"
+    );
+    assert!(
+        fields[5].strip_prefix("mpix_per_s=").unwrap().parse::<f64>().unwrap() > 0.0,
+        "{line}"
+    );
+    let e = stderr(&o);
+    assert!(
+        e.contains("setup+binning=")
+            && e.contains("rasterisation=")
+            && e.contains("shading=")
+            && e.contains("resolve="),
+        "{e}"
+    );
+}

@@ -94,8 +94,15 @@ pub struct RenderStats {
     pub pixels_shaded: u64,
     /// Vertex transform, per-vertex lighting, clipping, triangle setup and binning.
     pub setup: Duration,
-    /// Coverage, depth and shading in the tiles, with the resolve.
+    /// Coverage, depth and shading in the tiles, with the resolve (wall time).
     pub raster: Duration,
+    /// In the tiles, CPU time summed over threads: coverage and depth (the reference path
+    /// shades as it rasterises, so its shading counts here too).
+    pub tile_raster: Duration,
+    /// In the tiles, CPU time summed over threads: shading (fast path).
+    pub tile_shade: Duration,
+    /// In the tiles, CPU time summed over threads: the resolve.
+    pub tile_resolve: Duration,
 }
 
 /// Renders `scene` into a linear RGBA image.

@@ -15,7 +15,7 @@ use phong_core::mesh::facet_normal;
 use phong_core::{Color, Image, Interpolation, Object, Output, Scene, Shading, SurfacePoint, View, shade};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 const ONE: f32 = (1u32 << SUBPIXEL_BITS) as f32;
 /// Triangles per parallel setup task: large enough to amortise scheduling, small enough to
@@ -24,6 +24,23 @@ const SETUP_CHUNK: usize = 4096;
 /// Low bits of a triangle id that index within its setup chunk (4096 · 7 < 2^15).
 const ID_INDEX_BITS: u32 = 15;
 const HALF: i64 = 1 << (SUBPIXEL_BITS - 1);
+
+/// CPU time of the tiles' stages, summed over threads, in nanoseconds.
+#[derive(Default)]
+struct StageClock {
+    raster: AtomicU64,
+    shade: AtomicU64,
+    resolve: AtomicU64,
+}
+
+impl StageClock {
+    fn add(&self, raster: Instant, shade: Instant, resolve: Instant, end: Instant) {
+        let ns = |a: Instant, b: Instant| (b - a).as_nanos() as u64;
+        self.raster.fetch_add(ns(raster, shade), Ordering::Relaxed);
+        self.shade.fetch_add(ns(shade, resolve), Ordering::Relaxed);
+        self.resolve.fetch_add(ns(resolve, end), Ordering::Relaxed);
+    }
+}
 
 /// Resolves one pixel: the straight-alpha average of its `ns` samples, in sample order
 /// (both CPU paths use it, so they sum in the same order).
@@ -288,6 +305,7 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     let tiles_y = h.div_ceil(TILE_SIZE);
     let total = u64::from(frame.tiles_x * tiles_y);
     let done = AtomicU64::new(0);
+    let clock = StageClock::default();
     let shaded = AtomicU64::new(0);
     let bg = scene.image.background;
     // Tiles are written straight into the image, a strip of 64 rows per task, so that
@@ -306,9 +324,9 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
                 .map(|tx| {
                     let tile = ty as u32 * frame.tiles_x + tx;
                     let r = if options.reference {
-                        frame.tile(tile, bg)
+                        frame.tile(tile, bg, &clock)
                     } else {
-                        frame.tile_visible(tile, bg)
+                        frame.tile_visible(tile, bg, &clock)
                     };
                     let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                     if let Some(p) = options.progress {
@@ -333,6 +351,9 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
         pixels_shaded: shaded.into_inner(),
         setup,
         raster: t1.elapsed(),
+        tile_raster: Duration::from_nanos(clock.raster.into_inner()),
+        tile_shade: Duration::from_nanos(clock.shade.into_inner()),
+        tile_resolve: Duration::from_nanos(clock.resolve.into_inner()),
     };
     Ok((image, stats))
 }
@@ -468,7 +489,9 @@ impl Frame<'_> {
     }
 
     /// Renders one tile and resolves it; returns its pixels and the number of pixel shadings.
-    fn tile(&self, tile: u32, bg: [f32; 4]) -> (Vec<[f32; 4]>, u64) {
+    /// (Stages: rasterising and shading are interleaved here, so both count as `raster`.)
+    fn tile(&self, tile: u32, bg: [f32; 4], clock: &StageClock) -> (Vec<[f32; 4]>, u64) {
+        let t_start = Instant::now();
         let (x0, y0, x1, y1) = self.tile_rect(tile);
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let ns = self.pattern.len();
@@ -513,10 +536,12 @@ impl Frame<'_> {
                 }
             }
         }
+        let t_resolve = Instant::now();
         let out = color
             .chunks_exact(ns)
             .map(|px| resolve(px.iter().copied(), ns, bg))
             .collect();
+        clock.add(t_start, t_resolve, t_resolve, Instant::now());
         (out, shaded)
     }
 
@@ -544,7 +569,8 @@ impl Frame<'_> {
     /// Visibility first (the fast path): per sample the nearest triangle, with the reference's
     /// coverage and depth arithmetic; then each visible (pixel, triangle) pair is shaded once,
     /// Phong-interpolated objects 8 at a time by [`shade8`]; then the reference's resolve.
-    fn tile_visible(&self, tile: u32, bg: [f32; 4]) -> (Vec<[f32; 4]>, u64) {
+    fn tile_visible(&self, tile: u32, bg: [f32; 4], clock: &StageClock) -> (Vec<[f32; 4]>, u64) {
+        let t_start = Instant::now();
         let (x0, y0, x1, y1) = self.tile_rect(tile);
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let ns = self.pattern.len();
@@ -586,6 +612,7 @@ impl Frame<'_> {
                 }
             }
         }
+        let t_shade = Instant::now();
         // One job per visible (pixel, triangle); a pixel's jobs are contiguous.
         let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
         let mut starts = Vec::with_capacity(tw * th + 1);
@@ -643,6 +670,7 @@ impl Frame<'_> {
                 }
             }
         }
+        let t_resolve = Instant::now();
         // One sample: the pixel is its job's colour (opaque: the resolve is exact, x·1/1 = x)
         // or the background as the resolve makes it.
         if ns == 1 {
@@ -659,6 +687,7 @@ impl Frame<'_> {
                     }
                 })
                 .collect();
+            clock.add(t_start, t_shade, t_resolve, Instant::now());
             return (out, jobs.len() as u64);
         }
         // The reference's resolve, sample by sample.
@@ -675,6 +704,7 @@ impl Frame<'_> {
                 resolve(samples, ns, bg)
             })
             .collect();
+        clock.add(t_start, t_shade, t_resolve, Instant::now());
         (out, jobs.len() as u64)
     }
 
