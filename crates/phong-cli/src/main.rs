@@ -42,31 +42,17 @@ enum Backend {
     Auto,
 }
 
+/// What `render` and `bench` share: the input, its overrides and how to render it.
 #[derive(clap::Args)]
-struct RenderArgs {
+struct RunArgs {
     /// Scene file (.toml) or model (.obj).
     input: PathBuf,
-    /// Output PNG file.
-    #[arg(short = 'o', long = "out", value_name = "OUT.png")]
-    output: PathBuf,
     /// Image width in pixels (overrides the scene).
     #[arg(long)]
     width: Option<u32>,
     /// Image height in pixels (overrides the scene).
     #[arg(long)]
     height: Option<u32>,
-    /// Samples per pixel: 1, 4 or 16 (overrides the scene).
-    #[arg(long)]
-    antialias: Option<u32>,
-    /// Shading model: lambert, phong, blinn-phong, phong-lyon, opengl.
-    #[arg(long)]
-    model: Option<String>,
-    /// Interpolation: flat, gouraud, phong.
-    #[arg(long)]
-    interpolation: Option<String>,
-    /// What to show: color, ambient, diffuse, specular, normal, depth.
-    #[arg(long = "output", value_name = "TERM")]
-    term: Option<String>,
     /// Rendering threads for the CPU backend (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -81,33 +67,76 @@ struct RenderArgs {
     verbose: bool,
 }
 
+impl RunArgs {
+    /// Checks the flags, loads the scene (printing its warnings) and applies the size overrides.
+    fn load(&self) -> Result<phong_core::Scene> {
+        let max = phong_core::limits::MAX_IMAGE_DIMENSION;
+        for (flag, v) in [("--width", self.width), ("--height", self.height)] {
+            if let Some(v) = v
+                && !(1..=max).contains(&v)
+            {
+                bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
+            }
+        }
+        if self.threads == Some(0) {
+            bail!(InputError("--threads must be at least 1".into()));
+        }
+        let loaded = phong_scene::load(&self.input)?;
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        let mut scene = loaded.scene;
+        if let Some(w) = self.width {
+            scene.image.width = w;
+        }
+        if let Some(h) = self.height {
+            scene.image.height = h;
+        }
+        Ok(scene)
+    }
+
+    /// The CPU renderer's options.
+    fn options<'a>(&self, progress: Option<&'a (dyn Fn(u64, u64) + Sync)>) -> RenderOptions<'a> {
+        RenderOptions {
+            threads: self.threads,
+            progress,
+            reference: self.reference,
+            no_avx2: false,
+        }
+    }
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    run: RunArgs,
+    /// Output PNG file.
+    #[arg(short = 'o', long = "out", value_name = "OUT.png")]
+    output: PathBuf,
+    /// Samples per pixel: 1, 4 or 16 (overrides the scene).
+    #[arg(long)]
+    antialias: Option<u32>,
+    /// Shading model: lambert, phong, blinn-phong, phong-lyon, opengl.
+    #[arg(long)]
+    model: Option<String>,
+    /// Interpolation: flat, gouraud, phong.
+    #[arg(long)]
+    interpolation: Option<String>,
+    /// What to show: color, ambient, diffuse, specular, normal, depth.
+    #[arg(long = "output", value_name = "TERM")]
+    term: Option<String>,
+}
+
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Scene file (.toml) or model (.obj).
-    input: PathBuf,
+    #[command(flatten)]
+    run: RunArgs,
     /// Frames to time, after one warm-up frame.
     #[arg(long, default_value_t = 10)]
     frames: u32,
-    /// Rendering threads for the CPU backend (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// Image width (overrides the scene).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height (overrides the scene).
-    #[arg(long)]
-    height: Option<u32>,
-    /// Renderer.
-    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
-    backend: Backend,
-    /// CPU: the scalar reference path instead of the fast path.
-    #[arg(long)]
-    reference: bool,
-    /// Print the time of each stage.
-    #[arg(short, long)]
-    verbose: bool,
 }
 
+/// An error in what the user gave (exit code 2).
 #[derive(Debug)]
 struct InputError(String);
 impl std::fmt::Display for InputError {
@@ -190,39 +219,13 @@ fn render_once(
     })
 }
 
-fn check_size(width: Option<u32>, height: Option<u32>) -> Result<()> {
-    let max = phong_core::limits::MAX_IMAGE_DIMENSION;
-    for (flag, v) in [("--width", width), ("--height", height)] {
-        if let Some(v) = v
-            && !(1..=max).contains(&v)
-        {
-            bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
-        }
-    }
-    Ok(())
-}
-
 fn render(a: RenderArgs) -> Result<()> {
     let t0 = Instant::now();
     let is_png = a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if !is_png {
         bail!(InputError(format!("output {} must be a .png file", a.output.display())));
     }
-    check_size(a.width, a.height)?;
-    if a.threads == Some(0) {
-        bail!(InputError("--threads must be at least 1".into()));
-    }
-    let loaded = phong_scene::load(&a.input)?;
-    for w in &loaded.warnings {
-        eprintln!("warning: {w}");
-    }
-    let mut scene = loaded.scene;
-    if let Some(w) = a.width {
-        scene.image.width = w;
-    }
-    if let Some(h) = a.height {
-        scene.image.height = h;
-    }
+    let mut scene = a.run.load()?;
     if let Some(s) = a.antialias {
         if !phong_core::limits::SAMPLE_COUNTS.contains(&s) {
             bail!(InputError(format!("--antialias must be 1, 4 or 16, got {s}")));
@@ -262,7 +265,7 @@ fn render(a: RenderArgs) -> Result<()> {
     }
     let t_load = t0.elapsed();
 
-    let gpu = open_gpu(a.backend)?;
+    let gpu = open_gpu(a.run.backend)?;
     let bar = ProgressBar::hidden();
     bar.set_style(ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed}").expect("valid template"));
     let tty = std::io::stderr().is_terminal();
@@ -276,24 +279,20 @@ fn render(a: RenderArgs) -> Result<()> {
         bar.set_length(total);
         bar.set_position(done);
     };
-    let options = RenderOptions {
-        threads: a.threads,
-        progress: Some(&progress),
-        reference: a.reference,
-        no_avx2: false,
-    };
+    let options = a.run.options(Some(&progress));
     let (mut image, times, triangles, shaded) =
-        render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.input.display()))?;
+        render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.run.input.display()))?;
     bar.finish_and_clear();
     phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
     let t_write = Instant::now();
     phong_scene::write_png(&a.output, &image, scene.image.encoding)?;
     let t_write = t_write.elapsed();
-    if a.verbose {
+    if a.run.verbose {
         let backend = match &gpu {
             Some(g) => format!("gpu, {}", g.adapter_name()),
             None => {
                 let n = a
+                    .run
                     .threads
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
                 format!("cpu, {n} threads")
@@ -301,7 +300,7 @@ fn render(a: RenderArgs) -> Result<()> {
         };
         eprintln!(
             "phong: {} -> {}: {}x{} x{} samples, backend {backend}",
-            a.input.display(),
+            a.run.input.display(),
             a.output.display(),
             scene.image.width,
             scene.image.height,
@@ -334,24 +333,12 @@ fn render(a: RenderArgs) -> Result<()> {
 /// frame of the rendering alone: setup and raster on the CPU; the render pass on the GPU, with
 /// upload and read-back printed separately by -v.
 fn bench(a: BenchArgs) -> Result<()> {
-    if a.frames == 0 || a.threads == Some(0) {
-        bail!(InputError("--frames and --threads must be at least 1".into()));
+    if a.frames == 0 {
+        bail!(InputError("--frames must be at least 1".into()));
     }
-    check_size(a.width, a.height)?;
-    let mut scene = phong_scene::load(&a.input)?.scene;
-    if let Some(w) = a.width {
-        scene.image.width = w;
-    }
-    if let Some(h) = a.height {
-        scene.image.height = h;
-    }
-    let options = RenderOptions {
-        threads: a.threads,
-        progress: None,
-        reference: a.reference,
-        no_avx2: false,
-    };
-    let gpu = open_gpu(a.backend)?;
+    let scene = a.run.load()?;
+    let options = a.run.options(None);
+    let gpu = open_gpu(a.run.backend)?;
     render_once(&scene, gpu.as_ref(), &options)?;
     let mut sum = [Duration::ZERO; 6];
     for _ in 0..a.frames {
@@ -372,7 +359,7 @@ fn bench(a: BenchArgs) -> Result<()> {
         per * 1e3,
         pixels / per / 1e6
     );
-    if a.verbose {
+    if a.run.verbose {
         let ms = |d: Duration| d.as_secs_f64() * 1e3 / f64::from(a.frames);
         match &gpu {
             Some(g) => eprintln!(

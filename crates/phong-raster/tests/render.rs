@@ -233,17 +233,7 @@ fn mesh_covering_the_screen_covers_each_sample_once() {
     }
     // Vertices on pixel centres and edges through them: a 32×32 image, a quad split along the
     // diagonal that passes exactly through pixel centres.
-    let quad = Mesh::new(
-        vec![
-            Vec3::new(-1.0, -1.0, 0.0),
-            Vec3::new(1.0, -1.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(-1.0, 1.0, 0.0),
-        ],
-        vec![Vec3::Z; 4],
-        vec![[0, 1, 2], [0, 2, 3]],
-    )
-    .unwrap();
+    let quad = rect(-1.0, -1.0, 1.0, 1.0, 0.0);
     let s = scene(
         32,
         32,
@@ -262,17 +252,7 @@ fn mesh_covering_the_screen_covers_each_sample_once() {
 fn two_triangles_share_an_edge() {
     // Ortho camera of height 16 over 16×16 pixels: 1 world unit per pixel, x = px − 8.
     let (x0, x1, y0, y1) = (4.5 - 8.0, 10.5 - 8.0, 8.0 - 3.5, 8.0 - 12.5);
-    let quad = Mesh::new(
-        vec![
-            Vec3::new(x0, y1, 0.0),
-            Vec3::new(x1, y1, 0.0),
-            Vec3::new(x1, y0, 0.0),
-            Vec3::new(x0, y0, 0.0),
-        ],
-        vec![Vec3::Z; 4],
-        vec![[0, 1, 2], [0, 2, 3]],
-    )
-    .unwrap();
+    let quad = rect(x0, y1, x1, y0, 0.0);
     let s = scene(
         16,
         16,
@@ -354,18 +334,23 @@ fn perspective_correct_interpolation_and_near_clipping() {
     assert!(checked > 1000, "{checked}");
 }
 
-fn quad_at(z: f32, half: f32) -> Mesh {
+/// The rectangle [x0, x1] × [y0, y1] in the plane z, two triangles counter-clockwise seen from +z.
+fn rect(x0: f32, y0: f32, x1: f32, y1: f32, z: f32) -> Mesh {
     Mesh::new(
         vec![
-            Vec3::new(-half, -half, z),
-            Vec3::new(half, -half, z),
-            Vec3::new(half, half, z),
-            Vec3::new(-half, half, z),
+            Vec3::new(x0, y0, z),
+            Vec3::new(x1, y0, z),
+            Vec3::new(x1, y1, z),
+            Vec3::new(x0, y1, z),
         ],
         vec![Vec3::Z; 4],
         vec![[0, 1, 2], [0, 2, 3]],
     )
     .unwrap()
+}
+
+fn quad_at(z: f32, half: f32) -> Mesh {
+    rect(-half, -half, half, half, z)
 }
 
 fn emissive(c: Color) -> Material {
@@ -512,17 +497,7 @@ fn interpolation_modes_against_core() {
 fn antialiasing_averages_samples() {
     assert_eq!(sample_pattern(4).iter().filter(|(x, _)| *x < 0.5).count(), 2);
     let (x0, x1) = (-8.0, 10.5 - 8.0);
-    let quad = Mesh::new(
-        vec![
-            Vec3::new(x0, -8.0, 0.0),
-            Vec3::new(x1, -8.0, 0.0),
-            Vec3::new(x1, 8.0, 0.0),
-            Vec3::new(x0, 8.0, 0.0),
-        ],
-        vec![Vec3::Z; 4],
-        vec![[0, 1, 2], [0, 2, 3]],
-    )
-    .unwrap();
+    let quad = rect(x0, -8.0, x1, 8.0, 0.0);
     let mut s = scene(
         16,
         16,
