@@ -23,7 +23,7 @@ type F = [f32; LANES];
 type M = [bool; LANES];
 
 /// `[f(0), …, f(7)]` as a plain loop: `core::array::from_fn` is not always inlined, and its
-/// calls kept the kernel from vectorising (measured: 12 out-of-line calls per batch).
+/// calls kept the kernel from vectorising (seen in its disassembly: 12 out-of-line call sites).
 #[inline(always)]
 fn lanes<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
     let mut r = [T::default(); LANES];
@@ -388,7 +388,8 @@ pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) ->
         let on: M = lanes(|i| spec_on[i] && sf[i] > 0.0);
         acc(&mut spe, light.spe, fs, on);
     }
-    // Plain loops: array `map` goes through `Drain` and was not inlined (measured).
+    // Plain loops: array `map` goes through `Drain` and was not inlined (15 call sites in the
+    // disassembly before this change, none after).
     let fin = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(f32::MIN, f32::MAX) };
     let mut out = Shaded8 {
         ambient: amb,
