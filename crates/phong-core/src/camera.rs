@@ -64,11 +64,17 @@ impl Camera {
             });
         }
         let upn = up.normalize_or_zero();
-        if upn == Vec3::ZERO || fwd.cross(upn).length() < 1e-6 {
+        if upn == Vec3::ZERO {
             return Err(Error::InvalidDirection {
-                what: "camera up (must not be parallel to the view direction)",
+                what: "camera up",
                 value: up.to_array(),
             });
+        }
+        if fwd.cross(upn).length() < 1e-6 {
+            return Err(Error::Degenerate(format!(
+                "camera up [{}, {}, {}] is parallel to the view direction (from position to target); give another `up`",
+                up.x, up.y, up.z
+            )));
         }
         match projection {
             Projection::Perspective { fov_y_deg } => {

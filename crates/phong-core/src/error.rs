@@ -58,6 +58,10 @@ pub enum Error {
         /// Quadratic coefficient.
         k2: f32,
     },
+    /// Values that are each valid but do not work together (e.g. a camera's up vector
+    /// parallel to its view direction).
+    #[error("{0}")]
+    Degenerate(String),
     /// No built-in material has this name.
     #[error("unknown material {name:?}{}", suggest(.suggestions))]
     UnknownMaterial {

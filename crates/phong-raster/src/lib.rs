@@ -44,7 +44,10 @@ pub enum Error {
     #[error("antialias must be 1, 4 or 16 samples per pixel, got {0}")]
     Samples(u32),
     /// The image (times its samples) is larger than the renderer accepts.
-    #[error("image {width}x{height} with {samples} samples per pixel is too large (limit: 16384 on a side)")]
+    #[error(
+        "image {width}x{height} with {samples} samples per pixel is too large (limits: 16384 pixels on a side, \
+         and 16384x16384x4 samples in all)"
+    )]
     TooLarge {
         /// Width.
         width: u32,

@@ -324,6 +324,15 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
             has_normals,
         });
     }
+    if parts.is_empty() {
+        return Err(Error::at(
+            path,
+            &src,
+            0,
+            None,
+            "no faces (`f` records): nothing to render".into(),
+        ));
+    }
     // Merge parts that share a material within the same group name.
     let mut merged: Vec<ObjPart> = Vec::new();
     let mut index: HashMap<(String, Option<[u32; 4]>), usize> = HashMap::new();
@@ -411,6 +420,9 @@ mod tests {
             e.contains("range.obj:4:7: `f`: vertex index 9 is out of range: 3 defined"),
             "{e}"
         );
+        let obj = write(&d, "faceless.obj", "v 0 0 0\nv 1 0 0\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("faceless.obj:1:1: no faces"), "{e}");
         let obj = write(&d, "short.obj", "v 0 0\n");
         assert!(
             load_obj(&obj, &mut Vec::new())

@@ -164,6 +164,10 @@ fn value_errors_have_line_column_and_key() {
     assert_err("[camera]\nnear = 5\nfar = 1\n", &["scene.toml:3:7", "`far`"]);
     assert_err("[camera]\nposition = [0, 0, 0]\n", &["scene.toml:2:12", "`camera`"]);
     assert_err(
+        "[camera]\nposition = [0, 5, 0]\n",
+        &["scene.toml:2:12", "`camera`", "parallel to the view direction"],
+    );
+    assert_err(
         "[camera]\nposition = [0, 0]\n",
         &["scene.toml:2:12", "`position`", "3 numbers"],
     );
