@@ -7,7 +7,7 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::simd::{LANES, Prepared, avx2_available, shade8};
+use crate::simd::{Batch, Planes, Prepared, Term, avx2_available, shade_batch};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -121,6 +121,9 @@ struct Tri {
     v: [ClipVertex; 3],
     /// Flat: the triangle's colour and facet normal (as seen: flipped on a two-sided back face).
     flat: Option<(Color, Vec3)>,
+    /// The fast path's plane equations (Phong: world position and normal, flipped on a back
+    /// face; Gouraud: the colour seen); unused for other objects.
+    planes: Planes,
     /// A back face of a two-sided object: lit with flipped normals (OpenGL's two-sided lighting).
     back: bool,
     object: u32,
@@ -128,13 +131,22 @@ struct Tri {
     bbox: [u32; 4],
 }
 
+/// How the fast path shades an object's pixels.
+enum Mode {
+    /// Interpolated position and normal, the 8-lane kernel; the term shown.
+    Phong(Prepared, Term),
+    /// Interpolated vertex colours, 8 lanes.
+    Gouraud,
+    /// One pixel at a time, as the reference path (flat shading, normal and depth outputs).
+    Scalar,
+}
+
 struct Frame<'a> {
     scene: &'a Scene,
     /// Use the AVX2 build of the kernel (decided once per frame).
     avx2: bool,
-    /// Per object: the fast path's shading constants, for objects it shades with the kernel
-    /// (Phong interpolation, a lit output term).
-    prepared: Vec<Option<Prepared>>,
+    /// Per object: how the fast path shades it (decided once per frame).
+    modes: Vec<Mode>,
     /// Per object: its view vector rule.
     views: Vec<View>,
     w: u32,
@@ -163,28 +175,36 @@ impl<'a> Frame<'a> {
             .into_iter()
             .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
             .collect();
-        let prepared = scene
+        let modes = scene
             .objects
             .iter()
             .map(|o| {
-                let lit = matches!(
-                    o.shading.output,
-                    Output::Color | Output::Ambient | Output::Diffuse | Output::Specular
-                );
-                (lit && o.shading.interpolation == Interpolation::Phong).then(|| {
-                    Prepared::new(
-                        &scene.lighting,
-                        &o.material,
-                        &o.shading.options,
-                        scene.camera.view(o.shading.viewer),
-                    )
-                })
+                let term = match o.shading.output {
+                    Output::Color => Term::Color,
+                    Output::Ambient => Term::Ambient,
+                    Output::Diffuse => Term::Diffuse,
+                    Output::Specular => Term::Specular,
+                    _ => return Mode::Scalar,
+                };
+                match o.shading.interpolation {
+                    Interpolation::Phong => Mode::Phong(
+                        Prepared::new(
+                            &scene.lighting,
+                            &o.material,
+                            &o.shading.options,
+                            scene.camera.view(o.shading.viewer),
+                        ),
+                        term,
+                    ),
+                    Interpolation::Gouraud => Mode::Gouraud,
+                    Interpolation::Flat => Mode::Scalar,
+                }
             })
             .collect();
         let mut frame = Frame {
             scene,
             avx2: false,
-            prepared,
+            modes,
             views,
             w,
             h,
@@ -360,6 +380,38 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     Ok((image, stats))
 }
 
+/// Plane equations (see [`Planes`]) of two vector attributes, `attrs[j][i]` at vertex `i`, for a
+/// triangle with snapped vertices `xy` (1/256 pixel), edge coefficients `a`, `b` (edge `i`
+/// opposite vertex `i`, positive inside) and twice its area `area`: the barycentric `λ_i` is
+/// `E_i / area`, so `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and
+/// `q = q_0` at vertex 0. Computed in `f64`, stored in `f32`.
+fn plane_equations(
+    xy: &[(i64, i64); 3],
+    a: &[i64; 3],
+    b: &[i64; 3],
+    area: u64,
+    inv_w: [f32; 3],
+    attrs: [[Vec3; 3]; 2],
+) -> Planes {
+    let k = f64::from(1u32 << SUBPIXEL_BITS) / area as f64;
+    let plane = |q: [f32; 3]| {
+        let gx = (0..3).map(|i| a[i] as f64 * f64::from(q[i])).sum::<f64>() * k;
+        let gy = (0..3).map(|i| b[i] as f64 * f64::from(q[i])).sum::<f64>() * k;
+        [q[0], gx as f32, gy as f32]
+    };
+    let mut attr = [[0f32; 3]; 6];
+    for (j, vs) in attrs.iter().enumerate() {
+        for c in 0..3 {
+            attr[j * 3 + c] = plane([0, 1, 2].map(|i| vs[i][c] * inv_w[i]));
+        }
+    }
+    Planes {
+        origin: [xy[0].0 as f32 / ONE, xy[0].1 as f32 / ONE],
+        inv_w: plane(inv_w),
+        attr,
+    }
+}
+
 /// Lights a point of `obj`. Two-sided lighting is the renderer's: OpenGL decides by polygon
 /// facing (a back face is lit with its normals flipped), so the core's per-point flip is off.
 #[inline]
@@ -435,6 +487,24 @@ impl Frame<'_> {
             let top_left = (ya == yb && xb > xa) || yb < ya;
             bias[i] = if top_left { 0 } else { 1 };
         }
+        let planes = match self.modes[object as usize] {
+            Mode::Scalar => Planes::default(),
+            Mode::Phong(..) => {
+                let sign = if front { 1.0 } else { -1.0 };
+                plane_equations(
+                    &xy,
+                    &a,
+                    &b,
+                    area.unsigned_abs(),
+                    inv_w,
+                    [v.map(|v| v.world), v.map(|v| v.normal * sign)],
+                )
+            }
+            Mode::Gouraud => {
+                let c = v.map(|v| if front { v.color } else { v.color_back });
+                plane_equations(&xy, &a, &b, area.unsigned_abs(), inv_w, [c, [Vec3::ZERO; 3]])
+            }
+        };
         let (min_x, max_x) = (
             xy.iter().map(|p| p.0).min().unwrap(),
             xy.iter().map(|p| p.0).max().unwrap(),
@@ -460,6 +530,7 @@ impl Frame<'_> {
             inv_w,
             v,
             flat: flat.map(|f| f[usize::from(!front)]),
+            planes,
             back: !front,
             object,
             bbox: [px0 as u32, py0 as u32, px1 as u32, py1 as u32],
@@ -559,15 +630,6 @@ impl Frame<'_> {
         q.map(|x| x / sum)
     }
 
-    /// Interpolated world position and normal (flipped on a back face) of `t` at pixel `(px, py)`.
-    #[inline]
-    fn position_normal(t: &Tri, px: u32, py: u32) -> (Vec3, Vec3) {
-        let q = Self::weights(t, px, py);
-        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
-        let n = lerp3(|v| v.normal);
-        (lerp3(|v| v.world), if t.back { -n } else { n })
-    }
-
     /// Visibility first (the fast path): per sample the nearest triangle, with the reference's
     /// coverage and depth arithmetic; then each visible (pixel, triangle) pair is shaded once,
     /// Phong-interpolated objects 8 at a time by [`shade8`]; then the reference's resolve.
@@ -615,62 +677,60 @@ impl Frame<'_> {
             }
         }
         let t_shade = Instant::now();
-        // One job per visible (pixel, triangle); a pixel's jobs are contiguous.
+        // One job per visible (pixel, triangle), the pixel as `row << 16 | column` in the tile
+        // (no division to find it again: per-lane integer divisions were 1% of fill); a
+        // pixel's jobs are contiguous.
         let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
         let mut starts = Vec::with_capacity(tw * th + 1);
-        if ns == 1 {
-            for (pixel, &id) in ids.iter().enumerate() {
+        for row in 0..th {
+            for col in 0..tw {
+                let pixel = row * tw + col;
+                let packed = (row as u32) << 16 | col as u32;
                 starts.push(jobs.len());
-                if id != u32::MAX {
-                    jobs.push((pixel as u32, id));
+                if ns == 1 {
+                    if ids[pixel] != u32::MAX {
+                        jobs.push((packed, ids[pixel]));
+                    }
+                    continue;
                 }
-            }
-        } else {
-            for pixel in 0..tw * th {
-                starts.push(jobs.len());
                 let first = jobs.len();
                 for &id in &ids[pixel * ns..(pixel + 1) * ns] {
                     if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
-                        jobs.push((pixel as u32, id));
+                        jobs.push((packed, id));
                     }
                 }
             }
         }
         starts.push(jobs.len());
-        let at = |pixel: u32| (x0 + pixel % tw as u32, y0 + pixel / tw as u32);
+        let at = |packed: u32| (x0 + (packed & 0xffff), y0 + (packed >> 16));
         let mut colors = vec![[0f32; 4]; jobs.len()];
         let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
             let t = self.tri(ti);
-            if self.prepared[t.object as usize].is_some() {
-                batches[t.object as usize].push(k as u32);
-            } else {
+            if matches!(self.modes[t.object as usize], Mode::Scalar) {
                 let (px, py) = at(pixel);
                 colors[k] = self.shade_pixel(t, px, py);
+            } else {
+                batches[t.object as usize].push(k as u32);
             }
         }
         for (object, batch) in batches.iter().enumerate() {
-            let Some(prep) = &self.prepared[object] else { continue };
-            let output = self.scene.objects[object].shading.output;
-            for chunk in batch.chunks(LANES) {
-                let mut position = [Vec3::ZERO; LANES];
-                let mut normal = [Vec3::ZERO; LANES];
-                for lane in 0..LANES {
-                    let (pixel, ti) = jobs[chunk[lane.min(chunk.len() - 1)] as usize];
+            let kind = match &self.modes[object] {
+                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
+                Mode::Gouraud => Batch::Gouraud,
+                Mode::Scalar => continue,
+            };
+            shade_batch(
+                self.avx2,
+                kind,
+                batch.len(),
+                |i| {
+                    let (pixel, ti) = jobs[batch[i] as usize];
                     let (px, py) = at(pixel);
-                    (position[lane], normal[lane]) = Self::position_normal(self.tri(ti), px, py);
-                }
-                let sh = shade8(self.avx2, prep, &position, &normal);
-                let term = match output {
-                    Output::Ambient => sh.ambient,
-                    Output::Diffuse => sh.diffuse,
-                    Output::Specular => sh.specular,
-                    _ => sh.color,
-                };
-                for (lane, &k) in chunk.iter().enumerate() {
-                    colors[k as usize] = [term[0][lane], term[1][lane], term[2][lane], 1.0];
-                }
-            }
+                    (px as f32 + 0.5, py as f32 + 0.5, &self.tri(ti).planes)
+                },
+                |i, rgb| colors[batch[i] as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
+            );
         }
         let t_resolve = Instant::now();
         // One sample: the pixel is its job's colour (opaque: the resolve is exact, x·1/1 = x)

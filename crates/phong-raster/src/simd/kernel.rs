@@ -1,186 +1,150 @@
-//! The 8-lane shading kernel of the fast path: [`phong_core::shade`] for 8 points at once,
-//! in structure-of-arrays form (`[f32; 8]` per component) written as plain element-wise
-//! loops that LLVM vectorises (SSE2 at the baseline, wider where the target allows). No
-//! `unsafe` and no intrinsics.
+//! The shading kernels of the fast path, written once over the 8-lane vector of
+//! [`super::vector`]: [`phong_core::shade`] for 8 points at once in structure-of-arrays form,
+//! and the perspective-correct interpolation of a triangle's attributes from plane equations.
 //!
 //! Per object, [`Prepared`] hoists what does not change per pixel: the light-material
 //! products, the decoded options, the normalisation factors. Decisions (light type, model,
-//! options) are taken once per light and batch; lanes differ only in data, with selects.
+//! options, whether a light is attenuated) are taken once per light and batch; lanes differ
+//! only in data, with selects.
 //!
-//! The one approximation is `pow`: `x^s = 2^(s·log2 x)` with a 7th-order atanh series for
-//! `log2` on `[√½, √2)` (truncation below 2e-8) and a degree-7 Taylor polynomial for `2^f`
-//! on `[−½, ½]` (below 6e-9); the relative error of `x^s`, measured against `powf`, is at most
-//! `s·3.3e-7` (mostly the f32 rounding of `s·log2 x`): 3.3e-4 at `s = 1000`, far below 1/255
-//! for terms up to 1. The kernel is tested against `shade` (1e-4 absolute or relative) and the
-//! fast path's images against the reference path's (within 1/255 on every pixel).
+//! Approximations, all far below 1/255 on terms up to 1: `pow` is `x^s = 2^(s·log2 x)` with a
+//! 7th-order atanh series for `log2` on `[√½, √2)` (truncation below 2e-8) and a degree-7
+//! Taylor polynomial for `2^f` on `[−½, ½]` (below 6e-9); the relative error of `x^s`,
+//! measured against `powf`, is at most `s·3.3e-7` (mostly the f32 rounding of `s·log2 x`):
+//! 3.3e-4 at `s = 1000`. The AVX2 build also uses fused multiply-adds and refined estimates of
+//! `1/x` and `1/√x` (relative error about 2^−22). The kernel is tested against `shade` (5e-4
+//! relative, both builds) and the fast path's images against the reference path's (within
+//! 1/255 on every pixel).
 
+use super::vector::Vf32;
 use glam::Vec3;
 use phong_core::{Color, Light, Lighting, LyonLambda, Material, Normalization, ShadingOptions, SpecularModel, View};
 
-/// Lanes per batch.
+/// Lanes of [`shade8`].
 pub const LANES: usize = 8;
-type F = [f32; LANES];
-type M = [bool; LANES];
-
-/// `[f(0), …, f(7)]` as a plain loop: `core::array::from_fn` is not always inlined, and its
-/// calls kept the kernel from vectorising (seen in its disassembly: 12 out-of-line call sites).
-#[inline(always)]
-fn lanes<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
-    let mut r = [T::default(); LANES];
-    for (i, x) in r.iter_mut().enumerate() {
-        *x = f(i);
-    }
-    r
-}
-
-#[inline(always)]
-fn splat(x: f32) -> F {
-    [x; LANES]
-}
-#[inline(always)]
-fn map(a: F, f: impl Fn(f32) -> f32) -> F {
-    lanes(|i| f(a[i]))
-}
-#[inline(always)]
-fn zip(a: F, b: F, f: impl Fn(f32, f32) -> f32) -> F {
-    lanes(|i| f(a[i], b[i]))
-}
-#[inline(always)]
-fn sel(m: M, a: F, b: F) -> F {
-    lanes(|i| if m[i] { a[i] } else { b[i] })
-}
+/// The most lanes of any [`Vf32`] implementation.
+const MAX_LANES: usize = 16;
 
 /// Three lanes of vectors.
 #[derive(Clone, Copy)]
-struct V3 {
-    x: F,
-    y: F,
-    z: F,
+struct V3<V> {
+    x: V,
+    y: V,
+    z: V,
 }
 
-impl V3 {
+impl<V: Vf32> V3<V> {
     #[inline(always)]
-    fn splat(v: Vec3) -> V3 {
+    fn splat(v: Vec3) -> Self {
         V3 {
-            x: splat(v.x),
-            y: splat(v.y),
-            z: splat(v.z),
+            x: V::splat(v.x),
+            y: V::splat(v.y),
+            z: V::splat(v.z),
         }
     }
     #[inline(always)]
-    fn zero() -> V3 {
-        V3::splat(Vec3::ZERO)
-    }
-    #[inline(always)]
-    fn sub(self, o: V3) -> V3 {
+    fn sub(self, o: Self) -> Self {
         V3 {
-            x: zip(self.x, o.x, |a, b| a - b),
-            y: zip(self.y, o.y, |a, b| a - b),
-            z: zip(self.z, o.z, |a, b| a - b),
+            x: self.x.sub(o.x),
+            y: self.y.sub(o.y),
+            z: self.z.sub(o.z),
         }
     }
     #[inline(always)]
-    fn add(self, o: V3) -> V3 {
+    fn add(self, o: Self) -> Self {
         V3 {
-            x: zip(self.x, o.x, |a, b| a + b),
-            y: zip(self.y, o.y, |a, b| a + b),
-            z: zip(self.z, o.z, |a, b| a + b),
+            x: self.x.add(o.x),
+            y: self.y.add(o.y),
+            z: self.z.add(o.z),
         }
     }
     #[inline(always)]
-    fn scale(self, k: F) -> V3 {
+    fn scale(self, k: V) -> Self {
         V3 {
-            x: zip(self.x, k, |a, b| a * b),
-            y: zip(self.y, k, |a, b| a * b),
-            z: zip(self.z, k, |a, b| a * b),
+            x: self.x.mul(k),
+            y: self.y.mul(k),
+            z: self.z.mul(k),
         }
     }
     #[inline(always)]
-    fn div(self, k: F) -> V3 {
-        V3 {
-            x: zip(self.x, k, |a, b| a / b),
-            y: zip(self.y, k, |a, b| a / b),
-            z: zip(self.z, k, |a, b| a / b),
-        }
+    fn dot(self, o: Self) -> V {
+        self.z.mul_add(o.z, self.x.mul_add(o.x, self.y.mul(o.y)))
     }
     #[inline(always)]
-    fn neg(self) -> V3 {
+    fn select(m: V::M, a: Self, b: Self) -> Self {
         V3 {
-            x: map(self.x, |a| -a),
-            y: map(self.y, |a| -a),
-            z: map(self.z, |a| -a),
-        }
-    }
-    /// `(x·x' + y·y') + z·z'`, glam's order.
-    #[inline(always)]
-    fn dot(self, o: V3) -> F {
-        lanes(|i| self.x[i] * o.x[i] + self.y[i] * o.y[i] + self.z[i] * o.z[i])
-    }
-    #[inline(always)]
-    fn select(m: M, a: V3, b: V3) -> V3 {
-        V3 {
-            x: sel(m, a.x, b.x),
-            y: sel(m, a.y, b.y),
-            z: sel(m, a.z, b.z),
+            x: V::select(m, a.x, b.x),
+            y: V::select(m, a.y, b.y),
+            z: V::select(m, a.z, b.z),
         }
     }
     /// glam's `normalize_or_zero`: `v · (1/|v|)` when that reciprocal is finite and > 0.
     #[inline(always)]
-    fn normalize_or_zero(self) -> (V3, M) {
-        let rcp = map(self.dot(self), |d| 1.0 / d.sqrt());
-        let ok: M = lanes(|i| rcp[i].is_finite() && rcp[i] > 0.0);
-        (V3::select(ok, self.scale(rcp), V3::zero()), ok)
+    fn normalize_or_zero(self) -> (Self, V::M) {
+        let rcp = self.dot(self).rsqrt();
+        let ok = V::and(rcp.finite(), rcp.gt(V::splat(0.0)));
+        let zero = V::splat(0.0);
+        (
+            V3::select(
+                ok,
+                self.scale(rcp),
+                V3 {
+                    x: zero,
+                    y: zero,
+                    z: zero,
+                },
+            ),
+            ok,
+        )
     }
 }
 
 /// `log2 x` for finite `x > 0` (not denormal): `x = m·2^e`, `m` in `[√½, √2)`,
 /// `log2 m = 2/ln 2 · atanh(t)`, `t = (m − 1)/(m + 1)`, series to `t^7`.
 #[inline(always)]
-fn log2(x: f32) -> f32 {
-    let bits = x.to_bits();
-    let e = ((bits >> 23) & 0xff) as i32 - 127;
-    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    // Branch-free, so that lanes vectorise: halve m above √2.
-    let big = m > core::f32::consts::SQRT_2;
-    let m = if big { m * 0.5 } else { m };
-    let e = e + i32::from(big);
-    let t = (m - 1.0) / (m + 1.0);
-    let t2 = t * t;
-    let series = t * (1.0 + t2 * (1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0))));
-    e as f32 + series * (2.0 / core::f32::consts::LN_2)
+fn log2<V: Vf32>(x: V) -> V {
+    let (e, m) = x.frexp();
+    let one = V::splat(1.0);
+    let big = m.gt(V::splat(core::f32::consts::SQRT_2));
+    let m = V::select(big, m.mul(V::splat(0.5)), m);
+    let e = V::select(big, e.add(one), e);
+    let t = m.sub(one).mul(m.add(one).recip());
+    let t2 = t.mul(t);
+    let poly = t2.mul_add(V::splat(1.0 / 7.0), V::splat(1.0 / 5.0));
+    let poly = t2.mul_add(poly, V::splat(1.0 / 3.0));
+    let poly = t2.mul_add(poly, one);
+    t.mul(poly).mul_add(V::splat(2.0 / core::f32::consts::LN_2), e)
 }
 
 /// `2^y` for `y <= 0`: `y = k + f`, `f` in `[−½, ½]`, `2^f = e^(f ln 2)` to degree 7; 0 below
-/// 2^−126. Branch-free: `k` by the 1.5·2^23 rounding trick (round to nearest even).
+/// 2^−126.
 #[inline(always)]
-fn exp2(y: f32) -> f32 {
-    const MAGIC: f32 = 12_582_912.0;
-    let yc = y.max(-126.0);
-    let k = (yc + MAGIC) - MAGIC;
-    let z = (yc - k) * core::f32::consts::LN_2;
-    let p = 1.0
-        + z * (1.0
-            + z * (1.0 / 2.0
-                + z * (1.0 / 6.0 + z * (1.0 / 24.0 + z * (1.0 / 120.0 + z * (1.0 / 720.0 + z * (1.0 / 5040.0)))))));
-    let r = p * f32::from_bits(((k as i32 + 127) as u32) << 23);
-    if y < -126.0 { 0.0 } else { r }
+fn exp2<V: Vf32>(y: V) -> V {
+    let yc = y.max(V::splat(-126.0));
+    let k = yc.round();
+    let z = yc.sub(k).mul(V::splat(core::f32::consts::LN_2));
+    let mut p = V::splat(1.0 / 5040.0);
+    for c in [1.0 / 720.0, 1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 1.0 / 2.0, 1.0, 1.0] {
+        p = z.mul_add(p, V::splat(c));
+    }
+    let r = p.mul(k.pow2i());
+    V::select(y.lt(V::splat(-126.0)), V::splat(0.0), r)
 }
 
 /// `(x⁺)^s` with `0^s = 0` (as `phong_core::pow_positive`), `x` clamped to 1, by `2^(s·log2 x)`
 /// (`s = 0` gives `2^0 = 1` for `x > 0`).
 #[inline(always)]
-fn pow_positive(x: F, s: f32) -> F {
-    map(x, |x| {
-        let r = exp2(s * log2(x.clamp(f32::MIN_POSITIVE, 1.0)));
-        if x > 0.0 { r } else { 0.0 }
-    })
+fn pow_positive<V: Vf32>(x: V, s: f32) -> V {
+    let xc = x.max(V::splat(f32::MIN_POSITIVE)).min(V::splat(1.0));
+    let r = exp2(V::splat(s).mul(log2(xc)));
+    V::select(x.gt(V::splat(0.0)), r, V::splat(0.0))
 }
 
 /// `(x⁺)^s` for a per-light exponent (spot falloff), `0^0 = 1` as `powf`.
 #[inline(always)]
-fn pow_falloff(x: F, s: f32) -> F {
+fn pow_falloff<V: Vf32>(x: V, s: f32) -> V {
     if s == 0.0 {
-        return splat(1.0);
+        return V::splat(1.0);
     }
     pow_positive(x, s)
 }
@@ -268,151 +232,332 @@ impl Prepared {
 #[derive(Clone, Copy, Debug)]
 pub struct Shaded8 {
     /// Emission and ambient terms, per channel.
-    pub ambient: [F; 3],
+    pub ambient: [[f32; LANES]; 3],
     /// Diffuse term.
-    pub diffuse: [F; 3],
+    pub diffuse: [[f32; LANES]; 3],
     /// Specular term.
-    pub specular: [F; 3],
+    pub specular: [[f32; LANES]; 3],
     /// The (clamped) sum.
-    pub color: [F; 3],
+    pub color: [[f32; LANES]; 3],
 }
 
-#[inline(always)]
-fn acc(c: &mut [F; 3], k: Color, f: F, m: M) {
-    for (ch, kc) in c.iter_mut().zip([k.r, k.g, k.b]) {
-        *ch = lanes(|i| if m[i] { ch[i] + kc * f[i] } else { ch[i] });
+/// The four terms, per channel, in vectors.
+#[derive(Clone, Copy)]
+pub(crate) struct Terms<V> {
+    ambient: [V; 3],
+    diffuse: [V; 3],
+    specular: [V; 3],
+    color: [V; 3],
+}
+
+/// Which term of the shading an object shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Term {
+    /// Emission and ambient.
+    Ambient,
+    /// Diffuse.
+    Diffuse,
+    /// Specular.
+    Specular,
+    /// The sum.
+    Color,
+}
+
+impl<V: Vf32> Terms<V> {
+    #[inline(always)]
+    fn get(&self, term: Term) -> [V; 3] {
+        match term {
+            Term::Ambient => self.ambient,
+            Term::Diffuse => self.diffuse,
+            Term::Specular => self.specular,
+            Term::Color => self.color,
+        }
     }
 }
 
-/// Shades 8 points (positions and normals by lane) of one object: `phong_core::shade` with
-/// `pow` approximated as documented above. Inlined into each caller so that the AVX2 build
-/// in [`super`] compiles it with those features.
+/// `c += k·f` on the lanes of `m` (`k` is finite: `f` is zeroed elsewhere, one select instead
+/// of one per channel).
 #[inline(always)]
-pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
-    let pos = V3 {
-        x: lanes(|i| position[i].x),
-        y: lanes(|i| position[i].y),
-        z: lanes(|i| position[i].z),
-    };
-    let nrm = V3 {
-        x: lanes(|i| normal[i].x),
-        y: lanes(|i| normal[i].y),
-        z: lanes(|i| normal[i].z),
-    };
+fn acc<V: Vf32>(c: &mut [V; 3], k: Color, f: V, m: V::M) {
+    let f = V::select(m, f, V::splat(0.0));
+    for (ch, kc) in c.iter_mut().zip([k.r, k.g, k.b]) {
+        *ch = V::splat(kc).mul_add(f, *ch);
+    }
+}
+
+/// Shades 8 points (positions and unnormalised normals by lane) of one object:
+/// `phong_core::shade` with `pow` approximated as documented above.
+#[inline(always)]
+fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
+    let zero = V::splat(0.0);
     let (v, v_ok) = match p.view {
         View::Local { eye } => V3::splat(eye).sub(pos).normalize_or_zero(),
         View::Infinite { to_viewer } => {
             let v = to_viewer.normalize_or_zero();
-            (V3::splat(v), [v != Vec3::ZERO; LANES])
+            let ok = if v != Vec3::ZERO {
+                V::all_true()
+            } else {
+                V::not(V::all_true())
+            };
+            (V3::splat(v), ok)
         }
     };
     let (n, n_ok) = nrm.normalize_or_zero();
     let o = &p.options;
     let s = p.shininess;
     let normalized = o.normalization != Normalization::None;
-    let mut amb = [splat(p.base.r), splat(p.base.g), splat(p.base.b)];
-    let mut dif = [splat(0.0); 3];
-    let mut spe = [splat(0.0); 3];
+    let mut amb = [V::splat(p.base.r), V::splat(p.base.g), V::splat(p.base.b)];
+    let mut dif = [zero; 3];
+    let mut spe = [zero; 3];
     for light in &p.lights {
         let (l, l_ok, factor) = match light.kind {
-            Kind::Directional { to_light } => (V3::splat(to_light), [true; LANES], splat(1.0)),
+            Kind::Directional { to_light } => (V3::splat(to_light), V::all_true(), V::splat(1.0)),
             Kind::Positional { position, k, spot } => {
                 let dv = V3::splat(position).sub(pos);
-                let d = map(dv.dot(dv), f32::sqrt);
-                let pos_d: M = lanes(|i| d[i] > 0.0);
-                let l = V3::select(pos_d, dv.div(d), V3::zero());
-                let mut factor = map(d, |d| 1.0 / (k[0] + d * (k[1] + d * k[2])));
+                let d2 = dv.dot(dv);
+                let pos_d = d2.gt(zero);
+                let r = d2.rsqrt();
+                // d = √d² (NaN where d² = ∞, as the scalar 1/(k0 + ∞) ends at factor 0 too).
+                let d = V::select(pos_d, d2.mul(r), zero);
+                let l = V3::select(pos_d, dv.scale(r), V3::splat(Vec3::ZERO));
+                let mut factor = if k == [1.0, 0.0, 0.0] {
+                    V::splat(1.0)
+                } else {
+                    d.mul_add(V::splat(k[2]), V::splat(k[1]))
+                        .mul_add(d, V::splat(k[0]))
+                        .recip()
+                };
                 if let Some((axis, cos_cutoff, exponent)) = spot {
-                    let c = l.neg().dot(V3::splat(axis));
-                    let fall = pow_falloff(map(c, |c| c.max(0.0)), exponent);
-                    factor = lanes(|i| {
-                        if pos_d[i] {
-                            factor[i] * if c[i] >= cos_cutoff { fall[i] } else { 0.0 }
-                        } else {
-                            factor[i]
-                        }
-                    });
+                    let c = zero.sub(l.dot(V3::splat(axis)));
+                    let fall = pow_falloff(c.max(zero), exponent);
+                    let inside = V::select(c.ge(V::splat(cos_cutoff)), fall, zero);
+                    factor = V::select(pos_d, factor.mul(inside), factor);
                 }
-                let finite_d: M = lanes(|i| d[i].is_finite());
-                factor = sel(finite_d, factor, splat(0.0));
+                factor = V::select(d.finite(), factor, zero);
                 (l, pos_d, factor)
             }
         };
-        let active: M = lanes(|i| factor[i] > 0.0 && factor[i].is_finite());
+        let active = V::and(factor.gt(zero), factor.finite());
         acc(&mut amb, light.amb, factor, active);
-        let lit: M = lanes(|i| active[i] && l_ok[i] && n_ok[i]);
+        let lit = V::and(V::and(active, l_ok), n_ok);
         let ndotl = n.dot(l);
-        let front: M = lanes(|i| lit[i] && ndotl[i] > 0.0);
-        let fd: F = lanes(|i| factor[i] * p.kd * ndotl[i]);
+        let ndotl_pos = ndotl.gt(zero);
+        let front = V::and(lit, ndotl_pos);
+        let fd = factor.mul(V::splat(p.kd)).mul(ndotl);
         acc(&mut dif, light.dif, fd, front);
-        let spec_on: M = lanes(|i| lit[i] && (ndotl[i] > 0.0 || !o.gate_specular) && v_ok[i]);
-        if !spec_on.iter().any(|&b| b) {
+        let gate = if o.gate_specular { ndotl_pos } else { V::all_true() };
+        let spec_on = V::and(V::and(lit, gate), v_ok);
+        if !V::any(spec_on) {
             continue;
         }
         let mut sf = match o.specular {
-            SpecularModel::None => splat(0.0),
+            SpecularModel::None => zero,
             SpecularModel::Phong => {
-                let ln = l.dot(n);
-                let r = n.scale(map(ln, |x| 2.0 * x)).sub(l);
+                let r = n.scale(ndotl.add(ndotl)).sub(l);
                 pow_positive(r.dot(v), s)
             }
             SpecularModel::BlinnPhong => {
                 let (h, h_ok) = l.add(v).normalize_or_zero();
-                let x = n.dot(h);
-                sel(h_ok, pow_positive(x, s), splat(0.0))
+                V::select(h_ok, pow_positive(n.dot(h), s), zero)
             }
             SpecularModel::Lyon { squarings, lambda } => {
-                let ln = l.dot(n);
-                let r = n.scale(map(ln, |x| 2.0 * x)).sub(l);
+                let r = n.scale(ndotl.add(ndotl)).sub(l);
                 let rv = r.dot(v);
                 let lam = match lambda {
-                    LyonLambda::Dot => map(rv, |x| 1.0 - x),
+                    LyonLambda::Dot => V::splat(1.0).sub(rv),
                     LyonLambda::Difference => {
                         let d = r.sub(v);
-                        map(d.dot(d), |x| 0.5 * x)
+                        d.dot(d).mul(V::splat(0.5))
                     }
                 };
-                lanes(|i| {
-                    if rv[i] <= 0.0 {
-                        0.0
-                    } else {
-                        phong_core::lyon(lam[i].max(0.0), s, squarings)
+                // Lyon's squarings per lane (a rarely used model: not worth a vector form).
+                let (rv, lam) = (rv.to_array(), lam.to_array());
+                let mut out = V::A::default();
+                for (i, o) in out.as_mut().iter_mut().enumerate() {
+                    if rv.as_ref()[i] > 0.0 {
+                        *o = phong_core::lyon(lam.as_ref()[i].max(0.0), s, squarings);
                     }
-                })
+                }
+                V::from_array(out)
             }
         };
         if normalized {
-            sf = zip(sf, ndotl, |a, b| a * b.max(0.0));
+            sf = sf.mul(ndotl.max(zero));
         }
-        let fs: F = lanes(|i| factor[i] * p.ks * sf[i]);
-        let on: M = lanes(|i| spec_on[i] && sf[i] > 0.0);
+        let fs = factor.mul(V::splat(p.ks)).mul(sf);
+        let on = V::and(spec_on, sf.gt(zero));
         acc(&mut spe, light.spe, fs, on);
     }
-    // Plain loops: array `map` goes through `Drain` and was not inlined (15 call sites in the
-    // disassembly before this change, none after).
-    let fin = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(f32::MIN, f32::MAX) };
-    let mut out = Shaded8 {
+    // NaN → 0, overflow → ±f32::MAX, as `shade`.
+    let fin = |x: V| V::select(x.nan(), zero, x.max(V::splat(f32::MIN)).min(V::splat(f32::MAX)));
+    let mut t = Terms {
         ambient: amb,
         diffuse: dif,
         specular: spe,
-        color: [splat(0.0); 3],
+        color: [zero; 3],
     };
     for c in 0..3 {
-        for i in 0..LANES {
-            let (a, d, sp) = (fin(amb[c][i]), fin(dif[c][i]), fin(spe[c][i]));
-            out.ambient[c][i] = a;
-            out.diffuse[c][i] = d;
-            out.specular[c][i] = sp;
-            let sum = fin(a + d + sp);
-            out.color[c][i] = if o.clamp { sum.clamp(0.0, 1.0) } else { sum };
+        t.ambient[c] = fin(amb[c]);
+        t.diffuse[c] = fin(dif[c]);
+        t.specular[c] = fin(spe[c]);
+        let sum = fin(t.ambient[c].add(t.diffuse[c]).add(t.specular[c]));
+        t.color[c] = if o.clamp { sum.max(zero).min(V::splat(1.0)) } else { sum };
+    }
+    t
+}
+
+/// [`shade`] on arrays of positions and normals.
+#[inline(always)]
+pub(crate) fn shade_points<V: Vf32<A = [f32; LANES]>>(
+    p: &Prepared,
+    position: &[Vec3; LANES],
+    normal: &[Vec3; LANES],
+) -> Shaded8 {
+    let col = |a: &[Vec3; LANES], f: fn(Vec3) -> f32| V::from_array(std::array::from_fn(|i| f(a[i])));
+    let pos = V3 {
+        x: col(position, |v| v.x),
+        y: col(position, |v| v.y),
+        z: col(position, |v| v.z),
+    };
+    let nrm = V3 {
+        x: col(normal, |v| v.x),
+        y: col(normal, |v| v.y),
+        z: col(normal, |v| v.z),
+    };
+    let t = shade(p, pos, nrm);
+    let arr = |c: [V; 3]| c.map(V::to_array);
+    Shaded8 {
+        ambient: arr(t.ambient),
+        diffuse: arr(t.diffuse),
+        specular: arr(t.specular),
+        color: arr(t.color),
+    }
+}
+
+/// `shade8` in the portable build (the AVX2 build is [`super::shade8`]).
+pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
+    shade_points::<super::vector::Portable>(p, position, normal)
+}
+
+/// A triangle's perspective-correct attributes as plane equations in pixel coordinates:
+/// `q(x, y) = c + gx·(x − ox) + gy·(y − oy)` for `1/w` and for each attribute divided by `w`;
+/// the attribute is `q_a / q_w` (interpolating `a/w` and `1/w` linearly in screen space).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Planes {
+    /// `(ox, oy)`: where the planes' constants are taken (a vertex), in pixels.
+    pub origin: [f32; 2],
+    /// `1/w`: `[c, gx, gy]`.
+    pub inv_w: [f32; 3],
+    /// Attributes over `w`: Phong: world position then normal; Gouraud: the colour.
+    pub attr: [[f32; 3]; 6],
+}
+
+/// What a batch interpolates and how it colours the result.
+#[derive(Clone, Copy)]
+pub enum Batch<'a> {
+    /// Interpolated position and normal, shaded by the kernel; the given term.
+    Phong(&'a Prepared, Term),
+    /// Interpolated colour (Gouraud).
+    Gouraud,
+}
+
+/// Shades `n` pixels 8 at a time: `lane(i)` gives pixel `i`'s centre `(x, y)` in pixels and its
+/// triangle's planes; `out(i, rgb)` receives its colour.
+#[inline(always)]
+pub(crate) fn shade_batch<'p, V: Vf32>(
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    mut out: impl FnMut(usize, [f32; 3]),
+) {
+    let attrs = match batch {
+        Batch::Phong(..) => 6,
+        Batch::Gouraud => 3,
+    };
+    let mut start = 0;
+    while start < n {
+        let m = (n - start).min(V::N);
+        let mut xs = V::A::default();
+        let mut ys = V::A::default();
+        let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
+        for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
+            let (x, y, p) = lane(start + i.min(m - 1));
+            xs.as_mut()[i] = x;
+            ys.as_mut()[i] = y;
+            *plane = p;
         }
+        let q = interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys));
+        let rgb = match batch {
+            Batch::Phong(prep, term) => {
+                let pos = V3 {
+                    x: q[0],
+                    y: q[1],
+                    z: q[2],
+                };
+                let nrm = V3 {
+                    x: q[3],
+                    y: q[4],
+                    z: q[5],
+                };
+                shade(prep, pos, nrm).get(term)
+            }
+            Batch::Gouraud => [q[0], q[1], q[2]],
+        };
+        let rgb = rgb.map(V::to_array);
+        for i in 0..m {
+            out(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
+        }
+        start += m;
+    }
+}
+
+/// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
+#[inline(always)]
+fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
+    // One triangle for all lanes (the usual case): broadcast its coefficients.
+    let same = planes.iter().all(|p| std::ptr::eq(*p, planes[0]));
+    let (dx, dy) = if same {
+        let o = planes[0].origin;
+        (x.sub(V::splat(o[0])), y.sub(V::splat(o[1])))
+    } else {
+        let (mut ox, mut oy) = (V::A::default(), V::A::default());
+        for (i, p) in planes.iter().enumerate() {
+            ox.as_mut()[i] = p.origin[0];
+            oy.as_mut()[i] = p.origin[1];
+        }
+        (x.sub(V::from_array(ox)), y.sub(V::from_array(oy)))
+    };
+    let w = plane(planes, same, dx, dy, |p| p.inv_w).recip();
+    let mut out = [V::splat(0.0); 6];
+    for (a, o) in out.iter_mut().enumerate().take(attrs) {
+        *o = plane(planes, same, dx, dy, |p| p.attr[a]).mul(w);
     }
     out
+}
+
+/// `c + gx·dx + gy·dy` with the lanes' coefficients `f(planes[i])`.
+#[inline(always)]
+fn plane<V: Vf32>(planes: &[&Planes], same: bool, dx: V, dy: V, f: impl Fn(&Planes) -> [f32; 3]) -> V {
+    let (c, gx, gy) = if same {
+        let [c, gx, gy] = f(planes[0]);
+        (V::splat(c), V::splat(gx), V::splat(gy))
+    } else {
+        let mut k = [V::A::default(); 3];
+        for (i, p) in planes.iter().enumerate() {
+            let v = f(p);
+            k[0].as_mut()[i] = v[0];
+            k[1].as_mut()[i] = v[1];
+            k[2].as_mut()[i] = v[2];
+        }
+        (V::from_array(k[0]), V::from_array(k[1]), V::from_array(k[2]))
+    };
+    gy.mul_add(dy, gx.mul_add(dx, c))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::vector::Portable;
 
     #[test]
     fn pow_approximation_bound() {
@@ -422,7 +567,7 @@ mod tests {
             let x = i as f32 / 2000.0;
             for s in [0.5f32, 1.0, 7.3, 32.0, 128.0, 500.0, 1000.0] {
                 let want = x.powf(s) as f64;
-                let got = pow_positive(splat(x), s)[0] as f64;
+                let got = pow_positive(Portable::splat(x), s).0[0] as f64;
                 if want > 1e-30 {
                     worst = worst.max(((got - want) / want).abs() / f64::from(s).max(1.0));
                 }
@@ -430,7 +575,7 @@ mod tests {
         }
         // Per unit of exponent: measured 3.3e-7 (mostly the f32 rounding of s·log2 x).
         assert!(worst < 5e-7, "{worst:e}");
-        assert_eq!(pow_positive(splat(0.0), 0.0)[0], 0.0);
-        assert_eq!(pow_positive(splat(0.3), 0.0)[0], 1.0);
+        assert_eq!(pow_positive(Portable::splat(0.0), 0.0).0[0], 0.0);
+        assert_eq!(pow_positive(Portable::splat(0.3), 0.0).0[0], 1.0);
     }
 }

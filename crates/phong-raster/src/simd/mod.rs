@@ -1,16 +1,19 @@
-//! SIMD: the 8-lane shading kernel and its runtime dispatch. The only module of phong with
-//! `unsafe`, confined to the dispatch below.
+//! SIMD: the 8-lane kernels and their runtime dispatch. The only module of phong with
+//! `unsafe`: the AVX2 vector type's intrinsics ([`vector`]) and the calls below into functions
+//! compiled with AVX2 and FMA.
 //!
-//! The kernel is portable Rust ([`kernel`]) that LLVM vectorises. [`shade8`] runs it as
-//! compiled for the target's baseline (SSE2 on x86-64: 4-wide), or, when the CPU has AVX2 and
-//! FMA and the caller allows it, the same code compiled with those features enabled (8-wide).
-//! Rust never contracts `a·b + c` into a fused multiply-add on its own, so both builds compute
-//! bit-identical results (tested: `tests/fast.rs`).
+//! The kernels ([`kernel`]) are written once over the [`vector::Vf32`] trait. Each entry point
+//! here runs them either on [`vector::Portable`] (plain `[f32; 8]` loops, any CPU; LLVM
+//! vectorises what it can) or, when the CPU has AVX2 and FMA and the caller allows it, on
+//! [`vector::Avx2`] inside a `#[target_feature(enable = "avx2,fma")]` function. The two builds
+//! differ in rounding (fused multiply-adds, refined reciprocal estimates): both are tested
+//! against `phong_core::shade`, and the images of both against the reference path.
 
 pub mod kernel;
+pub mod vector;
 
 use glam::Vec3;
-pub use kernel::{LANES, Prepared, Shaded8};
+pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
 
 /// Whether the AVX2 build may be used: the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {
@@ -27,19 +30,57 @@ pub fn avx2_available() -> bool {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn shade8_avx2(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
-    kernel::shade8(p, position, normal)
+    kernel::shade_points::<vector::Avx2>(p, position, normal)
 }
 
-/// [`kernel::shade8`], with the AVX2 build when `avx2` is true (the caller checked
-/// [`avx2_available`]), else the baseline build.
+/// `phong_core::shade` on 8 points (`pow` approximated, see [`kernel`]), with the AVX2 build
+/// when `avx2` is true (the caller checked [`avx2_available`]), else the portable build.
 #[inline]
 pub fn shade8(avx2: bool, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        debug_assert!(avx2_available());
-        // SAFETY: `avx2` is only true when `avx2_available()` found AVX2 and FMA on this CPU.
+        assert!(
+            avx2_available(),
+            "the AVX2 build asked for on a CPU without AVX2 and FMA"
+        );
+        // SAFETY: the CPU has AVX2 and FMA (asserted above).
         return unsafe { shade8_avx2(p, position, normal) };
     }
     let _ = avx2;
     kernel::shade8(p, position, normal)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn shade_batch_avx2<'p>(
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [f32; 3]),
+) {
+    kernel::shade_batch::<vector::Avx2x2>(batch, n, lane, out)
+}
+
+/// Interpolates and shades `n` pixels, 8 at a time: `lane(i)` gives pixel `i`'s centre and its
+/// triangle's [`Planes`], `out(i, rgb)` takes its colour. AVX2 build when `avx2` is true.
+#[inline]
+pub fn shade_batch<'p>(
+    avx2: bool,
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [f32; 3]),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        assert!(
+            avx2_available(),
+            "the AVX2 build asked for on a CPU without AVX2 and FMA"
+        );
+        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        unsafe { shade_batch_avx2(batch, n, lane, out) };
+        return;
+    }
+    let _ = avx2;
+    kernel::shade_batch::<vector::Portable>(batch, n, lane, out)
 }
