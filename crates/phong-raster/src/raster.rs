@@ -332,7 +332,8 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     let bg = scene.image.background;
     // Tiles are written straight into the image, a strip of 64 rows per task, so that
     // nothing frame-sized exists besides the image (a collected copy did: 33 MB at 1080p).
-    let mut image = Image::new(w, h, bg)?;
+    // Zeroed (the allocator's zero pages, no fill): the tiles write every pixel.
+    let mut image = Image::new(w, h, [0.0; 4])?;
     let row_len = w as usize;
     image
         .pixels_mut()
@@ -651,6 +652,10 @@ impl Frame<'_> {
             }
             let step = t.a.map(|a| a << SUBPIXEL_BITS);
             let (bx0, bx1) = (t.bbox[0].max(x0), t.bbox[2].min(x1));
+            if ns == 1 {
+                self.visible_single(t, ti, offsets[0], (x0, y0, tw), (bx0, bx1), &mut depth, &mut ids);
+                continue;
+            }
             for py in t.bbox[1].max(y0)..t.bbox[3].min(y1) {
                 let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
                 let mut row = [0, 1, 2].map(|i| t.a[i] * cx + t.b[i] * cy + t.c[i]);
@@ -677,6 +682,9 @@ impl Frame<'_> {
             }
         }
         let t_shade = Instant::now();
+        if ns == 1 {
+            return self.shade_single(ids, (x0, y0, tw, th), bg, clock, t_start, t_shade);
+        }
         // One job per visible (pixel, triangle), the pixel as `row << 16 | column` in the tile
         // (no division to find it again: per-lane integer divisions were 1% of fill); a
         // pixel's jobs are contiguous.
@@ -687,12 +695,6 @@ impl Frame<'_> {
                 let pixel = row * tw + col;
                 let packed = (row as u32) << 16 | col as u32;
                 starts.push(jobs.len());
-                if ns == 1 {
-                    if ids[pixel] != u32::MAX {
-                        jobs.push((packed, ids[pixel]));
-                    }
-                    continue;
-                }
                 let first = jobs.len();
                 for &id in &ids[pixel * ns..(pixel + 1) * ns] {
                     if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
@@ -733,25 +735,6 @@ impl Frame<'_> {
             );
         }
         let t_resolve = Instant::now();
-        // One sample: the pixel is its job's colour (opaque: the resolve is exact, x·1/1 = x)
-        // or the background as the resolve makes it.
-        if ns == 1 {
-            let background = resolve(std::iter::once(bg), 1, bg);
-            let out = ids
-                .iter()
-                .enumerate()
-                .map(|(pixel, &id)| {
-                    if id == u32::MAX {
-                        background
-                    } else {
-                        let c = colors[starts[pixel]];
-                        resolve(std::iter::once(c), 1, bg)
-                    }
-                })
-                .collect();
-            clock.add(t_start, t_shade, t_resolve, Instant::now());
-            return (out, jobs.len() as u64);
-        }
         // The reference's resolve, sample by sample.
         let out = (0..tw * th)
             .map(|pixel| {
@@ -768,6 +751,127 @@ impl Frame<'_> {
             .collect();
         clock.add(t_start, t_shade, t_resolve, Instant::now());
         (out, jobs.len() as u64)
+    }
+
+    /// Visibility of triangle `t` (id `ti`) with one sample per pixel, over its rows in the tile
+    /// `(x0, y0, width)` and columns `bx0..bx1`: `o` is the sample's offset of the edge
+    /// functions (bias subtracted). Wide rows first find their covered span exactly (per edge,
+    /// the integer bound of `e − bias + k·step >= 0`), so the loop over pixels tests no edges;
+    /// narrow ones (under 8 pixels, where the three divisions cost more) test each pixel. Same
+    /// edge values and depth arithmetic as the reference, hence the same visibility.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn visible_single(
+        &self,
+        t: &Tri,
+        ti: u32,
+        o: [i64; 3],
+        (x0, y0, tw): (u32, u32, usize),
+        (bx0, bx1): (u32, u32),
+        depth: &mut [f32],
+        ids: &mut [u32],
+    ) {
+        let step = t.a.map(|a| a << SUBPIXEL_BITS);
+        let n = i64::from(bx1 - bx0);
+        let y1 = y0 + (depth.len() / tw) as u32;
+        for py in t.bbox[1].max(y0)..t.bbox[3].min(y1) {
+            let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
+            // e − bias at the row's first pixel.
+            let row = [0, 1, 2].map(|i| t.a[i] * cx + t.b[i] * cy + t.c[i] + o[i]);
+            let (mut lo, mut hi) = (0i64, n);
+            if n >= 8 {
+                for i in 0..3 {
+                    let (e, s) = (row[i], step[i]);
+                    if e < 0 {
+                        if s > 0 {
+                            lo = lo.max((-e + s - 1) / s);
+                        } else {
+                            hi = 0;
+                        }
+                    } else if s < 0 {
+                        hi = hi.min(e / -s + 1);
+                    }
+                }
+            }
+            let line = (py - y0) as usize * tw + (bx0 - x0) as usize;
+            let mut eb = [0, 1, 2].map(|i| row[i] + step[i] * lo);
+            for k in lo..hi {
+                if (eb[0] | eb[1] | eb[2]) >= 0 {
+                    let e = [0, 1, 2].map(|i| eb[i] + t.bias[i]);
+                    let l = e.map(|x| (x as f64 * t.inv_area) as f32);
+                    let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                    let at = line + k as usize;
+                    if zz < depth[at] {
+                        depth[at] = zz;
+                        ids[at] = ti;
+                    }
+                }
+                for i in 0..3 {
+                    eb[i] += step[i];
+                }
+            }
+        }
+    }
+
+    /// The fast path's shading with one sample per pixel: each visible pixel is shaded once and
+    /// written straight into the tile (no job list; the resolve of one opaque sample is the
+    /// sample itself, `x·1/1 = x`). `ids` is the visible triangle per pixel of the tile
+    /// `(x0, y0, width, height)`.
+    fn shade_single(
+        &self,
+        ids: Vec<u32>,
+        (x0, y0, tw, th): (u32, u32, usize, usize),
+        bg: [f32; 4],
+        clock: &StageClock,
+        t_start: Instant,
+        t_shade: Instant,
+    ) -> (Vec<[f32; 4]>, u64) {
+        let background = resolve(std::iter::once(bg), 1, bg);
+        let mut out = vec![background; tw * th];
+        // Per object, its visible pixels as `row << 16 | column`.
+        let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
+        let mut shaded = 0u64;
+        let mut last = (u32::MAX, 0usize);
+        for row in 0..th {
+            for col in 0..tw {
+                let id = ids[row * tw + col];
+                if id == u32::MAX {
+                    continue;
+                }
+                shaded += 1;
+                if id != last.0 {
+                    last = (id, self.tri(id).object as usize);
+                }
+                if matches!(self.modes[last.1], Mode::Scalar) {
+                    let c = self.shade_pixel(self.tri(id), x0 + col as u32, y0 + row as u32);
+                    out[row * tw + col] = resolve(std::iter::once(c), 1, bg);
+                } else {
+                    batches[last.1].push((row as u32) << 16 | col as u32);
+                }
+            }
+        }
+        for (object, batch) in batches.iter().enumerate() {
+            let kind = match &self.modes[object] {
+                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
+                Mode::Gouraud => Batch::Gouraud,
+                Mode::Scalar => continue,
+            };
+            let index = |packed: u32| (packed >> 16) as usize * tw + (packed & 0xffff) as usize;
+            shade_batch(
+                self.avx2,
+                kind,
+                batch.len(),
+                |i| {
+                    let p = batch[i];
+                    let (x, y) = (x0 + (p & 0xffff), y0 + (p >> 16));
+                    (x as f32 + 0.5, y as f32 + 0.5, &self.tri(ids[index(p)]).planes)
+                },
+                |i, rgb| out[index(batch[i])] = [rgb[0], rgb[1], rgb[2], 1.0],
+            );
+        }
+        let t_end = Instant::now();
+        clock.add(t_start, t_shade, t_end, t_end);
+        (out, shaded)
     }
 
     /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
