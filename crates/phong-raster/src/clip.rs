@@ -70,6 +70,30 @@ pub enum Clipped {
     Polygon(Vec<ClipVertex>),
 }
 
+/// Outcode bits of [`outcode`]: outside a view-volume plane (bits 0–5), outside a clipping
+/// plane (bits 6–11), not finite (bit 12).
+pub const OUTSIDE_VIEW: u16 = 0x3f;
+/// See [`OUTSIDE_VIEW`].
+pub const OUTSIDE_CLIP: u16 = 0xfc0;
+/// See [`OUTSIDE_VIEW`].
+pub const NOT_FINITE: u16 = 0x1000;
+
+/// Which planes clip-space point `c` is outside of (the same tests as [`clip_triangle`]), so
+/// that a triangle's trivial cases are decided from its vertices' codes: all sharing an
+/// [`OUTSIDE_VIEW`] bit is [`Clipped::Rejected`], none with [`OUTSIDE_CLIP`] or [`NOT_FINITE`]
+/// bits is [`Clipped::Inside`]; anything else goes to [`clip_triangle`].
+#[inline]
+pub fn outcode(c: Vec4) -> u16 {
+    let mut code = if c.is_finite() { 0 } else { NOT_FINITE };
+    for (i, p) in VIEW_PLANES.iter().enumerate() {
+        code |= u16::from(p.dot(c) < 0.0) << i;
+    }
+    for (i, p) in CLIP_PLANES.iter().enumerate() {
+        code |= u16::from(p.dot(c) < 0.0) << (6 + i);
+    }
+    code
+}
+
 /// Clips triangle `t`.
 pub fn clip_triangle(t: &[ClipVertex; 3]) -> Clipped {
     if !t.iter().all(|v| v.clip.is_finite()) {
@@ -144,6 +168,37 @@ mod tests {
             p.iter()
                 .any(|q| (q.clip.x - 0.25).abs() < 1e-6 && (q.clip.z + 1.0).abs() < 1e-6)
         );
+    }
+
+    /// The outcodes' trivial decisions agree with `clip_triangle` on random triangles around
+    /// the view volume and the guard band (and NaN).
+    #[test]
+    fn outcodes_decide_as_clip_triangle() {
+        let mut seed = 7u64;
+        let mut r = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let (mut rejected, mut inside) = (0, 0);
+        for i in 0..20000 {
+            let t: [ClipVertex; 3] = std::array::from_fn(|_| {
+                let w = 0.5 + r().abs() * 2.0;
+                let s = if i % 3 == 0 { 8.0 } else { 1.5 };
+                v(r() * s * w, r() * s * w, r() * 1.5 * w, if i % 97 == 0 { f32::NAN } else { w })
+            });
+            let c = t.map(|v| outcode(v.clip));
+            let got = clip_triangle(&t);
+            if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                assert_eq!(got, Clipped::Rejected, "{t:?}");
+                rejected += 1;
+            } else if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                assert_eq!(got, Clipped::Inside, "{t:?}");
+                inside += 1;
+            } else {
+                assert_ne!(got, Clipped::Inside, "{t:?}");
+            }
+        }
+        assert!(rejected > 100 && inside > 100, "{rejected} {inside}");
     }
 
     #[test]

@@ -6,8 +6,8 @@
 //! an edge cover each sample once. This is the scalar reference path, kept
 //! simple: each sample evaluates its three edge functions directly.
 
-use crate::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::simd::{Batch, Planes, Prepared, Term, avx2_available, shade_batch};
+use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
+use crate::simd::{Batch, LANES, Planes, Prepared, Shaded8, Term, avx2_available, shade_batch, shade8};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -102,6 +102,21 @@ fn term(output: Output, s: &Shading) -> Color {
     }
 }
 
+/// The kernel's term for a lit output; `None` for the normal and depth outputs.
+fn lit_term(output: Output) -> Option<Term> {
+    match output {
+        Output::Color => Some(Term::Color),
+        Output::Ambient => Some(Term::Ambient),
+        Output::Diffuse => Some(Term::Diffuse),
+        Output::Specular => Some(Term::Specular),
+        _ => None,
+    }
+}
+
+/// A vertex in the window: snapped `x`, `y` (1/256 pixel), depth, `1/w`.
+#[derive(Clone, Copy, Default)]
+struct Projected(i64, i64, f32, f32);
+
 /// A triangle ready for the tiles.
 struct Tri {
     /// Edge functions `E_i(X, Y) = a·X + b·Y + c` (edge i opposite vertex i), in 1/256 pixel.
@@ -116,11 +131,6 @@ struct Tri {
     inv_area: f64,
     /// Window depth in [0, 1] per vertex.
     z: [f32; 3],
-    /// 1/w per vertex.
-    inv_w: [f32; 3],
-    v: [ClipVertex; 3],
-    /// Flat: the triangle's colour and facet normal (as seen: flipped on a two-sided back face).
-    flat: Option<(Color, Vec3)>,
     /// The fast path's plane equations (Phong: world position and normal, flipped on a back
     /// face; Gouraud: the colour seen); unused for other objects.
     planes: Planes,
@@ -141,6 +151,24 @@ enum Mode {
     Scalar,
 }
 
+/// What the scalar shading of a triangle needs besides [`Tri`]: kept only for the reference
+/// path and for objects the fast path shades one pixel at a time (a 1M-triangle frame's
+/// triangles were 470 bytes each with these inside).
+struct Corners {
+    /// 1/w per vertex.
+    inv_w: [f32; 3],
+    v: [ClipVertex; 3],
+    /// Flat: the triangle's colour and facet normal (as seen: flipped on a two-sided back face).
+    flat: Option<(Color, Vec3)>,
+}
+
+/// The triangles one setup task made, with their [`Corners`] (same index) where kept, else
+/// none.
+struct Chunk {
+    tris: Vec<Tri>,
+    corners: Vec<Corners>,
+}
+
 struct Frame<'a> {
     scene: &'a Scene,
     /// Use the AVX2 build of the kernel (decided once per frame).
@@ -155,14 +183,14 @@ struct Frame<'a> {
     /// Set-up triangles, in the chunks the parallel setup made them (not copied into one
     /// vector: a 1M-triangle Gouraud frame's setup went 190 → 108 ms without that copy); ids
     /// pack (chunk, index), see [`Frame::tri`].
-    tris: Vec<Vec<Tri>>,
+    tris: Vec<Chunk>,
     tiles_x: u32,
     bins: Vec<Vec<u32>>,
 }
 
 impl<'a> Frame<'a> {
     /// Transforms, lights (Gouraud, flat), clips, sets up and bins every triangle.
-    fn build(scene: &'a Scene) -> Frame<'a> {
+    fn build(scene: &'a Scene, reference: bool, avx2: bool) -> Frame<'a> {
         let (w, h) = (scene.image.width, scene.image.height);
         let aspect = w as f32 / h as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);
@@ -179,12 +207,8 @@ impl<'a> Frame<'a> {
             .objects
             .iter()
             .map(|o| {
-                let term = match o.shading.output {
-                    Output::Color => Term::Color,
-                    Output::Ambient => Term::Ambient,
-                    Output::Diffuse => Term::Diffuse,
-                    Output::Specular => Term::Specular,
-                    _ => return Mode::Scalar,
+                let Some(term) = lit_term(o.shading.output) else {
+                    return Mode::Scalar;
                 };
                 match o.shading.interpolation {
                     Interpolation::Phong => Mode::Phong(
@@ -203,7 +227,7 @@ impl<'a> Frame<'a> {
             .collect();
         let mut frame = Frame {
             scene,
-            avx2: false,
+            avx2,
             modes,
             views,
             w,
@@ -220,33 +244,96 @@ impl<'a> Frame<'a> {
             let view = frame.views[oi];
             let mesh = &obj.mesh;
             let gouraud = interpolation == Interpolation::Gouraud;
-            let verts: Vec<ClipVertex> = mesh
-                .positions()
-                .par_iter()
-                .zip(mesh.normals().par_iter())
-                .map(|(&p, &n)| ClipVertex {
-                    clip: clip_from_world * Vec4::from((p, 1.0)),
-                    world: p,
-                    normal: n,
-                    color: if gouraud {
-                        let s = shade_at(scene, obj, &view, p, n);
-                        Vec3::from(term(output, &s).to_array())
-                    } else {
-                        Vec3::ZERO
-                    },
-                    color_back: if gouraud && two_sided {
-                        let s = shade_at(scene, obj, &view, p, -n);
-                        Vec3::from(term(output, &s).to_array())
-                    } else {
-                        Vec3::ZERO
-                    },
-                })
-                .collect();
+            let verts: Vec<ClipVertex> = if let (true, false, Some(lit)) = (gouraud, reference, lit_term(output)) {
+                // The fast path lights Gouraud vertices 8 at a time with the kernel.
+                let prep = Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view);
+                mesh.positions()
+                    .par_chunks(SETUP_CHUNK)
+                    .zip(mesh.normals().par_chunks(SETUP_CHUNK))
+                    .flat_map_iter(|(ps, ns)| {
+                        let mut out = Vec::with_capacity(ps.len());
+                        for (p8, n8) in ps.chunks(LANES).zip(ns.chunks(LANES)) {
+                            let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
+                            let (pp, nn) = (pad(p8), pad(n8));
+                            let pick = |s: &Shaded8| match lit {
+                                Term::Ambient => s.ambient,
+                                Term::Diffuse => s.diffuse,
+                                Term::Specular => s.specular,
+                                Term::Color => s.color,
+                            };
+                            let front = pick(&shade8(avx2, &prep, &pp, &nn));
+                            let back = two_sided.then(|| pick(&shade8(avx2, &prep, &pp, &nn.map(|n| -n))));
+                            for i in 0..p8.len() {
+                                out.push(ClipVertex {
+                                    clip: clip_from_world * Vec4::from((pp[i], 1.0)),
+                                    world: pp[i],
+                                    normal: nn[i],
+                                    color: Vec3::new(front[0][i], front[1][i], front[2][i]),
+                                    color_back: back.map_or(Vec3::ZERO, |b| Vec3::new(b[0][i], b[1][i], b[2][i])),
+                                });
+                            }
+                        }
+                        out
+                    })
+                    .collect()
+            } else {
+                mesh.positions()
+                    .par_iter()
+                    .zip(mesh.normals().par_iter())
+                    .map(|(&p, &n)| ClipVertex {
+                        clip: clip_from_world * Vec4::from((p, 1.0)),
+                        world: p,
+                        normal: n,
+                        color: if gouraud {
+                            let s = shade_at(scene, obj, &view, p, n);
+                            Vec3::from(term(output, &s).to_array())
+                        } else {
+                            Vec3::ZERO
+                        },
+                        color_back: if gouraud && two_sided {
+                            let s = shade_at(scene, obj, &view, p, -n);
+                            Vec3::from(term(output, &s).to_array())
+                        } else {
+                            Vec3::ZERO
+                        },
+                    })
+                    .collect()
+            };
             // Triangle setup in parallel chunks, merged and binned in submission order, so
             // that bins (and images) are those of a sequential setup.
+            // Per vertex, once: its outcode, and its projection where it is inside the clipping
+            // planes (a vertex is shared by about six triangles; per triangle, trivial
+            // clipping decisions and projections were a third of a 1M-triangle setup).
+            let codes: Vec<u16> = verts.par_iter().map(|v| outcode(v.clip)).collect();
+            let projected: Vec<Projected> = verts
+                .par_iter()
+                .zip(&codes)
+                .map(|(v, &code)| {
+                    if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                        frame.project(v.clip)
+                    } else {
+                        Projected::default()
+                    }
+                })
+                .collect();
+            // Corners are kept where scalar shading reads them.
+            let keep = reference || matches!(frame.modes[oi], Mode::Scalar);
             let setup_chunk = |chunk: &[[u32; 3]]| {
-                let mut out = Vec::with_capacity(chunk.len());
+                let mut out = Chunk {
+                    tris: Vec::with_capacity(chunk.len()),
+                    corners: Vec::new(),
+                };
+                let mut push = |r: Option<(Tri, Option<Corners>)>| {
+                    if let Some((t, c)) = r {
+                        out.tris.push(t);
+                        out.corners.extend(c);
+                    }
+                };
                 for tri in chunk {
+                    let c = tri.map(|i| codes[i as usize]);
+                    if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                        continue;
+                    }
                     let t = tri.map(|i| verts[i as usize]);
                     // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
                     let flat = (interpolation == Interpolation::Flat).then(|| {
@@ -260,19 +347,24 @@ impl<'a> Frame<'a> {
                         };
                         [(front, fnorm), (back, -fnorm)]
                     });
+                    if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                        let proj = tri.map(|i| projected[i as usize]);
+                        push(frame.setup(t, Some(proj), flat, oi as u32, keep));
+                        continue;
+                    }
                     match clip_triangle(&t) {
                         Clipped::Rejected => {}
-                        Clipped::Inside => out.extend(frame.setup(t, flat, oi as u32)),
+                        Clipped::Inside => push(frame.setup(t, None, flat, oi as u32, keep)),
                         Clipped::Polygon(p) => {
                             for i in 1..p.len() - 1 {
-                                out.extend(frame.setup([p[0], p[i], p[i + 1]], flat, oi as u32));
+                                push(frame.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, keep));
                             }
                         }
                     }
                 }
                 out
             };
-            let chunks: Vec<Vec<Tri>> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
+            let chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
             for chunk in chunks {
                 frame.bin_chunk(chunk);
             }
@@ -297,10 +389,10 @@ impl<'a> Frame<'a> {
 /// samples innermost), how many triangles cover it, depth ignored. Culling
 /// and clipping apply as in [`render`](crate::render).
 pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
-    let frame = Frame::build(scene);
+    let frame = Frame::build(scene, false, false);
     let ns = frame.pattern.len();
     let mut counts = vec![0u16; frame.w as usize * frame.h as usize * ns];
-    for t in frame.tris.iter().flatten() {
+    for t in frame.tris.iter().flat_map(|c| &c.tris) {
         for py in t.bbox[1]..t.bbox[3] {
             for px in t.bbox[0]..t.bbox[2] {
                 for (s, &(ox, oy)) in frame.pattern.iter().enumerate() {
@@ -319,8 +411,7 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
     let t0 = Instant::now();
     let (w, h) = (scene.image.width, scene.image.height);
-    let mut frame = Frame::build(scene);
-    frame.avx2 = !options.no_avx2 && avx2_available();
+    let frame = Frame::build(scene, options.reference, !options.no_avx2 && avx2_available());
     let setup = t0.elapsed();
 
     let t1 = Instant::now();
@@ -370,7 +461,7 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
         });
     let stats = RenderStats {
         triangles: scene.triangle_count(),
-        triangles_drawn: frame.tris.iter().map(Vec::len).sum(),
+        triangles_drawn: frame.tris.iter().map(|c| c.tris.len()).sum(),
         pixels_shaded: shaded.into_inner(),
         setup,
         raster: t1.elapsed(),
@@ -437,22 +528,33 @@ impl Frame<'_> {
         (x0, y0, (x0 + TILE_SIZE).min(self.w), (y0 + TILE_SIZE).min(self.h))
     }
 
-    /// Projects, snaps, culls, sets up edges and bins one clipped triangle.
+    /// Clip-space `c` (`w > 0`) to the window: snapped `x`, `y` (1/256 pixel), depth in [0, 1]
+    /// and `1/w`.
+    #[inline]
+    fn project(&self, c: Vec4) -> Projected {
+        let (wf, hf) = (self.w as f32, self.h as f32);
+        let iw = 1.0 / c.w;
+        let sx = (c.x * iw * 0.5 + 0.5) * wf;
+        let sy = (0.5 - c.y * iw * 0.5) * hf;
+        Projected(round_i64(sx * ONE), round_i64(sy * ONE), c.z * iw * 0.5 + 0.5, iw)
+    }
+
     /// Projects, snaps, culls and sets up the edges of one clipped triangle; `None` when it
     /// is culled, degenerate or covers no pixel.
-    fn setup(&self, mut v: [ClipVertex; 3], flat: Option<[(Color, Vec3); 2]>, object: u32) -> Option<Tri> {
-        let (wf, hf) = (self.w as f32, self.h as f32);
+    fn setup(
+        &self,
+        mut v: [ClipVertex; 3],
+        proj: Option<[Projected; 3]>,
+        flat: Option<[(Color, Vec3); 2]>,
+        object: u32,
+        keep: bool,
+    ) -> Option<(Tri, Option<Corners>)> {
         let mut xy = [(0i64, 0i64); 3];
         let mut z = [0f32; 3];
         let mut inv_w = [0f32; 3];
-        let project = |c: Vec4| {
-            let iw = 1.0 / c.w;
-            let sx = (c.x * iw * 0.5 + 0.5) * wf;
-            let sy = (0.5 - c.y * iw * 0.5) * hf;
-            (round_i64(sx * ONE), round_i64(sy * ONE), c.z * iw * 0.5 + 0.5, iw)
-        };
+        let proj = proj.unwrap_or_else(|| v.map(|v| self.project(v.clip)));
         for i in 0..3 {
-            let (x, y, zz, iw) = project(v[i].clip);
+            let Projected(x, y, zz, iw) = proj[i];
             xy[i] = (x, y);
             z[i] = zz;
             inv_w[i] = iw;
@@ -521,30 +623,33 @@ impl Frame<'_> {
         if px0 >= px1 || py0 >= py1 {
             return None;
         }
-        Some(Tri {
+        let tri = Tri {
             a,
             b,
             c,
             bias,
             inv_area: 1.0 / area.unsigned_abs() as f64,
             z,
-            inv_w,
-            v,
-            flat: flat.map(|f| f[usize::from(!front)]),
             planes,
             back: !front,
             object,
             bbox: [px0 as u32, py0 as u32, px1 as u32, py1 as u32],
-        })
+        };
+        let corners = keep.then(|| Corners {
+            inv_w,
+            v,
+            flat: flat.map(|f| f[usize::from(!front)]),
+        });
+        Some((tri, corners))
     }
 
     /// Keeps a chunk of set-up triangles and adds each to the bins of the tiles its bounds
     /// overlap, in order.
-    fn bin_chunk(&mut self, chunk: Vec<Tri>) {
+    fn bin_chunk(&mut self, chunk: Chunk) {
         let c = self.tris.len() as u32;
         // A setup chunk of SETUP_CHUNK input triangles makes at most 7 triangles of each.
-        debug_assert!(chunk.len() < 1 << ID_INDEX_BITS && c < (1 << (32 - ID_INDEX_BITS)) - 1);
-        for (i, t) in chunk.iter().enumerate() {
+        debug_assert!(chunk.tris.len() < 1 << ID_INDEX_BITS && c < (1 << (32 - ID_INDEX_BITS)) - 1);
+        for (i, t) in chunk.tris.iter().enumerate() {
             let idx = (c << ID_INDEX_BITS) | i as u32;
             let [px0, py0, px1, py1] = t.bbox;
             for ty in py0 / TILE_SIZE..=(py1 - 1) / TILE_SIZE {
@@ -559,7 +664,13 @@ impl Frame<'_> {
     /// The triangle with packed id `id` (chunk in the high bits, index in the low ones).
     #[inline]
     fn tri(&self, id: u32) -> &Tri {
-        &self.tris[(id >> ID_INDEX_BITS) as usize][(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+        &self.tris[(id >> ID_INDEX_BITS) as usize].tris[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The [`Corners`] of triangle `id` (kept for the reference path and scalar-shaded objects).
+    #[inline]
+    fn corners(&self, id: u32) -> &Corners {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].corners[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
     }
 
     /// Renders one tile and resolves it; returns its pixels and the number of pixel shadings.
@@ -600,7 +711,7 @@ impl Frame<'_> {
                         continue;
                     }
                     shaded += 1;
-                    let c = self.shade_pixel(t, px, py);
+                    let c = self.shade_pixel(ti, px, py);
                     for s in 0..ns {
                         if mask & (1 << s) != 0 {
                             depth[base + s] = zs[s];
@@ -622,11 +733,11 @@ impl Frame<'_> {
     /// Perspective-correct weights of triangle `t`'s vertices at the centre of pixel
     /// `(px, py)`: `(λ_i / w_i) / Σ (λ_j / w_j)`.
     #[inline]
-    fn weights(t: &Tri, px: u32, py: u32) -> [f32; 3] {
+    fn weights(t: &Tri, corners: &Corners, px: u32, py: u32) -> [f32; 3] {
         let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
         let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
         let e = [0, 1, 2].map(|i| (t.a[i] * sx + t.b[i] * sy + t.c[i]) as f64 * t.inv_area);
-        let q = [0, 1, 2].map(|i| e[i] as f32 * t.inv_w[i]);
+        let q = [0, 1, 2].map(|i| e[i] as f32 * corners.inv_w[i]);
         let sum = q[0] + q[1] + q[2];
         q.map(|x| x / sum)
     }
@@ -711,7 +822,7 @@ impl Frame<'_> {
             let t = self.tri(ti);
             if matches!(self.modes[t.object as usize], Mode::Scalar) {
                 let (px, py) = at(pixel);
-                colors[k] = self.shade_pixel(t, px, py);
+                colors[k] = self.shade_pixel(ti, px, py);
             } else {
                 batches[t.object as usize].push(k as u32);
             }
@@ -843,7 +954,7 @@ impl Frame<'_> {
                     last = (id, self.tri(id).object as usize);
                 }
                 if matches!(self.modes[last.1], Mode::Scalar) {
-                    let c = self.shade_pixel(self.tri(id), x0 + col as u32, y0 + row as u32);
+                    let c = self.shade_pixel(id, x0 + col as u32, y0 + row as u32);
                     out[row * tw + col] = resolve(std::iter::once(c), 1, bg);
                 } else {
                     batches[last.1].push((row as u32) << 16 | col as u32);
@@ -875,15 +986,17 @@ impl Frame<'_> {
     }
 
     /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
-    fn shade_pixel(&self, t: &Tri, px: u32, py: u32) -> [f32; 4] {
-        let q = Self::weights(t, px, py);
-        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&t.v[0]) * q[0] + f(&t.v[1]) * q[1] + f(&t.v[2]) * q[2];
+    fn shade_pixel(&self, id: u32, px: u32, py: u32) -> [f32; 4] {
+        let (t, corners) = (self.tri(id), self.corners(id));
+        let q = Self::weights(t, corners, px, py);
+        let v = &corners.v;
+        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
         let scene = self.scene;
         let obj = &scene.objects[t.object as usize];
         let output = obj.shading.output;
         let c = match output {
             Output::Normal => {
-                let n = match t.flat {
+                let n = match corners.flat {
                     Some((_, n)) => n,
                     None if t.back => -lerp3(|v| v.normal).normalize_or_zero(),
                     None => lerp3(|v| v.normal).normalize_or_zero(),
@@ -899,7 +1012,7 @@ impl Frame<'_> {
                 let d = cam.depth_of(lerp3(|v| v.world));
                 Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
             }
-            _ => match (t.flat, obj.shading.interpolation) {
+            _ => match (corners.flat, obj.shading.interpolation) {
                 (Some((c, _)), _) => c,
                 (None, Interpolation::Gouraud) => {
                     let c = if t.back {

@@ -190,7 +190,11 @@ fn fast_path_matches_reference_on_every_scene() {
                 "{} ({build}): {differ} channel values differ, largest {worst}/255",
                 path.file_name().unwrap().to_string_lossy()
             );
-            assert!(worst <= 1, "{} ({build}): a channel differs by {worst}/255", path.display());
+            assert!(
+                worst <= 1,
+                "{} ({build}): a channel differs by {worst}/255",
+                path.display()
+            );
         }
     }
 }
