@@ -184,7 +184,12 @@ mod tests {
             let t: [ClipVertex; 3] = std::array::from_fn(|_| {
                 let w = 0.5 + r().abs() * 2.0;
                 let s = if i % 3 == 0 { 8.0 } else { 1.5 };
-                v(r() * s * w, r() * s * w, r() * 1.5 * w, if i % 97 == 0 { f32::NAN } else { w })
+                v(
+                    r() * s * w,
+                    r() * s * w,
+                    r() * 1.5 * w,
+                    if i % 97 == 0 { f32::NAN } else { w },
+                )
             });
             let c = t.map(|v| outcode(v.clip));
             let got = clip_triangle(&t);

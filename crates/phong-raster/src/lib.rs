@@ -20,7 +20,7 @@
 //!    centre (as MSAA), perspective-correct; written to the covered samples. The
 //!    reference path shades as it draws; the fast path (the default) first finds
 //!    each sample's visible triangle, then shades each visible (pixel, triangle)
-//!    once, Phong-interpolated pixels 8 at a time ([`simd`]).
+//!    once, Phong- and Gouraud-interpolated pixels 8 or 16 at a time ([`simd`]).
 //! 5. **Resolve**: the samples' average (straight alpha) into the [`Image`].
 //!
 //! Every pixel of a tile is processed by one thread in triangle order, so the
