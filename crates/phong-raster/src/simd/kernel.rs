@@ -1,5 +1,5 @@
 //! The shading kernels of the fast path, written once over the 8-lane vector of
-//! [`super::vector`]: [`phong_core::shade`] for 8 points at once in structure-of-arrays form,
+//! `super::vector`: [`phong_core::shade`] for 8 points at once in structure-of-arrays form,
 //! and the perspective-correct interpolation of a triangle's attributes from plane equations.
 //!
 //! Per object, [`Prepared`] hoists what does not change per pixel: the light-material
@@ -22,7 +22,7 @@ use phong_core::{Color, Light, Lighting, LyonLambda, Material, Normalization, Sh
 
 /// Lanes of [`shade8`].
 pub const LANES: usize = 8;
-/// The most lanes of any [`Vf32`] implementation.
+/// The most lanes of any `Vf32` implementation.
 const MAX_LANES: usize = 16;
 
 /// Three lanes of vectors.

@@ -1,16 +1,17 @@
 //! SIMD: the 8-lane kernels and their runtime dispatch. The only module of phong with
-//! `unsafe`: the AVX2 vector type's intrinsics ([`vector`]) and the calls below into functions
+//! `unsafe`: the AVX2 vector type's intrinsics (`vector.rs`) and the calls below into functions
 //! compiled with AVX2 and FMA.
 //!
-//! The kernels ([`kernel`]) are written once over the [`vector::Vf32`] trait. Each entry point
-//! here runs them either on [`vector::Portable`] (plain `[f32; 8]` loops, any CPU; LLVM
+//! The kernels ([`kernel`]) are written once over the `vector::Vf32` trait. Each entry point
+//! here runs them either on `vector::Portable` (plain `[f32; 8]` loops, any CPU; LLVM
 //! vectorises what it can) or, when the CPU has AVX2 and FMA and the caller allows it, on
-//! [`vector::Avx2`] inside a `#[target_feature(enable = "avx2,fma")]` function. The two builds
+//! `vector::Avx2` inside a `#[target_feature(enable = "avx2,fma")]` function. The two builds
 //! differ in rounding (fused multiply-adds, refined reciprocal estimates): both are tested
 //! against `phong_core::shade`, and the images of both against the reference path.
 
 pub mod kernel;
-pub mod vector;
+/// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
+mod vector;
 
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};

@@ -1,5 +1,5 @@
 //! An 8-lane `f32` vector with two implementations: [`Portable`] (`[f32; 8]` and plain loops,
-//! any target, exact division and square root) and, on x86-64, [`Avx2`] (one `__m256`,
+//! any target, exact reciprocals and reciprocal square roots) and, on x86-64, [`Avx2`] (one `__m256`,
 //! AVX2 + FMA intrinsics, with fused multiply-adds and refined reciprocal estimates).
 //!
 //! The kernels in [`super::kernel`] are written once, generic over [`Vf32`]. The AVX2
@@ -35,12 +35,8 @@ pub trait Vf32: Copy {
     fn sub(self, b: Self) -> Self;
     /// `a · b`.
     fn mul(self, b: Self) -> Self;
-    /// `a / b`, exact.
-    fn div(self, b: Self) -> Self;
     /// `a · b + c` (fused where the hardware has it).
     fn mul_add(self, b: Self, c: Self) -> Self;
-    /// `√a`, exact.
-    fn sqrt(self) -> Self;
     /// `1/√a`, relative error below 1e-6 (exact in [`Portable`]); `+∞` at 0.
     fn rsqrt(self) -> Self;
     /// `1/a`, relative error below 1e-6 (exact in [`Portable`]).
@@ -51,8 +47,6 @@ pub trait Vf32: Copy {
     fn max(self, b: Self) -> Self;
     /// `a < b`.
     fn lt(self, b: Self) -> Self::M;
-    /// `a <= b`.
-    fn le(self, b: Self) -> Self::M;
     /// `a > b`.
     fn gt(self, b: Self) -> Self::M;
     /// `a >= b`.
@@ -81,7 +75,7 @@ pub trait Vf32: Copy {
     fn round(self) -> Self;
 }
 
-/// The portable twin: `[f32; 8]`, plain loops, exact `div`, `sqrt`, `rsqrt` and `recip`.
+/// The portable twin: `[f32; 8]`, plain loops, exact `rsqrt` and `recip`.
 #[derive(Clone, Copy, Debug)]
 pub struct Portable(pub [f32; 8]);
 
@@ -123,16 +117,8 @@ impl Vf32 for Portable {
         Portable(lanes(|i| self.0[i] * b.0[i]))
     }
     #[inline(always)]
-    fn div(self, b: Self) -> Self {
-        Portable(lanes(|i| self.0[i] / b.0[i]))
-    }
-    #[inline(always)]
     fn mul_add(self, b: Self, c: Self) -> Self {
         Portable(lanes(|i| self.0[i] * b.0[i] + c.0[i]))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Portable(lanes(|i| self.0[i].sqrt()))
     }
     #[inline(always)]
     fn rsqrt(self) -> Self {
@@ -153,10 +139,6 @@ impl Vf32 for Portable {
     #[inline(always)]
     fn lt(self, b: Self) -> Self::M {
         lanes(|i| self.0[i] < b.0[i])
-    }
-    #[inline(always)]
-    fn le(self, b: Self) -> Self::M {
-        lanes(|i| self.0[i] <= b.0[i])
     }
     #[inline(always)]
     fn gt(self, b: Self) -> Self::M {
@@ -273,19 +255,9 @@ mod avx2 {
             Avx2(unsafe { _mm256_mul_ps(self.0, b.0) })
         }
         #[inline(always)]
-        fn div(self, b: Self) -> Self {
-            // SAFETY: AVX is present (see above).
-            Avx2(unsafe { _mm256_div_ps(self.0, b.0) })
-        }
-        #[inline(always)]
         fn mul_add(self, b: Self, c: Self) -> Self {
             // SAFETY: FMA is present (see above).
             Avx2(unsafe { _mm256_fmadd_ps(self.0, b.0, c.0) })
-        }
-        #[inline(always)]
-        fn sqrt(self) -> Self {
-            // SAFETY: AVX is present (see above).
-            Avx2(unsafe { _mm256_sqrt_ps(self.0) })
         }
         #[inline(always)]
         fn rsqrt(self) -> Self {
@@ -325,11 +297,6 @@ mod avx2 {
         fn lt(self, b: Self) -> Self::M {
             // SAFETY: AVX is present (see above).
             unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, b.0) }
-        }
-        #[inline(always)]
-        fn le(self, b: Self) -> Self::M {
-            // SAFETY: AVX is present (see above).
-            unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, b.0) }
         }
         #[inline(always)]
         fn gt(self, b: Self) -> Self::M {
@@ -463,16 +430,8 @@ mod avx2 {
             both!(self, mul, b)
         }
         #[inline(always)]
-        fn div(self, b: Self) -> Self {
-            both!(self, div, b)
-        }
-        #[inline(always)]
         fn mul_add(self, b: Self, c: Self) -> Self {
             both!(self, mul_add, b, c)
-        }
-        #[inline(always)]
-        fn sqrt(self) -> Self {
-            both!(self, sqrt)
         }
         #[inline(always)]
         fn rsqrt(self) -> Self {
@@ -493,10 +452,6 @@ mod avx2 {
         #[inline(always)]
         fn lt(self, b: Self) -> Self::M {
             (self.0.lt(b.0), self.1.lt(b.1))
-        }
-        #[inline(always)]
-        fn le(self, b: Self) -> Self::M {
-            (self.0.le(b.0), self.1.le(b.1))
         }
         #[inline(always)]
         fn gt(self, b: Self) -> Self::M {
