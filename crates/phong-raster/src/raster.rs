@@ -7,7 +7,7 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
-use crate::simd::{Batch, LANES, Planes, Prepared, Shaded8, Term, avx2_available, shade_batch, shade8};
+use crate::simd::{Batch, LANES, Planes, Prepared, Term, avx2_available, shade_batch, shade8};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -255,14 +255,8 @@ impl<'a> Frame<'a> {
                         for (p8, n8) in ps.chunks(LANES).zip(ns.chunks(LANES)) {
                             let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
                             let (pp, nn) = (pad(p8), pad(n8));
-                            let pick = |s: &Shaded8| match lit {
-                                Term::Ambient => s.ambient,
-                                Term::Diffuse => s.diffuse,
-                                Term::Specular => s.specular,
-                                Term::Color => s.color,
-                            };
-                            let front = pick(&shade8(avx2, &prep, &pp, &nn));
-                            let back = two_sided.then(|| pick(&shade8(avx2, &prep, &pp, &nn.map(|n| -n))));
+                            let front = shade8(avx2, &prep, &pp, &nn).term(lit);
+                            let back = two_sided.then(|| shade8(avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
                             for i in 0..p8.len() {
                                 out.push(ClipVertex {
                                     clip: clip_from_world * Vec4::from((pp[i], 1.0)),
