@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use phong_core::{Material, named_materials};
-use phong_raster::{RenderOptions, render_with_stats};
+use phong_raster::{RenderOptions, render_into, render_with_stats};
 use phong_scene::{INTERPOLATIONS, MODELS, OUTPUTS, apply_model, parse_choice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -337,14 +337,50 @@ fn bench(a: BenchArgs) -> Result<()> {
         bail!(InputError("--frames must be at least 1".into()));
     }
     let scene = a.run.load()?;
-    let options = a.run.options(None);
     let gpu = open_gpu(a.run.backend)?;
-    render_once(&scene, gpu.as_ref(), &options)?;
     let mut sum = [Duration::ZERO; 6];
-    for _ in 0..a.frames {
-        let (_, t, _, _) = render_once(&scene, gpu.as_ref(), &options)?;
-        for k in 0..6 {
-            sum[k] += t[k];
+    match &gpu {
+        Some(g) => {
+            g.render(&scene)?;
+            for _ in 0..a.frames {
+                let st = g.render(&scene)?.1;
+                for (k, d) in [st.upload, st.render, st.readback].into_iter().enumerate() {
+                    sum[k] += d;
+                }
+            }
+        }
+        None => {
+            // As a real-time renderer runs: one thread pool and one framebuffer for all frames
+            // (llvmpipe's harness, too, draws every frame into the same buffer).
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(a.run.threads.unwrap_or(0))
+                .build()
+                .context("starting the rendering threads")?;
+            let options = RenderOptions {
+                threads: None,
+                ..a.run.options(None)
+            };
+            let mut image = None;
+            pool.install(|| -> Result<()> {
+                render_into(&scene, &options, &mut image)?;
+                for _ in 0..a.frames {
+                    let st = render_into(&scene, &options, &mut image)?;
+                    for (k, d) in [
+                        st.setup,
+                        st.raster,
+                        Duration::ZERO,
+                        st.tile_raster,
+                        st.tile_shade,
+                        st.tile_resolve,
+                    ]
+                    .into_iter()
+                    .enumerate()
+                    {
+                        sum[k] += d;
+                    }
+                }
+                Ok(())
+            })?;
         }
     }
     let timed = if gpu.is_some() { sum[1] } else { sum[0] + sum[1] };

@@ -7,7 +7,7 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
-use crate::simd::{Batch, LANES, Planes, Prepared, Term, avx2_available, shade_batch, shade8};
+use crate::simd::{Batch, LANES, Planes, Prepared, Term, avx2_available, shade_batch, shade_group, shade8};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -113,32 +113,71 @@ fn lit_term(output: Output) -> Option<Term> {
     }
 }
 
-/// A vertex in the window: snapped `x`, `y` (1/256 pixel), depth, `1/w`.
+/// A vertex in the window: snapped `x`, `y` (1/256 pixel; the guard band keeps them below
+/// 2^24), depth, `1/w`.
 #[derive(Clone, Copy, Default)]
-struct Projected(i64, i64, f32, f32);
+struct Projected(i32, i32, f32, f32);
 
-/// A triangle ready for the tiles.
+/// A vertex of the fast path's setup: its projection (where inside the clipping planes) and
+/// outcode. 20 bytes: the fast setup reads these instead of 64-byte [`ClipVertex`] copies (a
+/// 1M-triangle setup reads three per triangle).
+#[derive(Clone, Copy, Default)]
+struct FastVertex {
+    p: Projected,
+    code: u16,
+}
+
+/// A triangle ready for the tiles: what visibility reads, 80 bytes. Its object, shading planes
+/// and (where kept) [`Corners`] are in its [`Chunk`].
 struct Tri {
-    /// Edge functions `E_i(X, Y) = a·X + b·Y + c` (edge i opposite vertex i), in 1/256 pixel.
-    a: [i64; 3],
-    b: [i64; 3],
+    /// Edge functions `E_i(X, Y) = a·X + b·Y + c` (edge i opposite vertex i), in 1/256 pixel;
+    /// `a` and `b` are coordinate differences (below 2^25), `c` needs 64 bits.
+    a: [i32; 3],
+    b: [i32; 3],
     c: [i64; 3],
-    /// 0 for top-left edges, 1 for others: inside is `E − bias >= 0`.
-    bias: [i64; 3],
     /// 1 / (twice the signed area): barycentrics are `E_i · inv_area` (a multiplication,
     /// not a division, per covered sample; together with incremental edges: teapots' raster
     /// 80 → 65 ms, same run).
     inv_area: f64,
     /// Window depth in [0, 1] per vertex.
     z: [f32; 3],
-    /// The fast path's plane equations (Phong: world position and normal, flipped on a back
-    /// face; Gouraud: the colour seen); unused for other objects.
-    planes: Planes,
+    /// Pixel bounds, inclusive min, exclusive max (images are at most 16384 wide).
+    bbox: [u16; 4],
+    /// Bit i: edge i is not top-left, so inside is `E_i − 1 >= 0` (else `E_i >= 0`).
+    bias: u8,
     /// A back face of a two-sided object: lit with flipped normals (OpenGL's two-sided lighting).
     back: bool,
-    object: u32,
-    /// Pixel bounds, inclusive min, exclusive max.
-    bbox: [u32; 4],
+}
+
+impl Tri {
+    #[inline(always)]
+    fn a(&self, i: usize) -> i64 {
+        i64::from(self.a[i])
+    }
+    #[inline(always)]
+    fn b(&self, i: usize) -> i64 {
+        i64::from(self.b[i])
+    }
+    #[inline(always)]
+    fn bias(&self, i: usize) -> i64 {
+        i64::from((self.bias >> i) & 1)
+    }
+    #[inline(always)]
+    fn bbox(&self) -> [u32; 4] {
+        self.bbox.map(u32::from)
+    }
+}
+
+/// The edges of a set-up triangle and how its vertices were reordered (counter-clockwise on
+/// screen after the swap of a front face), for the caller's attributes.
+struct Setup {
+    tri: Tri,
+    /// Input vertex of each set-up vertex.
+    order: [usize; 3],
+    xy: [(i64, i64); 3],
+    inv_w: [f32; 3],
+    area: u64,
+    front: bool,
 }
 
 /// How the fast path shades an object's pixels.
@@ -165,7 +204,12 @@ struct Corners {
 /// The triangles one setup task made, with their [`Corners`] (same index) where kept, else
 /// none.
 struct Chunk {
+    /// The object all its triangles belong to.
+    object: u32,
     tris: Vec<Tri>,
+    /// The fast path's plane equations (Phong: world position and normal, flipped on a back
+    /// face; Gouraud: the colour seen), same index; empty for scalar-shaded objects.
+    planes: Vec<Planes>,
     corners: Vec<Corners>,
 }
 
@@ -238,127 +282,11 @@ impl<'a> Frame<'a> {
             bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
         };
         for (oi, obj) in scene.objects.iter().enumerate() {
-            let interpolation = obj.shading.interpolation;
-            let output = obj.shading.output;
-            let two_sided = obj.shading.options.two_sided;
-            let view = frame.views[oi];
-            let mesh = &obj.mesh;
-            let gouraud = interpolation == Interpolation::Gouraud;
-            let verts: Vec<ClipVertex> = if let (true, false, Some(lit)) = (gouraud, reference, lit_term(output)) {
-                // The fast path lights Gouraud vertices 8 at a time with the kernel.
-                let prep = Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view);
-                mesh.positions()
-                    .par_chunks(SETUP_CHUNK)
-                    .zip(mesh.normals().par_chunks(SETUP_CHUNK))
-                    .flat_map_iter(|(ps, ns)| {
-                        let mut out = Vec::with_capacity(ps.len());
-                        for (p8, n8) in ps.chunks(LANES).zip(ns.chunks(LANES)) {
-                            let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
-                            let (pp, nn) = (pad(p8), pad(n8));
-                            let front = shade8(avx2, &prep, &pp, &nn).term(lit);
-                            let back = two_sided.then(|| shade8(avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
-                            for i in 0..p8.len() {
-                                out.push(ClipVertex {
-                                    clip: clip_from_world * Vec4::from((pp[i], 1.0)),
-                                    world: pp[i],
-                                    normal: nn[i],
-                                    color: Vec3::new(front[0][i], front[1][i], front[2][i]),
-                                    color_back: back.map_or(Vec3::ZERO, |b| Vec3::new(b[0][i], b[1][i], b[2][i])),
-                                });
-                            }
-                        }
-                        out
-                    })
-                    .collect()
+            let chunks = if reference || matches!(frame.modes[oi], Mode::Scalar) {
+                frame.setup_object_full(oi, obj, clip_from_world)
             } else {
-                mesh.positions()
-                    .par_iter()
-                    .zip(mesh.normals().par_iter())
-                    .map(|(&p, &n)| ClipVertex {
-                        clip: clip_from_world * Vec4::from((p, 1.0)),
-                        world: p,
-                        normal: n,
-                        color: if gouraud {
-                            let s = shade_at(scene, obj, &view, p, n);
-                            Vec3::from(term(output, &s).to_array())
-                        } else {
-                            Vec3::ZERO
-                        },
-                        color_back: if gouraud && two_sided {
-                            let s = shade_at(scene, obj, &view, p, -n);
-                            Vec3::from(term(output, &s).to_array())
-                        } else {
-                            Vec3::ZERO
-                        },
-                    })
-                    .collect()
+                frame.setup_object_fast(oi, obj, clip_from_world)
             };
-            // Triangle setup in parallel chunks, merged and binned in submission order, so
-            // that bins (and images) are those of a sequential setup.
-            // Per vertex, once: its outcode, and its projection where it is inside the clipping
-            // planes (a vertex is shared by about six triangles; per triangle, trivial
-            // clipping decisions and projections were a third of a 1M-triangle setup).
-            let codes: Vec<u16> = verts.par_iter().map(|v| outcode(v.clip)).collect();
-            let projected: Vec<Projected> = verts
-                .par_iter()
-                .zip(&codes)
-                .map(|(v, &code)| {
-                    if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
-                        frame.project(v.clip)
-                    } else {
-                        Projected::default()
-                    }
-                })
-                .collect();
-            // Corners are kept where scalar shading reads them.
-            let keep = reference || matches!(frame.modes[oi], Mode::Scalar);
-            let setup_chunk = |chunk: &[[u32; 3]]| {
-                let mut out = Chunk {
-                    tris: Vec::with_capacity(chunk.len()),
-                    corners: Vec::new(),
-                };
-                let mut push = |r: Option<(Tri, Option<Corners>)>| {
-                    if let Some((t, c)) = r {
-                        out.tris.push(t);
-                        out.corners.extend(c);
-                    }
-                };
-                for tri in chunk {
-                    let c = tri.map(|i| codes[i as usize]);
-                    if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
-                        continue;
-                    }
-                    let t = tri.map(|i| verts[i as usize]);
-                    // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
-                    let flat = (interpolation == Interpolation::Flat).then(|| {
-                        let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
-                        let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                        let front = term(output, &shade_at(scene, obj, &view, centroid, fnorm));
-                        let back = if two_sided {
-                            term(output, &shade_at(scene, obj, &view, centroid, -fnorm))
-                        } else {
-                            front
-                        };
-                        [(front, fnorm), (back, -fnorm)]
-                    });
-                    if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
-                        let proj = tri.map(|i| projected[i as usize]);
-                        push(frame.setup(t, Some(proj), flat, oi as u32, keep));
-                        continue;
-                    }
-                    match clip_triangle(&t) {
-                        Clipped::Rejected => {}
-                        Clipped::Inside => push(frame.setup(t, None, flat, oi as u32, keep)),
-                        Clipped::Polygon(p) => {
-                            for i in 1..p.len() - 1 {
-                                push(frame.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, keep));
-                            }
-                        }
-                    }
-                }
-                out
-            };
-            let chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
             for chunk in chunks {
                 frame.bin_chunk(chunk);
             }
@@ -366,12 +294,231 @@ impl<'a> Frame<'a> {
         frame
     }
 
+    /// The fast path's setup of a Phong- or Gouraud-interpolated object, lean in memory traffic:
+    /// per vertex a 20-byte [`FastVertex`] (and for Gouraud its lit colours), per triangle its
+    /// edges and plane equations; [`ClipVertex`] values are made only for the triangles that
+    /// need clipping.
+    fn setup_object_fast(&self, oi: usize, obj: &Object, clip_from_world: glam::Mat4) -> Vec<Chunk> {
+        let two_sided = obj.shading.options.two_sided;
+        let mesh = &obj.mesh;
+        let (positions, normals) = (mesh.positions(), mesh.normals());
+        let mode = &self.modes[oi];
+        let vertices: Vec<FastVertex> = positions
+            .par_iter()
+            .map(|&p| {
+                let clip = clip_from_world * Vec4::from((p, 1.0));
+                let code = outcode(clip);
+                let p = if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    self.project(clip)
+                } else {
+                    Projected::default()
+                };
+                FastVertex { p, code }
+            })
+            .collect();
+        // Gouraud: the colour seen from the front and (two-sided) from the back, 8 vertices at a
+        // time by the kernel.
+        let colors: Vec<[Vec3; 2]> = match mode {
+            Mode::Gouraud => {
+                let lit = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
+                let prep = Prepared::new(
+                    &self.scene.lighting,
+                    &obj.material,
+                    &obj.shading.options,
+                    self.views[oi],
+                );
+                positions
+                    .par_chunks(SETUP_CHUNK)
+                    .zip(normals.par_chunks(SETUP_CHUNK))
+                    .flat_map_iter(|(ps, ns)| {
+                        let mut out = Vec::with_capacity(ps.len());
+                        for (p8, n8) in ps.chunks(LANES).zip(ns.chunks(LANES)) {
+                            let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
+                            let (pp, nn) = (pad(p8), pad(n8));
+                            let front = shade8(self.avx2, &prep, &pp, &nn).term(lit);
+                            let back = two_sided.then(|| shade8(self.avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
+                            let at = |c: &[[f32; LANES]; 3], i: usize| Vec3::new(c[0][i], c[1][i], c[2][i]);
+                            for i in 0..p8.len() {
+                                out.push([at(&front, i), back.as_ref().map_or(Vec3::ZERO, |b| at(b, i))]);
+                            }
+                        }
+                        out
+                    })
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
+        // The planes of a set-up triangle from its input vertices' indices.
+        let planes = |s: &Setup, idx: [u32; 3]| -> Planes {
+            let idx = s.order.map(|k| idx[k] as usize);
+            let attrs = match mode {
+                Mode::Gouraud => [idx.map(|i| colors[i][usize::from(!s.front)]), [Vec3::ZERO; 3]],
+                _ => {
+                    let sign = if s.front { 1.0 } else { -1.0 };
+                    [idx.map(|i| positions[i]), idx.map(|i| normals[i] * sign)]
+                }
+            };
+            plane_equations(&s.xy, &s.tri, s.area, s.inv_w, attrs, matches!(mode, Mode::Gouraud))
+        };
+        let setup_chunk = |chunk: &[[u32; 3]]| {
+            let mut out = Chunk {
+                object: oi as u32,
+                tris: Vec::with_capacity(chunk.len()),
+                planes: Vec::with_capacity(chunk.len()),
+                corners: Vec::new(),
+            };
+            for &tri in chunk {
+                let v = tri.map(|i| vertices[i as usize]);
+                let c = v.map(|v| v.code);
+                if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                    continue;
+                }
+                if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    if let Some(s) = self.setup_edges(v.map(|v| v.p), two_sided) {
+                        out.planes.push(planes(&s, tri));
+                        out.tris.push(s.tri);
+                    }
+                    continue;
+                }
+                // Rare: clip, with the vertices in full.
+                let t = tri.map(|i| {
+                    let i = i as usize;
+                    let [color, color_back] = colors.get(i).copied().unwrap_or([Vec3::ZERO; 2]);
+                    ClipVertex {
+                        clip: clip_from_world * Vec4::from((positions[i], 1.0)),
+                        world: positions[i],
+                        normal: normals[i],
+                        color,
+                        color_back,
+                    }
+                });
+                let mut push = |t: [ClipVertex; 3]| {
+                    if let Some((tri, p, _)) = self.setup(t, None, None, oi as u32, false) {
+                        out.tris.push(tri);
+                        out.planes.push(p);
+                    }
+                };
+                match clip_triangle(&t) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => push(t),
+                    Clipped::Polygon(p) => {
+                        for i in 1..p.len() - 1 {
+                            push([p[0], p[i], p[i + 1]]);
+                        }
+                    }
+                }
+            }
+            out
+        };
+        mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+    }
+
+    /// The setup of an object for the reference path, or for the fast path's scalar shading
+    /// (flat, normal and depth outputs): every vertex in full, [`Corners`] kept.
+    fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: glam::Mat4) -> Vec<Chunk> {
+        let scene = self.scene;
+        let interpolation = obj.shading.interpolation;
+        let output = obj.shading.output;
+        let two_sided = obj.shading.options.two_sided;
+        let view = self.views[oi];
+        let mesh = &obj.mesh;
+        let gouraud = interpolation == Interpolation::Gouraud;
+        let verts: Vec<ClipVertex> = mesh
+            .positions()
+            .par_iter()
+            .zip(mesh.normals().par_iter())
+            .map(|(&p, &n)| ClipVertex {
+                clip: clip_from_world * Vec4::from((p, 1.0)),
+                world: p,
+                normal: n,
+                color: if gouraud {
+                    let s = shade_at(scene, obj, &view, p, n);
+                    Vec3::from(term(output, &s).to_array())
+                } else {
+                    Vec3::ZERO
+                },
+                color_back: if gouraud && two_sided {
+                    let s = shade_at(scene, obj, &view, p, -n);
+                    Vec3::from(term(output, &s).to_array())
+                } else {
+                    Vec3::ZERO
+                },
+            })
+            .collect();
+        // Per vertex, once: its outcode, and its projection where it is inside the clipping
+        // planes (a vertex is shared by about six triangles; per triangle, trivial clipping
+        // decisions and projections were a third of a 1M-triangle setup).
+        let codes: Vec<u16> = verts.par_iter().map(|v| outcode(v.clip)).collect();
+        let projected: Vec<Projected> = verts
+            .par_iter()
+            .zip(&codes)
+            .map(|(v, &code)| {
+                if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    self.project(v.clip)
+                } else {
+                    Projected::default()
+                }
+            })
+            .collect();
+        let setup_chunk = |chunk: &[[u32; 3]]| {
+            let mut out = Chunk {
+                object: oi as u32,
+                tris: Vec::with_capacity(chunk.len()),
+                planes: Vec::new(),
+                corners: Vec::new(),
+            };
+            let mut push = |r: Option<(Tri, Planes, Option<Corners>)>| {
+                if let Some((t, _, c)) = r {
+                    out.tris.push(t);
+                    out.corners.extend(c);
+                }
+            };
+            for tri in chunk {
+                let c = tri.map(|i| codes[i as usize]);
+                if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                    continue;
+                }
+                let t = tri.map(|i| verts[i as usize]);
+                // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
+                let flat = (interpolation == Interpolation::Flat).then(|| {
+                    let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
+                    let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
+                    let front = term(output, &shade_at(scene, obj, &view, centroid, fnorm));
+                    let back = if two_sided {
+                        term(output, &shade_at(scene, obj, &view, centroid, -fnorm))
+                    } else {
+                        front
+                    };
+                    [(front, fnorm), (back, -fnorm)]
+                });
+                if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    let proj = tri.map(|i| projected[i as usize]);
+                    push(self.setup(t, Some(proj), flat, oi as u32, true));
+                    continue;
+                }
+                match clip_triangle(&t) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, true)),
+                    Clipped::Polygon(p) => {
+                        for i in 1..p.len() - 1 {
+                            push(self.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, true));
+                        }
+                    }
+                }
+            }
+            out
+        };
+        mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+    }
+}
+
+impl<'a> Frame<'a> {
     /// Evaluates triangle `t`'s three edge functions at sample `(sx, sy)` (1/256 pixel);
     /// `Some` when the sample is covered (top-left rule).
     #[inline]
     fn covers(t: &Tri, sx: i64, sy: i64) -> Option<[i64; 3]> {
-        let e = [0, 1, 2].map(|i| t.a[i] * sx + t.b[i] * sy + t.c[i]);
-        if (0..3).any(|i| e[i] - t.bias[i] < 0) {
+        let e = [0, 1, 2].map(|i| t.a(i) * sx + t.b(i) * sy + t.c[i]);
+        if (0..3).any(|i| e[i] - t.bias(i) < 0) {
             None
         } else {
             Some(e)
@@ -387,8 +534,9 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
     let ns = frame.pattern.len();
     let mut counts = vec![0u16; frame.w as usize * frame.h as usize * ns];
     for t in frame.tris.iter().flat_map(|c| &c.tris) {
-        for py in t.bbox[1]..t.bbox[3] {
-            for px in t.bbox[0]..t.bbox[2] {
+        let bb = t.bbox();
+        for py in bb[1]..bb[3] {
+            for px in bb[0]..bb[2] {
                 for (s, &(ox, oy)) in frame.pattern.iter().enumerate() {
                     let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
                     let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
@@ -402,7 +550,8 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
     counts
 }
 
-pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, RenderStats), Error> {
+/// Renders into `image`, of the scene's size; every pixel is written.
+pub(crate) fn render(scene: &Scene, options: &RenderOptions, image: &mut Image) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
     let (w, h) = (scene.image.width, scene.image.height);
     let frame = Frame::build(scene, options.reference, !options.no_avx2 && avx2_available());
@@ -417,8 +566,7 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
     let bg = scene.image.background;
     // Tiles are written straight into the image, a strip of 64 rows per task, so that
     // nothing frame-sized exists besides the image (a collected copy did: 33 MB at 1080p).
-    // Zeroed (the allocator's zero pages, no fill): the tiles write every pixel.
-    let mut image = Image::new(w, h, [0.0; 4])?;
+    debug_assert_eq!((image.width(), image.height()), (w, h));
     let row_len = w as usize;
     image
         .pixels_mut()
@@ -458,30 +606,30 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions) -> Result<(Image, R
         tile_shade: Duration::from_nanos(clock.shade.into_inner()),
         tile_resolve: Duration::from_nanos(clock.resolve.into_inner()),
     };
-    Ok((image, stats))
+    Ok(stats)
 }
 
-/// Plane equations (see [`Planes`]) of two vector attributes, `attrs[j][i]` at vertex `i`, for a
-/// triangle with snapped vertices `xy` (1/256 pixel), edge coefficients `a`, `b` (edge `i`
-/// opposite vertex `i`, positive inside) and twice its area `area`: the barycentric `λ_i` is
-/// `E_i / area`, so `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and
-/// `q = q_0` at vertex 0. Computed in `f64`, stored in `f32`.
+/// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
+/// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with snapped vertices `xy` (1/256
+/// pixel) and twice its area `area`: the barycentric `λ_i` is `E_i / area`, so
+/// `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and `q = q_0` at vertex 0.
+/// Computed in `f64`, stored in `f32`.
 fn plane_equations(
     xy: &[(i64, i64); 3],
-    a: &[i64; 3],
-    b: &[i64; 3],
+    t: &Tri,
     area: u64,
     inv_w: [f32; 3],
     attrs: [[Vec3; 3]; 2],
+    first_only: bool,
 ) -> Planes {
     let k = f64::from(1u32 << SUBPIXEL_BITS) / area as f64;
     let plane = |q: [f32; 3]| {
-        let gx = (0..3).map(|i| a[i] as f64 * f64::from(q[i])).sum::<f64>() * k;
-        let gy = (0..3).map(|i| b[i] as f64 * f64::from(q[i])).sum::<f64>() * k;
+        let gx = (0..3).map(|i| f64::from(t.a[i]) * f64::from(q[i])).sum::<f64>() * k;
+        let gy = (0..3).map(|i| f64::from(t.b[i]) * f64::from(q[i])).sum::<f64>() * k;
         [q[0], gx as f32, gy as f32]
     };
     let mut attr = [[0f32; 3]; 6];
-    for (j, vs) in attrs.iter().enumerate() {
+    for (j, vs) in attrs.iter().enumerate().take(if first_only { 1 } else { 2 }) {
         for c in 0..3 {
             attr[j * 3 + c] = plane([0, 1, 2].map(|i| vs[i][c] * inv_w[i]));
         }
@@ -525,86 +673,32 @@ impl Frame<'_> {
         let iw = 1.0 / c.w;
         let sx = (c.x * iw * 0.5 + 0.5) * wf;
         let sy = (0.5 - c.y * iw * 0.5) * hf;
-        Projected(round_i64(sx * ONE), round_i64(sy * ONE), c.z * iw * 0.5 + 0.5, iw)
+        Projected(
+            round_i64(sx * ONE) as i32,
+            round_i64(sy * ONE) as i32,
+            c.z * iw * 0.5 + 0.5,
+            iw,
+        )
     }
 
-    /// Projects, snaps, culls and sets up the edges of one clipped triangle; `None` when it
-    /// is culled, degenerate or covers no pixel.
-    fn setup(
-        &self,
-        mut v: [ClipVertex; 3],
-        proj: Option<[Projected; 3]>,
-        flat: Option<[(Color, Vec3); 2]>,
-        object: u32,
-        keep: bool,
-    ) -> Option<(Tri, Option<Corners>)> {
-        let mut xy = [(0i64, 0i64); 3];
-        let mut z = [0f32; 3];
-        let mut inv_w = [0f32; 3];
-        let proj = proj.unwrap_or_else(|| v.map(|v| self.project(v.clip)));
-        for i in 0..3 {
-            let Projected(x, y, zz, iw) = proj[i];
-            xy[i] = (x, y);
-            z[i] = zz;
-            inv_w[i] = iw;
-        }
+    /// Culls and sets up the edges of a triangle from its projected vertices; `None` when it is
+    /// culled (a back face of a one-sided object), degenerate or covers no pixel.
+    #[inline]
+    fn setup_edges(&self, proj: [Projected; 3], two_sided: bool) -> Option<Setup> {
+        let xy = proj.map(|p| (i64::from(p.0), i64::from(p.1)));
         let area = (xy[1].0 - xy[0].0) * (xy[2].1 - xy[0].1) - (xy[2].0 - xy[0].0) * (xy[1].1 - xy[0].1);
         if area == 0 {
             return None;
         }
         // Counter-clockwise in NDC (y up) is clockwise on screen (y down): area < 0 is front-facing.
         let front = area < 0;
-        if !front && !self.scene.objects[object as usize].shading.options.two_sided {
+        if !front && !two_sided {
             return None;
         }
-        if area < 0 {
-            v.swap(1, 2);
-            xy.swap(1, 2);
-            z.swap(1, 2);
-            inv_w.swap(1, 2);
-        }
-        let mut a = [0i64; 3];
-        let mut b = [0i64; 3];
-        let mut c = [0i64; 3];
-        let mut bias = [0i64; 3];
-        for i in 0..3 {
-            // Edge opposite vertex i, from vertex j to vertex k.
-            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            let ((xa, ya), (xb, yb)) = (xy[j], xy[k]);
-            // E(X, Y) = (xb − xa)(Y − ya) − (yb − ya)(X − xa), positive inside.
-            a[i] = -(yb - ya);
-            b[i] = xb - xa;
-            c[i] = -(a[i] * xa + b[i] * ya);
-            // Top edge: horizontal, going right; left edge: going up (y down). Both inclusive.
-            let top_left = (ya == yb && xb > xa) || yb < ya;
-            bias[i] = if top_left { 0 } else { 1 };
-        }
-        let planes = match self.modes[object as usize] {
-            Mode::Scalar => Planes::default(),
-            Mode::Phong(..) => {
-                let sign = if front { 1.0 } else { -1.0 };
-                plane_equations(
-                    &xy,
-                    &a,
-                    &b,
-                    area.unsigned_abs(),
-                    inv_w,
-                    [v.map(|v| v.world), v.map(|v| v.normal * sign)],
-                )
-            }
-            Mode::Gouraud => {
-                let c = v.map(|v| if front { v.color } else { v.color_back });
-                plane_equations(&xy, &a, &b, area.unsigned_abs(), inv_w, [c, [Vec3::ZERO; 3]])
-            }
-        };
-        let (min_x, max_x) = (
-            xy.iter().map(|p| p.0).min().unwrap(),
-            xy.iter().map(|p| p.0).max().unwrap(),
-        );
-        let (min_y, max_y) = (
-            xy.iter().map(|p| p.1).min().unwrap(),
-            xy.iter().map(|p| p.1).max().unwrap(),
-        );
+        let order = if front { [0, 2, 1] } else { [0, 1, 2] };
+        let xy = order.map(|k| xy[k]);
+        let (min_x, max_x) = (xy[0].0.min(xy[1].0).min(xy[2].0), xy[0].0.max(xy[1].0).max(xy[2].0));
+        let (min_y, max_y) = (xy[0].1.min(xy[1].1).min(xy[2].1), xy[0].1.max(xy[1].1).max(xy[2].1));
         let px0 = (min_x >> SUBPIXEL_BITS).max(0);
         let py0 = (min_y >> SUBPIXEL_BITS).max(0);
         let px1 = ((max_x >> SUBPIXEL_BITS) + 1).min(i64::from(self.w));
@@ -612,24 +706,77 @@ impl Frame<'_> {
         if px0 >= px1 || py0 >= py1 {
             return None;
         }
-        let tri = Tri {
-            a,
-            b,
-            c,
-            bias,
-            inv_area: 1.0 / area.unsigned_abs() as f64,
-            z,
-            planes,
-            back: !front,
-            object,
-            bbox: [px0 as u32, py0 as u32, px1 as u32, py1 as u32],
+        let mut a = [0i32; 3];
+        let mut b = [0i32; 3];
+        let mut c = [0i64; 3];
+        let mut bias = 0u8;
+        for i in 0..3 {
+            // Edge opposite vertex i, from vertex j to vertex k.
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let ((xa, ya), (xb, yb)) = (xy[j], xy[k]);
+            // E(X, Y) = (xb − xa)(Y − ya) − (yb − ya)(X − xa), positive inside.
+            let (ai, bi) = (-(yb - ya), xb - xa);
+            a[i] = ai as i32;
+            b[i] = bi as i32;
+            c[i] = -(ai * xa + bi * ya);
+            // Top edge: horizontal, going right; left edge: going up (y down). Both inclusive.
+            let top_left = (ya == yb && xb > xa) || yb < ya;
+            bias |= u8::from(!top_left) << i;
+        }
+        let area = area.unsigned_abs();
+        Some(Setup {
+            tri: Tri {
+                a,
+                b,
+                c,
+                inv_area: 1.0 / area as f64,
+                z: order.map(|k| proj[k].2),
+                bbox: [px0 as u16, py0 as u16, px1 as u16, py1 as u16],
+                bias,
+                back: !front,
+            },
+            order,
+            xy,
+            inv_w: order.map(|k| proj[k].3),
+            area,
+            front,
+        })
+    }
+
+    /// Projects (unless `proj` is given), snaps, culls and sets up one clipped triangle; with
+    /// `full`, its [`Corners`] for scalar shading, else its fast-path [`Planes`].
+    fn setup(
+        &self,
+        v: [ClipVertex; 3],
+        proj: Option<[Projected; 3]>,
+        flat: Option<[(Color, Vec3); 2]>,
+        object: u32,
+        full: bool,
+    ) -> Option<(Tri, Planes, Option<Corners>)> {
+        let proj = proj.unwrap_or_else(|| v.map(|v| self.project(v.clip)));
+        let s = self.setup_edges(proj, self.scene.objects[object as usize].shading.options.two_sided)?;
+        let v = s.order.map(|k| v[k]);
+        if full {
+            let corners = Corners {
+                inv_w: s.inv_w,
+                v,
+                flat: flat.map(|f| f[usize::from(!s.front)]),
+            };
+            return Some((s.tri, Planes::default(), Some(corners)));
+        }
+        let planes = match self.modes[object as usize] {
+            Mode::Scalar => Planes::default(),
+            Mode::Phong(..) => {
+                let sign = if s.front { 1.0 } else { -1.0 };
+                let attrs = [v.map(|v| v.world), v.map(|v| v.normal * sign)];
+                plane_equations(&s.xy, &s.tri, s.area, s.inv_w, attrs, false)
+            }
+            Mode::Gouraud => {
+                let c = v.map(|v| if s.front { v.color } else { v.color_back });
+                plane_equations(&s.xy, &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
+            }
         };
-        let corners = keep.then(|| Corners {
-            inv_w,
-            v,
-            flat: flat.map(|f| f[usize::from(!front)]),
-        });
-        Some((tri, corners))
+        Some((s.tri, planes, None))
     }
 
     /// Keeps a chunk of set-up triangles and adds each to the bins of the tiles its bounds
@@ -640,7 +787,7 @@ impl Frame<'_> {
         debug_assert!(chunk.tris.len() < 1 << ID_INDEX_BITS && c < (1 << (32 - ID_INDEX_BITS)) - 1);
         for (i, t) in chunk.tris.iter().enumerate() {
             let idx = (c << ID_INDEX_BITS) | i as u32;
-            let [px0, py0, px1, py1] = t.bbox;
+            let [px0, py0, px1, py1] = t.bbox();
             for ty in py0 / TILE_SIZE..=(py1 - 1) / TILE_SIZE {
                 for tx in px0 / TILE_SIZE..=(px1 - 1) / TILE_SIZE {
                     self.bins[(ty * self.tiles_x + tx) as usize].push(idx);
@@ -654,6 +801,18 @@ impl Frame<'_> {
     #[inline]
     fn tri(&self, id: u32) -> &Tri {
         &self.tris[(id >> ID_INDEX_BITS) as usize].tris[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The object of triangle `id`.
+    #[inline]
+    fn object(&self, id: u32) -> usize {
+        self.tris[(id >> ID_INDEX_BITS) as usize].object as usize
+    }
+
+    /// The fast path's plane equations of triangle `id`.
+    #[inline]
+    fn planes(&self, id: u32) -> &Planes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].planes[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
     }
 
     /// The [`Corners`] of triangle `id` (kept for the reference path and scalar-shaded objects).
@@ -675,10 +834,8 @@ impl Frame<'_> {
         let mut zs = [0f32; 16];
         for &ti in &self.bins[tile as usize] {
             let t = self.tri(ti);
-            let bx0 = t.bbox[0].max(x0);
-            let by0 = t.bbox[1].max(y0);
-            let bx1 = t.bbox[2].min(x1);
-            let by1 = t.bbox[3].min(y1);
+            let bb = t.bbox();
+            let (bx0, by0, bx1, by1) = (bb[0].max(x0), bb[1].max(y0), bb[2].min(x1), bb[3].min(y1));
             for py in by0..by1 {
                 for px in bx0..bx1 {
                     let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
@@ -724,7 +881,7 @@ impl Frame<'_> {
     fn weights(t: &Tri, corners: &Corners, px: u32, py: u32) -> [f32; 3] {
         let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
         let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
-        let e = [0, 1, 2].map(|i| (t.a[i] * sx + t.b[i] * sy + t.c[i]) as f64 * t.inv_area);
+        let e = [0, 1, 2].map(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area);
         let q = [0, 1, 2].map(|i| e[i] as f32 * corners.inv_w[i]);
         let sum = q[0] + q[1] + q[2];
         q.map(|x| x / sum)
@@ -741,23 +898,26 @@ impl Frame<'_> {
         let mut depth = vec![f32::INFINITY; tw * th * ns];
         let mut ids = vec![u32::MAX; tw * th * ns];
         let mut offsets = [[0i64; 3]; 16];
-        for &ti in &self.bins[tile as usize] {
+        let bin = &self.bins[tile as usize];
+        for (k, &ti) in bin.iter().enumerate() {
             let t = self.tri(ti);
             // Edge functions stepped incrementally (exact integer adds, so the same values as
             // the reference's direct evaluation): per sample an offset from the pixel corner,
             // per pixel a step of `a·256`.
             for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
-                *o = [0, 1, 2].map(|i| t.a[i] * ox + t.b[i] * oy - t.bias[i]);
+                *o = [0, 1, 2].map(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
             }
-            let step = t.a.map(|a| a << SUBPIXEL_BITS);
-            let (bx0, bx1) = (t.bbox[0].max(x0), t.bbox[2].min(x1));
+            let step = [0, 1, 2].map(|i| t.a(i) << SUBPIXEL_BITS);
+            let bb = t.bbox();
+            let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
             if ns == 1 {
-                self.visible_single(t, ti, offsets[0], (x0, y0, tw), (bx0, bx1), &mut depth, &mut ids);
+                // One sample: `ids` holds the index in the bin (see `shade_single`).
+                self.visible_single(t, k as u32, offsets[0], (x0, y0, tw), (bx0, bx1), &mut depth, &mut ids);
                 continue;
             }
-            for py in t.bbox[1].max(y0)..t.bbox[3].min(y1) {
+            for py in bb[1].max(y0)..bb[3].min(y1) {
                 let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
-                let mut row = [0, 1, 2].map(|i| t.a[i] * cx + t.b[i] * cy + t.c[i]);
+                let mut row = [0, 1, 2].map(|i| t.a(i) * cx + t.b(i) * cy + t.c[i]);
                 for px in bx0..bx1 {
                     let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
                     for (s, o) in offsets[..ns].iter().enumerate() {
@@ -766,7 +926,7 @@ impl Frame<'_> {
                         if (eb[0] | eb[1] | eb[2]) < 0 {
                             continue;
                         }
-                        let e = [0, 1, 2].map(|i| eb[i] + t.bias[i]);
+                        let e = [0, 1, 2].map(|i| eb[i] + t.bias(i));
                         let l = e.map(|x| (x as f64 * t.inv_area) as f32);
                         let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
                         if zz < depth[base + s] {
@@ -782,7 +942,7 @@ impl Frame<'_> {
         }
         let t_shade = Instant::now();
         if ns == 1 {
-            return self.shade_single(ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows);
+            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows);
         }
         // One job per visible (pixel, triangle), the pixel as `row << 16 | column` in the tile
         // (no division to find it again: per-lane integer divisions were 1% of fill); a
@@ -807,12 +967,11 @@ impl Frame<'_> {
         let mut colors = vec![[0f32; 4]; jobs.len()];
         let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
-            let t = self.tri(ti);
-            if matches!(self.modes[t.object as usize], Mode::Scalar) {
+            if matches!(self.modes[self.object(ti)], Mode::Scalar) {
                 let (px, py) = at(pixel);
                 colors[k] = self.shade_pixel(ti, px, py);
             } else {
-                batches[t.object as usize].push(k as u32);
+                batches[self.object(ti)].push(k as u32);
             }
         }
         for (object, batch) in batches.iter().enumerate() {
@@ -828,7 +987,7 @@ impl Frame<'_> {
                 |i| {
                     let (pixel, ti) = jobs[batch[i] as usize];
                     let (px, py) = at(pixel);
-                    (px as f32 + 0.5, py as f32 + 0.5, &self.tri(ti).planes)
+                    (px as f32 + 0.5, py as f32 + 0.5, self.planes(ti))
                 },
                 |i, rgb| colors[batch[i] as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
             );
@@ -871,13 +1030,14 @@ impl Frame<'_> {
         depth: &mut [f32],
         ids: &mut [u32],
     ) {
-        let step = t.a.map(|a| a << SUBPIXEL_BITS);
+        let step = [0, 1, 2].map(|i| t.a(i) << SUBPIXEL_BITS);
+        let bb = t.bbox();
         let n = i64::from(bx1 - bx0);
         let y1 = y0 + (depth.len() / tw) as u32;
-        for py in t.bbox[1].max(y0)..t.bbox[3].min(y1) {
+        for py in bb[1].max(y0)..bb[3].min(y1) {
             let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
             // e − bias at the row's first pixel.
-            let row = [0, 1, 2].map(|i| t.a[i] * cx + t.b[i] * cy + t.c[i] + o[i]);
+            let row = [0, 1, 2].map(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
             let (mut lo, mut hi) = (0i64, n);
             if n >= 8 {
                 for i in 0..3 {
@@ -897,7 +1057,7 @@ impl Frame<'_> {
             let mut eb = [0, 1, 2].map(|i| row[i] + step[i] * lo);
             for k in lo..hi {
                 if (eb[0] | eb[1] | eb[2]) >= 0 {
-                    let e = [0, 1, 2].map(|i| eb[i] + t.bias[i]);
+                    let e = [0, 1, 2].map(|i| eb[i] + t.bias(i));
                     let l = e.map(|x| (x as f64 * t.inv_area) as f32);
                     let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
                     let at = line + k as usize;
@@ -915,10 +1075,14 @@ impl Frame<'_> {
 
     /// The fast path's shading with one sample per pixel: each visible pixel is shaded once and
     /// written straight into the tile (no job list; the resolve of one opaque sample is the
-    /// sample itself, `x·1/1 = x`). `ids` is the visible triangle per pixel of the tile
-    /// `(x0, y0, width, height)`.
+    /// sample itself, `x·1/1 = x`). `ids` is, per pixel of the tile `(x0, y0, width, height)`,
+    /// the index in `bin` of its visible triangle. The visible pixels are sorted by triangle
+    /// (a counting sort over the bin), so that each triangle's pixels are shaded together with
+    /// its plane coefficients broadcast, not gathered lane by lane from neighbouring triangles.
+    #[allow(clippy::too_many_arguments)]
     fn shade_single(
         &self,
+        bin: &[u32],
         ids: Vec<u32>,
         (x0, y0, tw, th): (u32, u32, usize, usize),
         bg: [f32; 4],
@@ -927,57 +1091,88 @@ impl Frame<'_> {
         out: &mut [&mut [[f32; 4]]],
     ) -> u64 {
         let background = resolve(std::iter::once(bg), 1, bg);
-        for row in out.iter_mut() {
-            row.fill(background);
-        }
-        // Per object, its visible pixels as `row << 16 | column`.
-        let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
-        let mut shaded = 0u64;
-        let mut last = (u32::MAX, 0usize);
-        for row in 0..th {
-            for col in 0..tw {
-                let id = ids[row * tw + col];
-                if id == u32::MAX {
-                    continue;
-                }
-                shaded += 1;
-                if id != last.0 {
-                    last = (id, self.tri(id).object as usize);
-                }
-                if matches!(self.modes[last.1], Mode::Scalar) {
-                    let c = self.shade_pixel(id, x0 + col as u32, y0 + row as u32);
-                    out[row][col] = resolve(std::iter::once(c), 1, bg);
-                } else {
-                    batches[last.1].push((row as u32) << 16 | col as u32);
+        // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
+        // where its pixels end in `order`.
+        let mut starts = vec![0u32; bin.len() + 1];
+        for (row, line) in out.iter_mut().enumerate().take(th) {
+            for (col, o) in line.iter_mut().enumerate() {
+                match ids[row * tw + col] {
+                    u32::MAX => *o = background,
+                    k => starts[k as usize + 1] += 1,
                 }
             }
         }
-        for (object, batch) in batches.iter().enumerate() {
+        for k in 0..bin.len() {
+            starts[k + 1] += starts[k];
+        }
+        let shaded = starts[bin.len()];
+        let mut order = vec![0u32; shaded as usize];
+        let mut next = starts.clone();
+        for row in 0..th {
+            for col in 0..tw {
+                let k = ids[row * tw + col];
+                if k != u32::MAX {
+                    order[next[k as usize] as usize] = (row as u32) << 16 | col as u32;
+                    next[k as usize] += 1;
+                }
+            }
+        }
+        // Per object, the pixels left over from whole vectors, with their triangles: shaded
+        // together, each lane gathering its triangle's planes.
+        let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
+        let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
+        for (k, &id) in bin.iter().enumerate() {
+            let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
+            if pixels.is_empty() {
+                continue;
+            }
+            let object = self.object(id);
+            let kind = match &self.modes[object] {
+                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
+                Mode::Gouraud => Batch::Gouraud,
+                Mode::Scalar => {
+                    for &p in pixels {
+                        let (r, c) = at(p);
+                        let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32);
+                        out[r][c] = resolve(std::iter::once(color), 1, bg);
+                    }
+                    continue;
+                }
+            };
+            let done = shade_group(self.avx2, kind, self.planes(id), (x0, y0), pixels, |p, rgb| {
+                let (r, c) = at(p);
+                out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+            });
+            rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
+        }
+        for (object, batch) in rest.iter().enumerate() {
             let kind = match &self.modes[object] {
                 Mode::Phong(prep, term) => Batch::Phong(prep, *term),
                 Mode::Gouraud => Batch::Gouraud,
                 Mode::Scalar => continue,
             };
-            let index = |packed: u32| (packed >> 16) as usize * tw + (packed & 0xffff) as usize;
-            let at = |packed: u32| ((packed >> 16) as usize, (packed & 0xffff) as usize);
             shade_batch(
                 self.avx2,
                 kind,
                 batch.len(),
                 |i| {
-                    let p = batch[i];
-                    let (x, y) = (x0 + (p & 0xffff), y0 + (p >> 16));
-                    (x as f32 + 0.5, y as f32 + 0.5, &self.tri(ids[index(p)]).planes)
+                    let (p, id) = batch[i];
+                    let (r, c) = at(p);
+                    (
+                        (x0 + c as u32) as f32 + 0.5,
+                        (y0 + r as u32) as f32 + 0.5,
+                        self.planes(id),
+                    )
                 },
                 |i, rgb| {
-                    let (r, c) = at(batch[i]);
+                    let (r, c) = at(batch[i].0);
                     out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
                 },
             );
         }
         let t_end = Instant::now();
         clock.add(t_start, t_shade, t_end, t_end);
-        shaded
+        u64::from(shaded)
     }
 
     /// The colour of triangle `t` at the centre of pixel `(px, py)`, perspective-correct.
@@ -987,7 +1182,7 @@ impl Frame<'_> {
         let v = &corners.v;
         let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
         let scene = self.scene;
-        let obj = &scene.objects[t.object as usize];
+        let obj = &scene.objects[self.object(id)];
         let output = obj.shading.output;
         let c = match output {
             Output::Normal => {
@@ -1020,7 +1215,7 @@ impl Frame<'_> {
                 _ => {
                     let n = lerp3(|v| v.normal);
                     let n = if t.back { -n } else { n };
-                    let view = &self.views[t.object as usize];
+                    let view = &self.views[self.object(id)];
                     term(output, &shade_at(scene, obj, view, lerp3(|v| v.world), n))
                 }
             },

@@ -6,6 +6,7 @@ use common::Rng;
 
 use glam::Vec3;
 use phong_core::*;
+use phong_raster::clip::{ClipVertex, Clipped, clip_triangle};
 use phong_raster::simd::{LANES, Prepared, avx2_available, shade8};
 use phong_raster::{RenderOptions, render};
 use std::path::Path;
@@ -194,6 +195,102 @@ fn fast_path_matches_reference_on_every_scene() {
                 worst <= 1,
                 "{} ({build}): a channel differs by {worst}/255",
                 path.display()
+            );
+        }
+    }
+}
+
+/// The fast path's clipped triangles: a two-sided ground plane that passes under and behind
+/// the camera (its triangles cross the near plane and leave the guard band) and a torus
+/// cutting the near plane, Gouraud and Phong, against the reference path, both builds. The
+/// scene must make clipped triangles: more triangles are drawn than the meshes' front faces
+/// could give without clipping.
+#[test]
+fn fast_path_matches_reference_where_triangles_are_clipped() {
+    for interpolation in ["gouraud", "phong"] {
+        let src = format!(
+            r#"
+[image]
+width = 200
+height = 150
+[camera]
+position = [0.0, 0.3, 0.0]
+target = [0.0, 0.0, -2.0]
+near = 0.1
+[shading]
+model = "blinn-phong"
+interpolation = "{interpolation}"
+two_sided = true
+[[light]]
+type = "point"
+position = [0.5, 2.0, -1.0]
+attenuation = [1.0, 0.1, 0.05]
+[[light]]
+type = "directional"
+direction = [0.3, -1.0, -0.5]
+[[object]]
+shape = "plane"
+segments = 8
+material = "pewter"
+position = [0.0, -0.5, 0.0]
+scale = 400.0
+[[object]]
+shape = "torus"
+segments = 24
+material = "ruby"
+position = [0.0, 0.3, -0.3]
+rotation = [0.0, 90.0, 0.0]
+"#
+        );
+        let scene = phong_scene::parse_scene(&src, Path::new("clipped.toml")).unwrap().scene;
+        let reference = render(
+            &scene,
+            &RenderOptions {
+                reference: true,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let (fast, stats) = phong_raster::render_with_stats(&scene, &RenderOptions::default()).unwrap();
+        let portable = render(
+            &scene,
+            &RenderOptions {
+                no_avx2: true,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        // Clipping happened: some triangles are clipped into polygons.
+        let aspect = scene.image.width as f32 / scene.image.height as f32;
+        let clip_from_world = scene.camera.clip_from_world(aspect);
+        let clipped = scene
+            .objects
+            .iter()
+            .flat_map(|o| {
+                o.mesh.triangles().iter().map(|t| {
+                    t.map(|i| {
+                        let p = o.mesh.positions()[i as usize];
+                        ClipVertex {
+                            clip: clip_from_world * p.extend(1.0),
+                            world: p,
+                            normal: Vec3::Z,
+                            color: Vec3::ZERO,
+                            color_back: Vec3::ZERO,
+                        }
+                    })
+                })
+            })
+            .filter(|t| matches!(clip_triangle(t), Clipped::Polygon(_)))
+            .count();
+        assert!(clipped > 10, "{interpolation}: only {clipped} triangles clipped");
+        assert!(stats.triangles_drawn > 0);
+        let a = reference.to_bytes(scene.image.encoding, false);
+        for (build, image) in [("fast", &fast), ("portable", &portable)] {
+            let b = image.to_bytes(scene.image.encoding, false);
+            let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+            assert!(
+                worst <= 1,
+                "{interpolation} ({build}): a channel differs by {worst}/255"
             );
         }
     }

@@ -85,3 +85,41 @@ pub fn shade_batch<'p>(
     let _ = avx2;
     kernel::shade_batch::<vector::Portable>(batch, n, lane, out)
 }
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn shade_group_avx2(
+    batch: Batch,
+    planes: &Planes,
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, [f32; 3]),
+) -> usize {
+    kernel::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+}
+
+/// Interpolates and shades the pixels of one triangle (its [`Planes`] broadcast to all lanes):
+/// `pixels` are `row << 16 | column` from `origin`, `out(pixel, rgb)` takes each colour. Whole
+/// vectors only: returns how many of `pixels` (from the start) were shaded. AVX2 build when
+/// `avx2` is true.
+#[inline]
+pub fn shade_group(
+    avx2: bool,
+    batch: Batch,
+    planes: &Planes,
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, [f32; 3]),
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        assert!(
+            avx2_available(),
+            "the AVX2 build asked for on a CPU without AVX2 and FMA"
+        );
+        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        return unsafe { shade_group_avx2(batch, planes, origin, pixels, out) };
+    }
+    let _ = avx2;
+    kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
+}
