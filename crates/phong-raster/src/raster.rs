@@ -683,6 +683,14 @@ impl Frame<'_> {
     /// culled (a back face of a one-sided object), degenerate or covers no pixel.
     #[inline]
     fn setup_edges(&self, proj: [Projected; 3], two_sided: bool) -> Option<Setup> {
+        setup_edges(proj, two_sided, self.w, self.h)
+    }
+}
+
+/// [`Frame::setup_edges`] for an image of `w × h` pixels.
+#[inline]
+fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32) -> Option<Setup> {
+    {
         let xy = proj.map(|p| (i64::from(p.0), i64::from(p.1)));
         let area = (xy[1].0 - xy[0].0) * (xy[2].1 - xy[0].1) - (xy[2].0 - xy[0].0) * (xy[1].1 - xy[0].1);
         if area == 0 {
@@ -699,8 +707,8 @@ impl Frame<'_> {
         let (min_y, max_y) = (xy[0].1.min(xy[1].1).min(xy[2].1), xy[0].1.max(xy[1].1).max(xy[2].1));
         let px0 = (min_x >> SUBPIXEL_BITS).max(0);
         let py0 = (min_y >> SUBPIXEL_BITS).max(0);
-        let px1 = ((max_x >> SUBPIXEL_BITS) + 1).min(i64::from(self.w));
-        let py1 = ((max_y >> SUBPIXEL_BITS) + 1).min(i64::from(self.h));
+        let px1 = ((max_x >> SUBPIXEL_BITS) + 1).min(i64::from(w));
+        let py1 = ((max_y >> SUBPIXEL_BITS) + 1).min(i64::from(h));
         if px0 >= px1 || py0 >= py1 {
             return None;
         }
@@ -740,7 +748,9 @@ impl Frame<'_> {
             front,
         })
     }
+}
 
+impl Frame<'_> {
     /// Projects (unless `proj` is given), snaps, culls and sets up one clipped triangle; with
     /// `full`, its [`Corners`] for scalar shading, else its fast-path [`Planes`].
     fn setup(
@@ -786,13 +796,37 @@ impl Frame<'_> {
         for (i, t) in chunk.tris.iter().enumerate() {
             let idx = (c << ID_INDEX_BITS) | i as u32;
             let [px0, py0, px1, py1] = t.bbox();
-            for ty in py0 / TILE_SIZE..=(py1 - 1) / TILE_SIZE {
-                for tx in px0 / TILE_SIZE..=(px1 - 1) / TILE_SIZE {
+            let (tx0, tx1) = (px0 / TILE_SIZE, (px1 - 1) / TILE_SIZE);
+            let (ty0, ty1) = (py0 / TILE_SIZE, (py1 - 1) / TILE_SIZE);
+            let several = tx0 != tx1 || ty0 != ty1;
+            for ty in ty0..=ty1 {
+                for tx in tx0..=tx1 {
+                    if several && Self::misses_tile(t, tx, ty) {
+                        continue;
+                    }
                     self.bins[(ty * self.tiles_x + tx) as usize].push(idx);
                 }
             }
         }
         self.tris.push(chunk);
+    }
+
+    /// Trivial reject of a tile: some edge of `t` is negative on all of tile `(tx, ty)`'s square
+    /// (pixel corners, so every sample position of every pattern is inside it), tested at the
+    /// square's corner where the edge is largest. Binning by bounding box alone put both
+    /// triangles of a full-screen quad in every tile.
+    #[inline]
+    fn misses_tile(t: &Tri, tx: u32, ty: u32) -> bool {
+        let (x0, y0) = (
+            i64::from(tx * TILE_SIZE) << SUBPIXEL_BITS,
+            i64::from(ty * TILE_SIZE) << SUBPIXEL_BITS,
+        );
+        let side = i64::from(TILE_SIZE) << SUBPIXEL_BITS;
+        (0..3).any(|i| {
+            let x = if t.a[i] >= 0 { x0 + side } else { x0 };
+            let y = if t.b[i] >= 0 { y0 + side } else { y0 };
+            t.a(i) * x + t.b(i) * y + t.c[i] - t.bias(i) < 0
+        })
     }
 
     /// The triangle with packed id `id` (chunk in the high bits, index in the low ones).
@@ -893,10 +927,18 @@ impl Frame<'_> {
         let (x0, y0, x1, y1) = self.tile_rect(tile);
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let ns = self.pattern.len();
+        let bin = &self.bins[tile as usize];
+        if ns == 1 && bin.len() == 1 && self.covers_rect(bin[0], (x0, y0, x1, y1)) {
+            // Trivial accept: the tile's only triangle covers all of it, so every pixel sees it
+            // (its depth, finite inside the clipped volume, passes the test against the cleared
+            // buffer): no edge, depth or sorting work. Most tiles of a large triangle.
+            let t_shade = Instant::now();
+            let ids = vec![0u32; tw * th];
+            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows);
+        }
         let mut depth = vec![f32::INFINITY; tw * th * ns];
         let mut ids = vec![u32::MAX; tw * th * ns];
         let mut offsets = [[0i64; 3]; 16];
-        let bin = &self.bins[tile as usize];
         for (k, &ti) in bin.iter().enumerate() {
             let t = self.tri(ti);
             // Edge functions stepped incrementally (exact integer adds, so the same values as
@@ -1008,6 +1050,17 @@ impl Frame<'_> {
         }
         clock.add(t_start, t_shade, t_resolve, Instant::now());
         jobs.len() as u64
+    }
+
+    /// Whether triangle `id` covers the centre of every pixel of the rectangle `(x0, y0, x1, y1)`
+    /// (exclusive max) by the top-left rule: the four corner pixels are covered, and the
+    /// triangle is convex.
+    fn covers_rect(&self, id: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> bool {
+        let t = self.tri(id);
+        let centre = |p: u32| (i64::from(p) << SUBPIXEL_BITS) + HALF;
+        [(x0, y0), (x1 - 1, y0), (x0, y1 - 1), (x1 - 1, y1 - 1)]
+            .iter()
+            .all(|&(px, py)| Frame::covers(t, centre(px), centre(py)).is_some())
     }
 
     /// Visibility of triangle `t` (id `ti`) with one sample per pixel, over its rows in the tile
@@ -1224,7 +1277,70 @@ impl Frame<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::round_i64;
+    use super::*;
+
+    /// Binning's trivial reject never drops a tile where a sample of any pattern is covered,
+    /// and does drop some (random triangles up to 2.5 tiles across, in a 4×4-tile image).
+    #[test]
+    fn tile_reject_is_conservative() {
+        let (w, h) = (4 * TILE_SIZE, 4 * TILE_SIZE);
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |range: i64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % range as u64) as i64
+        };
+        let patterns: Vec<Vec<(i64, i64)>> = [1, 4, 16]
+            .iter()
+            .map(|&n| {
+                sample_pattern(n)
+                    .iter()
+                    .map(|&(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
+                    .collect()
+            })
+            .collect();
+        let mut rejected = 0;
+        for _ in 0..400 {
+            let span = i64::from(TILE_SIZE) * 160 * 2;
+            let (cx, cy) = (next(i64::from(w) * 256), next(i64::from(h) * 256));
+            let proj = [0; 3].map(|_| {
+                Projected(
+                    (cx + next(span) - span / 2) as i32,
+                    (cy + next(span) - span / 2) as i32,
+                    0.5,
+                    1.0,
+                )
+            });
+            let Some(s) = setup_edges(proj, true, w, h) else {
+                continue;
+            };
+            let t = &s.tri;
+            for ty in 0..h / TILE_SIZE {
+                for tx in 0..w / TILE_SIZE {
+                    if !Frame::misses_tile(t, tx, ty) {
+                        continue;
+                    }
+                    rejected += 1;
+                    for py in ty * TILE_SIZE..(ty + 1) * TILE_SIZE {
+                        for px in tx * TILE_SIZE..(tx + 1) * TILE_SIZE {
+                            for &(ox, oy) in patterns.iter().flatten() {
+                                let (sx, sy) = (
+                                    (i64::from(px) << SUBPIXEL_BITS) + ox,
+                                    (i64::from(py) << SUBPIXEL_BITS) + oy,
+                                );
+                                assert!(
+                                    Frame::covers(t, sx, sy).is_none(),
+                                    "tile ({tx}, {ty}) rejected, ({px}, {py}) covered"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(rejected > 100, "only {rejected} tiles rejected");
+    }
 
     #[test]
     fn round_matches_f32_round() {
