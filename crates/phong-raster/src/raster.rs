@@ -1144,13 +1144,23 @@ impl Frame<'_> {
         let background = resolve(std::iter::once(bg), 1, bg);
         // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
         // where its pixels end in `order`.
+        // By runs of equal ids along rows (`(row << 16 | first column, length, k)`): a count per
+        // run, not a read-modify-write of the same counter per pixel (a chain through memory).
         let mut starts = vec![0u32; bin.len() + 1];
+        let mut runs: Vec<(u32, u32, u32)> = Vec::with_capacity(tw * th / 4);
         for (row, line) in out.iter_mut().enumerate().take(th) {
-            for (col, o) in line.iter_mut().enumerate() {
-                match ids[row * tw + col] {
-                    u32::MAX => *o = background,
-                    k => starts[k as usize + 1] += 1,
+            let ids = &ids[row * tw..(row + 1) * tw];
+            let mut col = 0;
+            while col < tw {
+                let k = ids[col];
+                let len = ids[col..].iter().take_while(|&&id| id == k).count();
+                if k == u32::MAX {
+                    line[col..col + len].fill(background);
+                } else {
+                    starts[k as usize + 1] += len as u32;
+                    runs.push(((row as u32) << 16 | col as u32, len as u32, k));
                 }
+                col += len;
             }
         }
         for k in 0..bin.len() {
@@ -1159,14 +1169,12 @@ impl Frame<'_> {
         let shaded = starts[bin.len()];
         let mut order = vec![0u32; shaded as usize];
         let mut next = starts.clone();
-        for row in 0..th {
-            for col in 0..tw {
-                let k = ids[row * tw + col];
-                if k != u32::MAX {
-                    order[next[k as usize] as usize] = (row as u32) << 16 | col as u32;
-                    next[k as usize] += 1;
-                }
+        for &(first, len, k) in &runs {
+            let at = next[k as usize] as usize;
+            for (i, o) in order[at..at + len as usize].iter_mut().enumerate() {
+                *o = first + i as u32;
             }
+            next[k as usize] += len;
         }
         // Per object, the pixels left over from whole vectors, with their triangles: shaded
         // together, each lane gathering its triangle's planes.
