@@ -7,7 +7,9 @@
 //! simple: each sample evaluates its three edge functions directly.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
-use crate::simd::{Batch, LANES, Planes, Prepared, Term, avx2_available, shade_batch, shade_group, shade8};
+use crate::simd::{
+    Batch, LANES, Planes, Prepared, Term, avx2_available, group_lanes, shade_batch, shade_group, shade8,
+};
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
@@ -636,6 +638,7 @@ fn plane_equations(
         origin: [xy[0].0 as f32 / ONE, xy[0].1 as f32 / ONE],
         inv_w: plane(inv_w),
         attr,
+        pad: 0.0,
     }
 }
 
@@ -1180,6 +1183,7 @@ impl Frame<'_> {
         // together, each lane gathering its triangle's planes.
         let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
+        let group = group_lanes(self.avx2);
         for (k, &id) in bin.iter().enumerate() {
             let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
             if pixels.is_empty() {
@@ -1198,10 +1202,16 @@ impl Frame<'_> {
                     continue;
                 }
             };
-            let done = shade_group(self.avx2, kind, self.planes(id), (x0, y0), pixels, |p, rgb| {
-                let (r, c) = at(p);
-                out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
-            });
+            // Fewer pixels than a vector: straight to the gathered batch (no call; a 1M-triangle
+            // tile has thousands of one-pixel triangles).
+            let done = if pixels.len() < group {
+                0
+            } else {
+                shade_group(self.avx2, kind, self.planes(id), (x0, y0), pixels, |p, rgb| {
+                    let (r, c) = at(p);
+                    out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                })
+            };
             rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
         }
         for (object, batch) in rest.iter().enumerate() {

@@ -454,7 +454,11 @@ pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) ->
 /// A triangle's perspective-correct attributes as plane equations in pixel coordinates:
 /// `q(x, y) = c + gx·(x − ox) + gy·(y − oy)` for `1/w` and for each attribute divided by `w`;
 /// the attribute is `q_a / q_w` (interpolating `a/w` and `1/w` linearly in screen space).
-#[derive(Clone, Copy, Debug, Default)]
+///
+/// 24 floats in this order (`repr(C)`, plain data), read by a batch as three rows of 8 that
+/// it transposes into vectors: Gouraud needs the first two rows, Phong all three.
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Planes {
     /// `(ox, oy)`: where the planes' constants are taken (a vertex), in pixels.
     pub origin: [f32; 2],
@@ -462,6 +466,16 @@ pub struct Planes {
     pub inv_w: [f32; 3],
     /// Attributes over `w`: Phong: world position then normal; Gouraud: the colour.
     pub attr: [[f32; 3]; 6],
+    /// Padding to three rows of 8.
+    pub pad: f32,
+}
+
+impl Planes {
+    /// The 24 floats as three rows of 8.
+    #[inline(always)]
+    fn rows(&self) -> &[[f32; 8]; 3] {
+        bytemuck::cast_ref(self)
+    }
 }
 
 /// What a batch interpolates and how it colours the result.
@@ -595,44 +609,33 @@ pub(crate) fn shade_group<V: Vf32>(
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
 #[inline(always)]
 fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
-    // One triangle for all lanes (the usual case): broadcast its coefficients.
-    let same = planes.iter().all(|p| std::ptr::eq(*p, planes[0]));
-    let (dx, dy) = if same {
-        let o = planes[0].origin;
-        (x.sub(V::splat(o[0])), y.sub(V::splat(o[1])))
-    } else {
-        let (mut ox, mut oy) = (V::A::default(), V::A::default());
-        for (i, p) in planes.iter().enumerate() {
-            ox.as_mut()[i] = p.origin[0];
-            oy.as_mut()[i] = p.origin[1];
+    // The planes' 24 floats as vectors: broadcast when one triangle has all lanes (the usual
+    // case in large triangles), else gathered by transposing each lane's rows.
+    let mut k = [V::splat(0.0); 24];
+    let rows = if attrs > 3 { 3 } else { 2 };
+    if planes.iter().all(|p| std::ptr::eq(*p, planes[0])) {
+        let f = bytemuck::cast_ref::<_, [f32; 24]>(planes[0]);
+        for (v, &c) in k.iter_mut().zip(f).take(rows * 8) {
+            *v = V::splat(c);
         }
-        (x.sub(V::from_array(ox)), y.sub(V::from_array(oy)))
-    };
-    let w = plane(planes, same, dx, dy, |p| p.inv_w).recip();
+    } else {
+        for r in 0..rows {
+            let mut lanes: [&[f32; 8]; MAX_LANES] = [&planes[0].rows()[r]; MAX_LANES];
+            for (l, p) in lanes.iter_mut().zip(planes) {
+                *l = &p.rows()[r];
+            }
+            k[r * 8..r * 8 + 8].copy_from_slice(&V::transpose(&lanes[..V::N]));
+        }
+    }
+    let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
+    // `c + gx·dx + gy·dy` from floats `i..i + 3`.
+    let plane = |i: usize| k[i + 2].mul_add(dy, k[i + 1].mul_add(dx, k[i]));
+    let w = plane(2).recip();
     let mut out = [V::splat(0.0); 6];
     for (a, o) in out.iter_mut().enumerate().take(attrs) {
-        *o = plane(planes, same, dx, dy, |p| p.attr[a]).mul(w);
+        *o = plane(5 + 3 * a).mul(w);
     }
     out
-}
-
-/// `c + gx·dx + gy·dy` with the lanes' coefficients `f(planes[i])`.
-#[inline(always)]
-fn plane<V: Vf32>(planes: &[&Planes], same: bool, dx: V, dy: V, f: impl Fn(&Planes) -> [f32; 3]) -> V {
-    let (c, gx, gy) = if same {
-        let [c, gx, gy] = f(planes[0]);
-        (V::splat(c), V::splat(gx), V::splat(gy))
-    } else {
-        let mut k = [V::A::default(); 3];
-        for (i, p) in planes.iter().enumerate() {
-            let v = f(p);
-            k[0].as_mut()[i] = v[0];
-            k[1].as_mut()[i] = v[1];
-            k[2].as_mut()[i] = v[2];
-        }
-        (V::from_array(k[0]), V::from_array(k[1]), V::from_array(k[2]))
-    };
-    gy.mul_add(dy, gx.mul_add(dx, c))
 }
 
 #[cfg(test)]

@@ -86,6 +86,15 @@ pub fn shade_batch<'p>(
     kernel::shade_batch::<vector::Portable>(batch, n, lane, out)
 }
 
+/// The lanes of [`shade_group`]'s vectors: it shades whole vectors only.
+pub fn group_lanes(avx2: bool) -> usize {
+    if avx2 && cfg!(target_arch = "x86_64") {
+        16
+    } else {
+        LANES
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn shade_group_avx2(

@@ -73,6 +73,11 @@ pub trait Vf32: Copy {
     fn pow2i(self) -> Self;
     /// Round to the nearest integer, ties to even.
     fn round(self) -> Self;
+    /// Transposes `N` rows of 8 floats (lane `i` takes row `i`) into 8 vectors: vector `j`
+    /// holds element `j` of every row. How a batch gathers its lanes' plane coefficients
+    /// (8 loads and 24 shuffles per 8 lanes in the AVX2 build, instead of 64 scalar stores and
+    /// reloads through an array).
+    fn transpose(rows: &[&[f32; 8]]) -> [Self; 8];
 }
 
 /// The portable twin: `[f32; 8]`, plain loops, exact `rsqrt` and `recip`.
@@ -198,6 +203,16 @@ impl Vf32 for Portable {
             let x = self.0[i];
             if x.abs() < 4_194_304.0 { (x + MAGIC) - MAGIC } else { x }
         }))
+    }
+    #[inline(always)]
+    fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
+        let mut out = [Portable([0.0; 8]); 8];
+        for (i, row) in rows.iter().enumerate().take(8) {
+            for (j, o) in out.iter_mut().enumerate() {
+                o.0[i] = row[j];
+            }
+        }
+        out
     }
 }
 
@@ -379,6 +394,45 @@ mod avx2 {
             // SAFETY: AVX is present (see above).
             Avx2(unsafe { _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0) })
         }
+        #[inline(always)]
+        fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
+            let rows: &[&[f32; 8]; 8] = rows.try_into().expect("8 rows for 8 lanes");
+            // SAFETY: AVX is present (see above); each row is 8 readable f32 (unaligned loads).
+            unsafe {
+                let r = rows.map(|row| _mm256_loadu_ps(row.as_ptr()));
+                // Pairs interleaved, then quadruples, then the 128-bit halves swapped.
+                let t = [
+                    _mm256_unpacklo_ps(r[0], r[1]),
+                    _mm256_unpackhi_ps(r[0], r[1]),
+                    _mm256_unpacklo_ps(r[2], r[3]),
+                    _mm256_unpackhi_ps(r[2], r[3]),
+                    _mm256_unpacklo_ps(r[4], r[5]),
+                    _mm256_unpackhi_ps(r[4], r[5]),
+                    _mm256_unpacklo_ps(r[6], r[7]),
+                    _mm256_unpackhi_ps(r[6], r[7]),
+                ];
+                let q = [
+                    _mm256_shuffle_ps::<0x44>(t[0], t[2]),
+                    _mm256_shuffle_ps::<0xee>(t[0], t[2]),
+                    _mm256_shuffle_ps::<0x44>(t[1], t[3]),
+                    _mm256_shuffle_ps::<0xee>(t[1], t[3]),
+                    _mm256_shuffle_ps::<0x44>(t[4], t[6]),
+                    _mm256_shuffle_ps::<0xee>(t[4], t[6]),
+                    _mm256_shuffle_ps::<0x44>(t[5], t[7]),
+                    _mm256_shuffle_ps::<0xee>(t[5], t[7]),
+                ];
+                [
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q[0], q[4])),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q[1], q[5])),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q[2], q[6])),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q[3], q[7])),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q[0], q[4])),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q[1], q[5])),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q[2], q[6])),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q[3], q[7])),
+                ]
+            }
+        }
     }
 
     /// Two [`Avx2`] vectors as one of 16 lanes: every operation is issued twice, on
@@ -506,6 +560,46 @@ mod avx2 {
         #[inline(always)]
         fn round(self) -> Self {
             both!(self, round)
+        }
+        #[inline(always)]
+        fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
+            let (lo, hi) = (Avx2::transpose(&rows[..8]), Avx2::transpose(&rows[8..16]));
+            core::array::from_fn(|j| Avx2x2(lo[j], hi[j]))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Element `j` of row `i` lands in lane `i` of vector `j`, for 8 and (AVX2) 16 lanes.
+    fn check_transpose<V: Vf32>() {
+        let rows: Vec<[f32; 8]> = (0..V::N)
+            .map(|i| core::array::from_fn(|j| (i * 8 + j) as f32))
+            .collect();
+        let refs: Vec<&[f32; 8]> = rows.iter().collect();
+        let out = V::transpose(&refs);
+        for (j, v) in out.iter().enumerate() {
+            let a = v.to_array();
+            for i in 0..V::N {
+                assert_eq!(a.as_ref()[i], rows[i][j], "row {i}, element {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn transpose_moves_rows_into_lanes() {
+        check_transpose::<Portable>();
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::avx2_available() {
+            #[target_feature(enable = "avx2,fma")]
+            fn avx2() {
+                check_transpose::<Avx2>();
+                check_transpose::<Avx2x2>();
+            }
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            unsafe { avx2() };
         }
     }
 }
