@@ -8,7 +8,7 @@
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
-    Batch, LANES, Planes, Prepared, Term, avx2_available, group_lanes, shade_batch, shade_group, shade8,
+    Batch, LANES, Planes, Prepared, Term, avx2_available, gouraud_row, group_lanes, shade_batch, shade_group, shade8,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -175,6 +175,16 @@ struct Setup {
     inv_w: [f32; 3],
     area: u64,
     front: bool,
+}
+
+/// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
+const FORWARD: u32 = u32::MAX - 1;
+
+/// Gouraud on the fast path with one sample: colours written into the tile's rows as pixels
+/// pass the depth test, from the triangle's colour planes.
+struct Forward<'p, 'r, 'i> {
+    planes: &'p Planes,
+    rows: &'r mut [&'i mut [[f32; 4]]],
 }
 
 /// How the fast path shades an object's pixels.
@@ -954,8 +964,27 @@ impl Frame<'_> {
             let bb = t.bbox();
             let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
             if ns == 1 {
-                // One sample: `ids` holds the index in the bin (see `shade_single`).
-                self.visible_single(t, k as u32, offsets[0], (x0, y0, tw), (bx0, bx1), &mut depth, &mut ids);
+                // One sample: `ids` holds the index in the bin (see `shade_single`). Gouraud
+                // triangles write their colour as they pass the depth test (see `Forward`).
+                let tile = (x0, y0, tw);
+                if matches!(self.modes[self.object(ti)], Mode::Gouraud) {
+                    let forward = Forward {
+                        planes: self.planes(ti),
+                        rows: &mut *rows,
+                    };
+                    self.visible_single(
+                        t,
+                        k as u32,
+                        offsets[0],
+                        tile,
+                        (bx0, bx1),
+                        &mut depth,
+                        &mut ids,
+                        Some(forward),
+                    );
+                } else {
+                    self.visible_single(t, k as u32, offsets[0], tile, (bx0, bx1), &mut depth, &mut ids, None);
+                }
                 continue;
             }
             for py in bb[1].max(y0)..bb[3].min(y1) {
@@ -1072,8 +1101,12 @@ impl Frame<'_> {
     /// the integer bound of `e − bias + k·step >= 0`), so the loop over pixels tests no edges;
     /// narrow ones (under 8 pixels, where the three divisions cost more) test each pixel. Same
     /// edge values and depth arithmetic as the reference, hence the same visibility.
+    ///
+    /// With `forward` (Gouraud), each pixel that passes the depth test gets its colour at once
+    /// and the id [`FORWARD`]: interpolating a colour costs less than sorting the pixel for a
+    /// deferred pass, and a later, nearer triangle overwrites both.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     fn visible_single(
         &self,
         t: &Tri,
@@ -1083,6 +1116,7 @@ impl Frame<'_> {
         (bx0, bx1): (u32, u32),
         depth: &mut [f32],
         ids: &mut [u32],
+        mut forward: Option<Forward>,
     ) {
         let step = [0, 1, 2].map(|i| t.a(i) << SUBPIXEL_BITS);
         let bb = t.bbox();
@@ -1109,6 +1143,8 @@ impl Frame<'_> {
             }
             let line = (py - y0) as usize * tw + (bx0 - x0) as usize;
             let mut eb = [0, 1, 2].map(|i| row[i] + step[i] * lo);
+            // Forward: the pixels of this row (at most a tile's 64) that passed.
+            let mut passed = 0u64;
             for k in lo..hi {
                 if (eb[0] | eb[1] | eb[2]) >= 0 {
                     let e = [0, 1, 2].map(|i| eb[i] + t.bias(i));
@@ -1117,12 +1153,23 @@ impl Frame<'_> {
                     let at = line + k as usize;
                     if zz < depth[at] {
                         depth[at] = zz;
-                        ids[at] = ti;
+                        if forward.is_some() {
+                            ids[at] = FORWARD;
+                            passed |= 1 << k;
+                        } else {
+                            ids[at] = ti;
+                        }
                     }
                 }
                 for i in 0..3 {
                     eb[i] += step[i];
                 }
+            }
+            if let Some(f) = &mut forward
+                && passed != 0
+            {
+                let row = &mut f.rows[(py - y0) as usize][(bx0 - x0) as usize..(bx1 - x0) as usize];
+                gouraud_row(self.avx2, f.planes, (bx0, py), passed, row);
             }
         }
     }
@@ -1150,6 +1197,7 @@ impl Frame<'_> {
         // By runs of equal ids along rows (`(row << 16 | first column, length, k)`): a count per
         // run, not a read-modify-write of the same counter per pixel (a chain through memory).
         let mut starts = vec![0u32; bin.len() + 1];
+        let mut shaded = 0u32;
         let mut runs: Vec<(u32, u32, u32)> = Vec::with_capacity(tw * th / 4);
         for (row, line) in out.iter_mut().enumerate().take(th) {
             let ids = &ids[row * tw..(row + 1) * tw];
@@ -1159,6 +1207,9 @@ impl Frame<'_> {
                 let len = ids[col..].iter().take_while(|&&id| id == k).count();
                 if k == u32::MAX {
                     line[col..col + len].fill(background);
+                } else if k == FORWARD {
+                    // Coloured during visibility.
+                    shaded += len as u32;
                 } else {
                     starts[k as usize + 1] += len as u32;
                     runs.push(((row as u32) << 16 | col as u32, len as u32, k));
@@ -1169,8 +1220,9 @@ impl Frame<'_> {
         for k in 0..bin.len() {
             starts[k + 1] += starts[k];
         }
-        let shaded = starts[bin.len()];
-        let mut order = vec![0u32; shaded as usize];
+        let sorted = starts[bin.len()];
+        shaded += sorted;
+        let mut order = vec![0u32; sorted as usize];
         let mut next = starts.clone();
         for &(first, len, k) in &runs {
             let at = next[k as usize] as usize;
