@@ -295,3 +295,65 @@ rotation = [0.0, 90.0, 0.0]
         }
     }
 }
+
+/// Objects of different interpolations hiding each other, in both drawing orders: Gouraud
+/// pixels are coloured during visibility and Phong ones after it, so a nearer triangle of
+/// either kind must win over a farther one of the other, whatever came first.
+#[test]
+fn fast_path_matches_reference_where_interpolations_overlap() {
+    for (first, second) in [("gouraud", "phong"), ("phong", "gouraud")] {
+        let src = format!(
+            r#"
+[image]
+width = 160
+height = 120
+[camera]
+position = [0.0, 0.0, 4.0]
+[shading]
+model = "blinn-phong"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+segments = 24
+material = "brass"
+interpolation = "{first}"
+position = [-0.3, 0.0, 0.0]
+[[object]]
+shape = "torus"
+segments = 24
+material = "jade"
+interpolation = "{second}"
+position = [0.4, 0.1, 0.3]
+rotation = [60.0, 0.0, 0.0]
+"#
+        );
+        let scene = phong_scene::parse_scene(&src, Path::new("overlap.toml")).unwrap().scene;
+        let reference = render(
+            &scene,
+            &RenderOptions {
+                reference: true,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let a = reference.to_bytes(scene.image.encoding, false);
+        for no_avx2 in [false, true] {
+            let fast = render(
+                &scene,
+                &RenderOptions {
+                    no_avx2,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let b = fast.to_bytes(scene.image.encoding, false);
+            let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+            assert!(
+                worst <= 1,
+                "{first} then {second} (no_avx2 {no_avx2}): a channel differs by {worst}/255"
+            );
+        }
+    }
+}
