@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use phong_core::{Material, named_materials};
-use phong_raster::{RenderOptions, render_into, render_with_stats};
+use phong_raster::{RenderOptions, Renderer, render_with_stats};
 use phong_scene::{INTERPOLATIONS, MODELS, OUTPUTS, apply_model, parse_choice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -350,8 +350,9 @@ fn bench(a: BenchArgs) -> Result<()> {
             }
         }
         None => {
-            // As a real-time renderer runs: one thread pool and one framebuffer for all frames
-            // (llvmpipe's harness, too, draws every frame into the same buffer).
+            // As a real-time renderer runs: one thread pool, one framebuffer and one working
+            // memory for all frames (llvmpipe's harness, too, draws every frame into the same
+            // buffer).
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(a.run.threads.unwrap_or(0))
                 .build()
@@ -360,11 +361,11 @@ fn bench(a: BenchArgs) -> Result<()> {
                 threads: None,
                 ..a.run.options(None)
             };
-            let mut image = None;
+            let mut renderer = Renderer::new();
             pool.install(|| -> Result<()> {
-                render_into(&scene, &options, &mut image)?;
+                renderer.render(&scene, &options)?;
                 for _ in 0..a.frames {
-                    let st = render_into(&scene, &options, &mut image)?;
+                    let st = renderer.render(&scene, &options)?.1;
                     for (k, d) in [
                         st.setup,
                         st.raster,

@@ -220,6 +220,33 @@ struct Chunk {
     corners: Vec<Corners>,
 }
 
+/// Working memory kept between frames by a [`Renderer`](crate::Renderer): emptied, never
+/// shrunk.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// The fast setup's per-vertex buffers (one object at a time).
+    vertices: Vec<FastVertex>,
+    colors: Vec<[Vec3; 2]>,
+    /// Chunks of set-up triangles, emptied, for the next frame's setup tasks.
+    chunks: Vec<Chunk>,
+    bins: Vec<Vec<u32>>,
+}
+
+impl Chunk {
+    /// An empty chunk for `object` with room for `n` triangles, from `spare` if it has one.
+    fn reuse(spare: &std::sync::Mutex<Vec<Chunk>>, object: usize, n: usize) -> Chunk {
+        let mut c = spare.lock().ok().and_then(|mut s| s.pop()).unwrap_or(Chunk {
+            object: 0,
+            tris: Vec::new(),
+            planes: Vec::new(),
+            corners: Vec::new(),
+        });
+        c.object = object as u32;
+        c.tris.reserve(n);
+        c
+    }
+}
+
 struct Frame<'a> {
     scene: &'a Scene,
     /// Use the AVX2 build of the kernel (decided once per frame).
@@ -240,8 +267,9 @@ struct Frame<'a> {
 }
 
 impl<'a> Frame<'a> {
-    /// Transforms, lights (Gouraud, flat), clips, sets up and bins every triangle.
-    fn build(scene: &'a Scene, reference: bool, avx2: bool) -> Frame<'a> {
+    /// Transforms, lights (Gouraud, flat), clips, sets up and bins every triangle, in memory
+    /// taken from `scratch` (give it back with [`Frame::recycle`]).
+    fn build(scene: &'a Scene, reference: bool, avx2: bool, scratch: &mut Scratch) -> Frame<'a> {
         let (w, h) = (scene.image.width, scene.image.height);
         let aspect = w as f32 / h as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);
@@ -286,31 +314,59 @@ impl<'a> Frame<'a> {
             pattern,
             tris: Vec::new(),
             tiles_x: w.div_ceil(TILE_SIZE),
-            bins: vec![Vec::new(); (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize],
+            bins: std::mem::take(&mut scratch.bins),
         };
+        frame
+            .bins
+            .resize((w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize, Vec::new());
+        let spare = std::sync::Mutex::new(std::mem::take(&mut scratch.chunks));
         for (oi, obj) in scene.objects.iter().enumerate() {
             let chunks = if reference || matches!(frame.modes[oi], Mode::Scalar) {
                 frame.setup_object_full(oi, obj, clip_from_world)
             } else {
-                frame.setup_object_fast(oi, obj, clip_from_world)
+                frame.setup_object_fast(oi, obj, clip_from_world, scratch, &spare)
             };
             for chunk in chunks {
                 frame.bin_chunk(chunk);
             }
         }
+        scratch.chunks = spare.into_inner().unwrap_or_default();
         frame
+    }
+
+    /// Gives the frame's memory back to `scratch`, emptied, for the next frame.
+    fn recycle(self, scratch: &mut Scratch) {
+        for mut chunk in self.tris {
+            chunk.tris.clear();
+            chunk.planes.clear();
+            chunk.corners.clear();
+            scratch.chunks.push(chunk);
+        }
+        scratch.bins = self.bins;
+        for bin in &mut scratch.bins {
+            bin.clear();
+        }
     }
 
     /// The fast path's setup of a Phong- or Gouraud-interpolated object, lean in memory traffic:
     /// per vertex a 20-byte [`FastVertex`] (and for Gouraud its lit colours), per triangle its
     /// edges and plane equations; [`ClipVertex`] values are made only for the triangles that
     /// need clipping.
-    fn setup_object_fast(&self, oi: usize, obj: &Object, clip_from_world: glam::Mat4) -> Vec<Chunk> {
+    fn setup_object_fast(
+        &self,
+        oi: usize,
+        obj: &Object,
+        clip_from_world: glam::Mat4,
+        scratch: &mut Scratch,
+        spare: &std::sync::Mutex<Vec<Chunk>>,
+    ) -> Vec<Chunk> {
         let two_sided = obj.shading.options.two_sided;
         let mesh = &obj.mesh;
         let (positions, normals) = (mesh.positions(), mesh.normals());
         let mode = &self.modes[oi];
-        let mut vertices = vec![FastVertex::default(); positions.len()];
+        let vertices = &mut scratch.vertices;
+        vertices.clear();
+        vertices.resize(positions.len(), FastVertex::default());
         vertices
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
@@ -328,36 +384,35 @@ impl<'a> Frame<'a> {
             });
         // Gouraud: the colour seen from the front and (two-sided) from the back, 8 vertices at a
         // time by the kernel.
-        let colors: Vec<[Vec3; 2]> = match mode {
-            Mode::Gouraud => {
-                let lit = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
-                let prep = Prepared::new(
-                    &self.scene.lighting,
-                    &obj.material,
-                    &obj.shading.options,
-                    self.views[oi],
-                );
-                positions
-                    .par_chunks(SETUP_CHUNK)
-                    .zip(normals.par_chunks(SETUP_CHUNK))
-                    .flat_map_iter(|(ps, ns)| {
-                        let mut out = Vec::with_capacity(ps.len());
-                        for (p8, n8) in ps.chunks(LANES).zip(ns.chunks(LANES)) {
-                            let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
-                            let (pp, nn) = (pad(p8), pad(n8));
-                            let front = shade8(self.avx2, &prep, &pp, &nn).term(lit);
-                            let back = two_sided.then(|| shade8(self.avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
-                            let at = |c: &[[f32; LANES]; 3], i: usize| Vec3::new(c[0][i], c[1][i], c[2][i]);
-                            for i in 0..p8.len() {
-                                out.push([at(&front, i), back.as_ref().map_or(Vec3::ZERO, |b| at(b, i))]);
-                            }
+        let colors = &mut scratch.colors;
+        colors.clear();
+        if let Mode::Gouraud = mode {
+            let lit = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
+            let prep = Prepared::new(
+                &self.scene.lighting,
+                &obj.material,
+                &obj.shading.options,
+                self.views[oi],
+            );
+            colors.resize(positions.len(), [Vec3::ZERO; 2]);
+            colors
+                .par_chunks_mut(SETUP_CHUNK)
+                .zip(positions.par_chunks(SETUP_CHUNK))
+                .zip(normals.par_chunks(SETUP_CHUNK))
+                .for_each(|((out, ps), ns)| {
+                    for ((o8, p8), n8) in out.chunks_mut(LANES).zip(ps.chunks(LANES)).zip(ns.chunks(LANES)) {
+                        let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
+                        let (pp, nn) = (pad(p8), pad(n8));
+                        let front = shade8(self.avx2, &prep, &pp, &nn).term(lit);
+                        let back = two_sided.then(|| shade8(self.avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
+                        let at = |c: &[[f32; LANES]; 3], i: usize| Vec3::new(c[0][i], c[1][i], c[2][i]);
+                        for (i, o) in o8.iter_mut().enumerate() {
+                            *o = [at(&front, i), back.as_ref().map_or(Vec3::ZERO, |b| at(b, i))];
                         }
-                        out
-                    })
-                    .collect()
-            }
-            _ => Vec::new(),
-        };
+                    }
+                });
+        }
+        let (vertices, colors) = (&*vertices, &*colors);
         // The planes of a set-up triangle from its input vertices' indices.
         let planes = |s: &Setup, idx: [u32; 3]| -> Planes {
             let idx = s.order.map(|k| idx[k] as usize);
@@ -371,12 +426,8 @@ impl<'a> Frame<'a> {
             plane_equations(&s.xy, &s.tri, s.area, s.inv_w, attrs, matches!(mode, Mode::Gouraud))
         };
         let setup_chunk = |chunk: &[[u32; 3]]| {
-            let mut out = Chunk {
-                object: oi as u32,
-                tris: Vec::with_capacity(chunk.len()),
-                planes: Vec::with_capacity(chunk.len()),
-                corners: Vec::new(),
-            };
+            let mut out = Chunk::reuse(spare, oi, chunk.len());
+            out.planes.reserve(chunk.len());
             for &tri in chunk {
                 let v = tri.map(|i| vertices[i as usize]);
                 let c = v.map(|v| v.code);
@@ -540,7 +591,7 @@ impl<'a> Frame<'a> {
 /// samples innermost), how many triangles cover it, depth ignored. Culling
 /// and clipping apply as in [`render`](crate::render).
 pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
-    let frame = Frame::build(scene, false, false);
+    let frame = Frame::build(scene, false, false, &mut Scratch::default());
     let ns = frame.pattern.len();
     let mut counts = vec![0u16; frame.w as usize * frame.h as usize * ns];
     for t in frame.tris.iter().flat_map(|c| &c.tris) {
@@ -561,10 +612,15 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 }
 
 /// Renders into `image`, of the scene's size; every pixel is written.
-pub(crate) fn render(scene: &Scene, options: &RenderOptions, image: &mut Image) -> Result<RenderStats, Error> {
+pub(crate) fn render(
+    scene: &Scene,
+    options: &RenderOptions,
+    image: &mut Image,
+    scratch: &mut Scratch,
+) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
     let (w, h) = (scene.image.width, scene.image.height);
-    let frame = Frame::build(scene, options.reference, !options.no_avx2 && avx2_available());
+    let frame = Frame::build(scene, options.reference, !options.no_avx2 && avx2_available(), scratch);
     let setup = t0.elapsed();
 
     let t1 = Instant::now();
@@ -606,9 +662,11 @@ pub(crate) fn render(scene: &Scene, options: &RenderOptions, image: &mut Image) 
                 }
             });
         });
+    let triangles_drawn = frame.tris.iter().map(|c| c.tris.len()).sum();
+    frame.recycle(scratch);
     let stats = RenderStats {
         triangles: scene.triangle_count(),
-        triangles_drawn: frame.tris.iter().map(|c| c.tris.len()).sum(),
+        triangles_drawn,
         pixels_shaded: shaded.into_inner(),
         setup,
         raster: t1.elapsed(),

@@ -357,3 +357,25 @@ rotation = [60.0, 0.0, 0.0]
         }
     }
 }
+
+/// A `Renderer` kept across frames of different scenes (sizes, meshes, sample counts, both
+/// paths) makes the same images as fresh renders: nothing of a previous frame leaks into the
+/// next through its reused memory.
+#[test]
+fn renderer_reuse_matches_fresh_renders() {
+    let mut renderer = phong_raster::Renderer::new();
+    let paths = scenes();
+    for (i, path) in paths.iter().chain(paths.iter().rev()).enumerate() {
+        let mut scene = phong_scene::load(path).unwrap().scene;
+        scene.image.width = [96, 160, 64][i % 3];
+        scene.image.height = [64, 90, 64][i % 3];
+        let options = RenderOptions {
+            reference: i % 4 == 3,
+            threads: Some(2),
+            ..Default::default()
+        };
+        let fresh = render(&scene, &options).unwrap();
+        let (kept, _) = renderer.render(&scene, &options).unwrap();
+        assert!(kept == &fresh, "{}: a reused renderer changed the image", path.display());
+    }
+}
