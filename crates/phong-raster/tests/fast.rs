@@ -376,6 +376,10 @@ fn renderer_reuse_matches_fresh_renders() {
         };
         let fresh = render(&scene, &options).unwrap();
         let (kept, _) = renderer.render(&scene, &options).unwrap();
-        assert!(kept == &fresh, "{}: a reused renderer changed the image", path.display());
+        assert!(
+            kept == &fresh,
+            "{}: a reused renderer changed the image",
+            path.display()
+        );
     }
 }
