@@ -201,6 +201,16 @@ struct Forward<'p, 'r, 'i> {
     rows: &'r mut [&'i mut [[f32; 4]]],
 }
 
+/// The Gouraud colour at the centre of pixel `(px, py)`: `q_c / q_w` from the planes, as
+/// [`gouraud_row`] in scalar `f32` (without fused multiply-adds).
+#[inline(always)]
+fn gouraud_color(p: &Planes, px: u32, py: u32) -> [f32; 4] {
+    let (dx, dy) = (px as f32 + 0.5 - p.origin[0], py as f32 + 0.5 - p.origin[1]);
+    let eval = |[c, gx, gy]: [f32; 3]| c + gx * dx + gy * dy;
+    let w = 1.0 / eval(p.inv_w);
+    [eval(p.attr[0]) * w, eval(p.attr[1]) * w, eval(p.attr[2]) * w, 1.0]
+}
+
 /// How the fast path shades an object's pixels.
 enum Mode {
     /// Interpolated position and normal, the 8-lane kernel; the term shown.
@@ -1263,7 +1273,18 @@ impl Frame<'_> {
                 && passed != 0
             {
                 let row = &mut f.rows[(py - y0) as usize][(bx0 - x0) as usize..(bx1 - x0) as usize];
-                gouraud_row(self.avx2, f.planes, (bx0, py), passed, row);
+                if passed.count_ones() <= 2 {
+                    // One or two pixels (the rows of a 1M-triangle mesh): in scalar code, not a
+                    // call into the vector kernel.
+                    let mut m = passed;
+                    while m != 0 {
+                        let j = m.trailing_zeros();
+                        row[j as usize] = gouraud_color(f.planes, bx0 + j, py);
+                        m &= m - 1;
+                    }
+                } else {
+                    gouraud_row(self.avx2, f.planes, (bx0, py), passed, row);
+                }
             }
         }
     }
