@@ -9,6 +9,7 @@
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
     Batch, LANES, Planes, Prepared, Term, avx2_available, gouraud_row, group_lanes, shade_batch, shade_group, shade8,
+    stream_fence, stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -1321,7 +1322,7 @@ impl Frame<'_> {
                 let k = ids[col];
                 let len = ids[col..].iter().take_while(|&&id| id == k).count();
                 if k == u32::MAX {
-                    line[col..col + len].fill(background);
+                    stream_fill(&mut line[col..col + len], background);
                 } else if k == FORWARD {
                     // Coloured during visibility.
                     shaded += len as u32;
@@ -1332,6 +1333,7 @@ impl Frame<'_> {
                 col += len;
             }
         }
+        stream_fence();
         for k in 0..bin.len() {
             starts[k + 1] += starts[k];
         }

@@ -155,3 +155,32 @@ pub fn gouraud_row(avx2: bool, planes: &Planes, at: (u32, u32), mask: u64, out: 
     let _ = avx2;
     kernel::gouraud_row::<vector::Portable>(planes, at, mask, out)
 }
+
+/// Fills `dst` with `value` by non-temporal stores where `dst` is 16-byte aligned (on x86-64),
+/// else by plain stores: the background of a tile is written once and not read back by the
+/// renderer, so its cache lines need not be fetched before being written. Call
+/// [`stream_fence`] before the tile's pixels are read.
+pub fn stream_fill(dst: &mut [[f32; 4]], value: [f32; 4]) {
+    #[cfg(target_arch = "x86_64")]
+    if dst.as_ptr() as usize % 16 == 0 {
+        use core::arch::x86_64::{_mm_loadu_ps, _mm_stream_ps};
+        // SAFETY: SSE is part of x86-64; `value` is 4 readable f32.
+        let v = unsafe { _mm_loadu_ps(value.as_ptr()) };
+        for d in dst {
+            // SAFETY: SSE is part of x86-64; `d` is 4 writable f32 at a 16-byte aligned address
+            // (every element of a 16-byte aligned slice of `[f32; 4]` is).
+            unsafe { _mm_stream_ps(d.as_mut_ptr(), v) };
+        }
+        return;
+    }
+    dst.fill(value);
+}
+
+/// Orders earlier non-temporal stores ([`stream_fill`]) before later stores.
+pub fn stream_fence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86-64.
+    unsafe {
+        core::arch::x86_64::_mm_sfence()
+    };
+}
