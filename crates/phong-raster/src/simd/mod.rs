@@ -162,7 +162,7 @@ pub fn gouraud_row(avx2: bool, planes: &Planes, at: (u32, u32), mask: u64, out: 
 /// [`stream_fence`] before the tile's pixels are read.
 pub fn stream_fill(dst: &mut [[f32; 4]], value: [f32; 4]) {
     #[cfg(target_arch = "x86_64")]
-    if dst.as_ptr() as usize % 16 == 0 {
+    if (dst.as_ptr() as usize).is_multiple_of(16) {
         use core::arch::x86_64::{_mm_loadu_ps, _mm_stream_ps};
         // SAFETY: SSE is part of x86-64; `value` is 4 readable f32.
         let v = unsafe { _mm_loadu_ps(value.as_ptr()) };
