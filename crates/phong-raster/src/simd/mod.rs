@@ -184,3 +184,24 @@ pub fn stream_fence() {
         core::arch::x86_64::_mm_sfence()
     };
 }
+
+#[cfg(test)]
+mod tests {
+    /// Aligned (streamed) and unaligned (plain) destinations are both filled, and nothing
+    /// outside them.
+    #[test]
+    fn stream_fill_fills_exactly_its_slice() {
+        let mut buf = vec![0f32; 4 * 40 + 8];
+        for offset in 0..4 {
+            buf.fill(-1.0);
+            let pixels: &mut [[f32; 4]] = bytemuck::cast_slice_mut(&mut buf[offset..offset + 4 * 37]);
+            super::stream_fill(&mut pixels[3..35], [0.25, 0.5, 0.75, 1.0]);
+            super::stream_fence();
+            for (i, p) in pixels.iter().enumerate() {
+                let want = if (3..35).contains(&i) { [0.25, 0.5, 0.75, 1.0] } else { [-1.0; 4] };
+                assert_eq!(*p, want, "offset {offset}, pixel {i}");
+            }
+            assert!(buf[offset + 4 * 37..].iter().all(|&x| x == -1.0));
+        }
+    }
+}
