@@ -8,7 +8,7 @@
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
-    Batch, LANES, Planes, Prepared, Term, avx2_available, gouraud_row, group_lanes, shade_batch, shade_group, shade8,
+    Batch, Planes, Prepared, Term, avx2_available, gouraud_row, group_lanes, light_vertices, shade_batch, shade_group,
     stream_fence, stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
@@ -425,14 +425,11 @@ impl<'a> Frame<'a> {
                 .zip(positions.par_chunks(SETUP_CHUNK))
                 .zip(normals.par_chunks(SETUP_CHUNK))
                 .for_each(|((out, ps), ns)| {
-                    for ((o8, p8), n8) in out.chunks_mut(LANES).zip(ps.chunks(LANES)).zip(ns.chunks(LANES)) {
-                        let pad = |a: &[Vec3]| -> [Vec3; LANES] { std::array::from_fn(|i| a[i.min(a.len() - 1)]) };
-                        let (pp, nn) = (pad(p8), pad(n8));
-                        let front = shade8(self.avx2, &prep, &pp, &nn).term(lit);
-                        let back = two_sided.then(|| shade8(self.avx2, &prep, &pp, &nn.map(|n| -n)).term(lit));
-                        let at = |c: &[[f32; LANES]; 3], i: usize| Vec3::new(c[0][i], c[1][i], c[2][i]);
-                        for (i, o) in o8.iter_mut().enumerate() {
-                            *o = [at(&front, i), back.as_ref().map_or(Vec3::ZERO, |b| at(b, i))];
+                    let mut lit_colors = vec![Vec3::ZERO; ps.len()];
+                    for (side, flip) in [(0, false), (1, true)].into_iter().take(if two_sided { 2 } else { 1 }) {
+                        light_vertices(self.avx2, &prep, lit, ps, ns, flip, &mut lit_colors);
+                        for (o, c) in out.iter_mut().zip(&lit_colors) {
+                            o[side] = *c;
                         }
                     }
                 });

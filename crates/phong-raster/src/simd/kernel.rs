@@ -446,6 +446,44 @@ pub(crate) fn shade_points<V: Vf32<A = [f32; LANES]>>(
     }
 }
 
+/// Lights vertices for Gouraud, [`V::N`](Vf32::N) at a time: `out[i]` becomes `term` of the
+/// shading at `positions[i]` with normal `normals[i]` (negated with `flip`). The same
+/// arithmetic per lane as [`shade_points`], only the term asked for kept.
+#[inline(always)]
+pub(crate) fn light_vertices<V: Vf32>(
+    p: &Prepared,
+    term: Term,
+    positions: &[Vec3],
+    normals: &[Vec3],
+    flip: bool,
+    out: &mut [Vec3],
+) {
+    for ((ps, ns), os) in positions
+        .chunks(V::N)
+        .zip(normals.chunks(V::N))
+        .zip(out.chunks_mut(V::N))
+    {
+        let m = ps.len();
+        let mut c = [V::A::default(); 6];
+        for i in 0..V::N {
+            let (pp, mut nn) = (ps[i.min(m - 1)], ns[i.min(m - 1)]);
+            if flip {
+                nn = -nn;
+            }
+            for (k, v) in [pp.x, pp.y, pp.z, nn.x, nn.y, nn.z].into_iter().enumerate() {
+                c[k].as_mut()[i] = v;
+            }
+        }
+        let [px, py, pz, nx, ny, nz] = c.map(V::from_array);
+        let rgb = shade(p, V3 { x: px, y: py, z: pz }, V3 { x: nx, y: ny, z: nz })
+            .get(term)
+            .map(V::to_array);
+        for (i, o) in os.iter_mut().enumerate() {
+            *o = Vec3::new(rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]);
+        }
+    }
+}
+
 /// `shade8` in the portable build (the AVX2 build is [`super::shade8`]).
 pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     shade_points::<super::vector::Portable>(p, position, normal)

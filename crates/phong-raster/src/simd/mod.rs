@@ -86,6 +86,38 @@ pub fn shade_batch<'p>(
     kernel::shade_batch::<vector::Portable>(batch, n, lane, out)
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn light_vertices_avx2(p: &Prepared, term: Term, positions: &[Vec3], normals: &[Vec3], flip: bool, out: &mut [Vec3]) {
+    kernel::light_vertices::<vector::Avx2x2>(p, term, positions, normals, flip, out)
+}
+
+/// Gouraud's vertex lighting: `out[i]` = `term` of `phong_core::shade` at `positions[i]` with
+/// `normals[i]` (negated with `flip`), `pow` approximated as in [`kernel`]. AVX2 build (16
+/// lanes) when `avx2` is true.
+pub fn light_vertices(
+    avx2: bool,
+    p: &Prepared,
+    term: Term,
+    positions: &[Vec3],
+    normals: &[Vec3],
+    flip: bool,
+    out: &mut [Vec3],
+) {
+    assert!(positions.len() == normals.len() && out.len() == positions.len());
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        assert!(
+            avx2_available(),
+            "the AVX2 build asked for on a CPU without AVX2 and FMA"
+        );
+        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        return unsafe { light_vertices_avx2(p, term, positions, normals, flip, out) };
+    }
+    let _ = avx2;
+    kernel::light_vertices::<vector::Portable>(p, term, positions, normals, flip, out)
+}
+
 /// The lanes of [`shade_group`]'s vectors: it shades whole vectors only.
 pub fn group_lanes(avx2: bool) -> usize {
     if avx2 && cfg!(target_arch = "x86_64") {
@@ -198,7 +230,11 @@ mod tests {
             super::stream_fill(&mut pixels[3..35], [0.25, 0.5, 0.75, 1.0]);
             super::stream_fence();
             for (i, p) in pixels.iter().enumerate() {
-                let want = if (3..35).contains(&i) { [0.25, 0.5, 0.75, 1.0] } else { [-1.0; 4] };
+                let want = if (3..35).contains(&i) {
+                    [0.25, 0.5, 0.75, 1.0]
+                } else {
+                    [-1.0; 4]
+                };
                 assert_eq!(*p, want, "offset {offset}, pixel {i}");
             }
             assert!(buf[offset + 4 * 37..].iter().all(|&x| x == -1.0));
