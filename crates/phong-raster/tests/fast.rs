@@ -7,7 +7,7 @@ use common::Rng;
 use glam::Vec3;
 use phong_core::*;
 use phong_raster::clip::{ClipVertex, Clipped, clip_triangle};
-use phong_raster::simd::{LANES, Prepared, avx2_available, shade8};
+use phong_raster::simd::{LANES, Prepared, Term, avx2_available, light_vertices, shade8};
 use phong_raster::{RenderOptions, render};
 use std::path::Path;
 
@@ -86,6 +86,26 @@ fn kernel_matches_shade() {
                 continue;
             }
             let got = shade8(avx2, &prep, &pos, &nrm);
+            // Gouraud's vertex entry (16 lanes in the AVX2 build), on the same points with a
+            // 5-point tail: each term it keeps exactly as `shade8` has it, flipped normals as
+            // negated.
+            for (term, want) in [
+                (Term::Ambient, got.ambient),
+                (Term::Diffuse, got.diffuse),
+                (Term::Specular, got.specular),
+                (Term::Color, got.color),
+            ] {
+                let n = 13;
+                let ps: Vec<Vec3> = (0..n).map(|i| pos[i % LANES]).collect();
+                let ns: Vec<Vec3> = (0..n).map(|i| -nrm[i % LANES]).collect();
+                let mut out = vec![Vec3::NAN; n];
+                light_vertices(avx2, &prep, term, &ps, &ns, true, &mut out);
+                for (i, o) in out.iter().enumerate() {
+                    let w = Vec3::new(want[0][i % LANES], want[1][i % LANES], want[2][i % LANES]);
+                    // Lane-wise the same operations: the same bits.
+                    assert_eq!(*o, w, "round {round} vertex {i} avx2 {avx2} {term:?}");
+                }
+            }
             for lane in 0..LANES {
                 let want = shade(
                     &SurfacePoint {
