@@ -582,8 +582,8 @@ mod tests {
         let out = V::transpose(&refs);
         for (j, v) in out.iter().enumerate() {
             let a = v.to_array();
-            for i in 0..V::N {
-                assert_eq!(a.as_ref()[i], rows[i][j], "row {i}, element {j}");
+            for (i, row) in rows.iter().enumerate() {
+                assert_eq!(a.as_ref()[i], row[j], "row {i}, element {j}");
             }
         }
     }
