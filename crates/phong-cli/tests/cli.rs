@@ -15,10 +15,27 @@ fn phong(args: &[&str]) -> Output {
         .expect("run phong")
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("phong-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+/// A path named `name` in a fresh temporary directory, removed (with what the test wrote
+/// there) when this is dropped.
+struct TmpPath(tempfile::TempDir, PathBuf);
+
+impl std::ops::Deref for TmpPath {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.1
+    }
+}
+
+impl AsRef<Path> for TmpPath {
+    fn as_ref(&self) -> &Path {
+        &self.1
+    }
+}
+
+fn tmp(name: &str) -> TmpPath {
+    let dir = tempfile::Builder::new().prefix("phong-cli-").tempdir().unwrap();
+    let path = dir.path().join(name);
+    TmpPath(dir, path)
 }
 
 fn stderr(o: &Output) -> String {
