@@ -17,25 +17,29 @@ fn phong(args: &[&str]) -> Output {
 
 /// A path named `name` in a fresh temporary directory, removed (with what the test wrote
 /// there) when this is dropped.
-struct TmpPath(tempfile::TempDir, PathBuf);
+struct TmpPath {
+    /// Held for its `Drop`, which removes the directory.
+    _dir: tempfile::TempDir,
+    path: PathBuf,
+}
 
 impl std::ops::Deref for TmpPath {
     type Target = Path;
     fn deref(&self) -> &Path {
-        &self.1
+        &self.path
     }
 }
 
 impl AsRef<Path> for TmpPath {
     fn as_ref(&self) -> &Path {
-        &self.1
+        &self.path
     }
 }
 
 fn tmp(name: &str) -> TmpPath {
     let dir = tempfile::Builder::new().prefix("phong-cli-").tempdir().unwrap();
     let path = dir.path().join(name);
-    TmpPath(dir, path)
+    TmpPath { _dir: dir, path }
 }
 
 fn stderr(o: &Output) -> String {
