@@ -84,12 +84,31 @@ pub const NOT_FINITE: u16 = 0x1000;
 /// bits is [`Clipped::Inside`]; anything else goes to [`clip_triangle`].
 #[inline]
 pub fn outcode(c: Vec4) -> u16 {
+    // The planes' dot products written out: each has two non-zero terms, so `a + b` here is
+    // the dot product's value exactly (the zero terms add nothing; `G·w` is exact for the
+    // power-of-two guard band) wherever `c` is finite; where it is not, the triangle is
+    // rejected either way. Ten sums instead of ten 4-wide dot products; the test below checks
+    // the decisions against `clip_triangle`.
+    const _: () = assert!(GUARD_BAND == 4.0);
+    let (x, y, z, w) = (c.x, c.y, c.z, c.w);
+    let g = GUARD_BAND * w;
+    let outside = [
+        z + w,
+        w - z,
+        x + w,
+        w - x,
+        y + w,
+        w - y,
+        z + w,
+        w - z,
+        x + g,
+        g - x,
+        y + g,
+        g - y,
+    ];
     let mut code = if c.is_finite() { 0 } else { NOT_FINITE };
-    for (i, p) in VIEW_PLANES.iter().enumerate() {
-        code |= u16::from(p.dot(c) < 0.0) << i;
-    }
-    for (i, p) in CLIP_PLANES.iter().enumerate() {
-        code |= u16::from(p.dot(c) < 0.0) << (6 + i);
+    for (i, d) in outside.iter().enumerate() {
+        code |= u16::from(*d < 0.0) << i;
     }
     code
 }
@@ -204,6 +223,48 @@ mod tests {
             }
         }
         assert!(rejected > 100 && inside > 100, "{rejected} {inside}");
+    }
+
+    /// The written-out outcode equals the planes' dot products bit for bit on finite points,
+    /// on the planes exactly (x = ±w, ±4w; z = ±w), one ulp off them, and at random.
+    #[test]
+    fn outcode_matches_plane_dot_products() {
+        let by_dots = |c: Vec4| {
+            let mut code = 0u16;
+            for (i, p) in VIEW_PLANES.iter().chain(&CLIP_PLANES).enumerate() {
+                code |= u16::from(p.dot(c) < 0.0) << i;
+            }
+            code
+        };
+        let mut seed = 11u64;
+        let mut r = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let mut checked = 0;
+        for _ in 0..5000 {
+            let w = r() * 3.0;
+            let on = [-GUARD_BAND * w, -w, w, GUARD_BAND * w, r() * 5.0 * w, 0.0];
+            for &a in &on {
+                for da in [
+                    a,
+                    f32::from_bits(a.to_bits() + 1),
+                    f32::from_bits(a.to_bits().wrapping_sub(1)),
+                ] {
+                    for c in [
+                        Vec4::new(da, r(), r(), w),
+                        Vec4::new(r(), da, r(), w),
+                        Vec4::new(r(), r(), da, w),
+                    ] {
+                        if c.is_finite() {
+                            assert_eq!(outcode(c), by_dots(c), "{c:?}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 200_000);
     }
 
     #[test]

@@ -403,7 +403,8 @@ impl<'a> Frame<'a> {
         let (positions, normals) = (mesh.positions(), mesh.normals());
         let mode = &self.modes[oi];
         let vertices = &mut scratch.vertices;
-        vertices.clear();
+        // Every record is overwritten below: keep last frame's (no fill) where there are enough.
+        vertices.truncate(positions.len());
         vertices.resize(positions.len(), FastVertex::default());
         vertices
             .par_chunks_mut(SETUP_CHUNK)
