@@ -1050,7 +1050,10 @@ impl Frame<'_> {
 
     /// Visibility first (the fast path): per sample the nearest triangle, with the reference's
     /// coverage and depth arithmetic; then each visible (pixel, triangle) pair is shaded once,
-    /// Phong-interpolated objects 8 at a time by [`shade8`]; then the reference's resolve.
+    /// Phong and Gouraud objects by the vector kernels. With one sample: a tile covered by its
+    /// only triangle skips visibility, Gouraud pixels are coloured during it, and the rest go
+    /// to [`Frame::shade_single`]; with several, one job per visible (pixel, triangle) and the
+    /// reference's resolve.
     fn tile_visible(&self, tile: u32, bg: [f32; 4], clock: &StageClock, rows: &mut [&mut [[f32; 4]]]) -> u64 {
         let t_start = Instant::now();
         let (x0, y0, x1, y1) = self.tile_rect(tile);
@@ -1082,7 +1085,7 @@ impl Frame<'_> {
             if ns == 1 {
                 // One sample: `ids` holds the index in the bin (see `shade_single`). Gouraud
                 // triangles write their colour as they pass the depth test (see `Forward`).
-                let tile = (x0, y0, tw);
+                let tile = (x0, y0, tw, y1);
                 if matches!(self.modes[self.object(ti)], Mode::Gouraud) {
                     let forward = Forward {
                         planes: self.planes(ti),
@@ -1212,7 +1215,7 @@ impl Frame<'_> {
     }
 
     /// Visibility of triangle `t` (id `ti`) with one sample per pixel, over its rows in the tile
-    /// `(x0, y0, width)` and columns `bx0..bx1`: `o` is the sample's offset of the edge
+    /// `(x0, y0, width, y1)` and columns `bx0..bx1`: `o` is the sample's offset of the edge
     /// functions (bias subtracted). Wide rows first find their covered span exactly (per edge,
     /// the integer bound of `e − bias + k·step >= 0`), so the loop over pixels tests no edges;
     /// narrow ones (under 8 pixels, where the three divisions cost more) test each pixel. Same
@@ -1228,7 +1231,7 @@ impl Frame<'_> {
         t: &Tri,
         ti: u32,
         o: [i64; 3],
-        (x0, y0, tw): (u32, u32, usize),
+        (x0, y0, tw, y1): (u32, u32, usize, u32),
         (bx0, bx1): (u32, u32),
         depth: &mut [f32],
         ids: &mut [u32],
@@ -1237,7 +1240,6 @@ impl Frame<'_> {
         let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
         let bb = t.bbox();
         let n = i64::from(bx1 - bx0);
-        let y1 = y0 + (depth.len() / tw) as u32;
         for py in bb[1].max(y0)..bb[3].min(y1) {
             let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
             // e − bias at the row's first pixel.
