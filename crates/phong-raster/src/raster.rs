@@ -235,6 +235,17 @@ enum Mode {
     Scalar,
 }
 
+impl Mode {
+    /// The vector kernels' batch for this mode; `None` for scalar shading.
+    fn batch(&self) -> Option<Batch<'_>> {
+        match self {
+            Mode::Phong(prep, term) => Some(Batch::Phong(prep, *term)),
+            Mode::Gouraud => Some(Batch::Gouraud),
+            Mode::Scalar => None,
+        }
+    }
+}
+
 /// What the scalar shading of a triangle needs besides [`Tri`]: kept only for the reference
 /// path and for objects the fast path shades one pixel at a time (a 1M-triangle frame's
 /// triangles were 470 bytes each with these inside).
@@ -1166,10 +1177,8 @@ impl Frame<'_> {
             }
         }
         for (object, batch) in batches.iter().enumerate() {
-            let kind = match &self.modes[object] {
-                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
-                Mode::Gouraud => Batch::Gouraud,
-                Mode::Scalar => continue,
+            let Some(kind) = self.modes[object].batch() else {
+                continue;
             };
             shade_batch(
                 self.avx2,
@@ -1372,17 +1381,13 @@ impl Frame<'_> {
                 continue;
             }
             let object = self.object(id);
-            let kind = match &self.modes[object] {
-                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
-                Mode::Gouraud => Batch::Gouraud,
-                Mode::Scalar => {
-                    for &p in pixels {
-                        let (r, c) = at(p);
-                        let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32);
-                        out[r][c] = resolve(std::iter::once(color), 1, bg);
-                    }
-                    continue;
+            let Some(kind) = self.modes[object].batch() else {
+                for &p in pixels {
+                    let (r, c) = at(p);
+                    let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32);
+                    out[r][c] = resolve(std::iter::once(color), 1, bg);
                 }
+                continue;
             };
             // Fewer pixels than a vector: straight to the gathered batch (no call; a 1M-triangle
             // tile has thousands of one-pixel triangles).
@@ -1397,10 +1402,8 @@ impl Frame<'_> {
             rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
         }
         for (object, batch) in rest.iter().enumerate() {
-            let kind = match &self.modes[object] {
-                Mode::Phong(prep, term) => Batch::Phong(prep, *term),
-                Mode::Gouraud => Batch::Gouraud,
-                Mode::Scalar => continue,
+            let Some(kind) = self.modes[object].batch() else {
+                continue;
             };
             shade_batch(
                 self.avx2,

@@ -525,6 +525,28 @@ pub enum Batch<'a> {
     Gouraud,
 }
 
+/// The colour of a batch's interpolated attributes `q`: Phong shades position `q[0..3]` and
+/// normal `q[3..6]` and keeps its term; Gouraud's colour is `q[0..3]`.
+#[inline(always)]
+fn batch_color<V: Vf32>(batch: Batch, q: [V; 6]) -> [V; 3] {
+    match batch {
+        Batch::Phong(prep, term) => {
+            let pos = V3 {
+                x: q[0],
+                y: q[1],
+                z: q[2],
+            };
+            let nrm = V3 {
+                x: q[3],
+                y: q[4],
+                z: q[5],
+            };
+            shade(prep, pos, nrm).get(term)
+        }
+        Batch::Gouraud => [q[0], q[1], q[2]],
+    }
+}
+
 /// Shades `n` pixels 8 at a time: `lane(i)` gives pixel `i`'s centre `(x, y)` in pixels and its
 /// triangle's planes; `out(i, rgb)` receives its colour.
 #[inline(always)]
@@ -551,23 +573,7 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
             *plane = p;
         }
         let q = interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys));
-        let rgb = match batch {
-            Batch::Phong(prep, term) => {
-                let pos = V3 {
-                    x: q[0],
-                    y: q[1],
-                    z: q[2],
-                };
-                let nrm = V3 {
-                    x: q[3],
-                    y: q[4],
-                    z: q[5],
-                };
-                shade(prep, pos, nrm).get(term)
-            }
-            Batch::Gouraud => [q[0], q[1], q[2]],
-        };
-        let rgb = rgb.map(V::to_array);
+        let rgb = batch_color(batch, q).map(V::to_array);
         for i in 0..m {
             out(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
         }
@@ -620,23 +626,7 @@ pub(crate) fn shade_group<V: Vf32>(
         for (o, k) in q.iter_mut().zip(attr).take(attrs) {
             *o = eval(k).mul(w);
         }
-        let rgb = match batch {
-            Batch::Phong(prep, term) => {
-                let pos = V3 {
-                    x: q[0],
-                    y: q[1],
-                    z: q[2],
-                };
-                let nrm = V3 {
-                    x: q[3],
-                    y: q[4],
-                    z: q[5],
-                };
-                shade(prep, pos, nrm).get(term)
-            }
-            Batch::Gouraud => [q[0], q[1], q[2]],
-        };
-        let rgb = rgb.map(V::to_array);
+        let rgb = batch_color(batch, q).map(V::to_array);
         for (i, &p) in chunk.iter().enumerate() {
             out(p, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
         }
