@@ -202,21 +202,22 @@ fn render_once(
         }
         None => {
             let (img, st) = render_with_stats(scene, options)?;
-            (
-                img,
-                [
-                    st.setup,
-                    st.raster,
-                    Duration::ZERO,
-                    st.tile_raster,
-                    st.tile_shade,
-                    st.tile_resolve,
-                ],
-                st.triangles_drawn,
-                st.pixels_shaded,
-            )
+            (img, cpu_times(&st), st.triangles_drawn, st.pixels_shaded)
         }
     })
+}
+
+/// The CPU renderer's times in [`render_once`]'s order: setup, raster, (no read-back), then the
+/// tiles' rasterisation, shading and resolve CPU times.
+fn cpu_times(st: &phong_raster::RenderStats) -> [Duration; 6] {
+    [
+        st.setup,
+        st.raster,
+        Duration::ZERO,
+        st.tile_raster,
+        st.tile_shade,
+        st.tile_resolve,
+    ]
 }
 
 fn render(a: RenderArgs) -> Result<()> {
@@ -366,17 +367,7 @@ fn bench(a: BenchArgs) -> Result<()> {
                 renderer.render(&scene, &options)?;
                 for _ in 0..a.frames {
                     let st = renderer.render(&scene, &options)?.1;
-                    for (k, d) in [
-                        st.setup,
-                        st.raster,
-                        Duration::ZERO,
-                        st.tile_raster,
-                        st.tile_shade,
-                        st.tile_resolve,
-                    ]
-                    .into_iter()
-                    .enumerate()
-                    {
+                    for (k, d) in cpu_times(&st).into_iter().enumerate() {
                         sum[k] += d;
                     }
                 }

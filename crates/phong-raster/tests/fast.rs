@@ -351,7 +351,10 @@ fn assert_fast_matches_reference(scene: &Scene, what: &str) {
         .unwrap();
         let b = fast.to_bytes(scene.image.encoding, false);
         let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-        assert!(worst <= 1, "{what} (no_avx2 {no_avx2}): a channel differs by {worst}/255");
+        assert!(
+            worst <= 1,
+            "{what} (no_avx2 {no_avx2}): a channel differs by {worst}/255"
+        );
     }
 }
 
