@@ -30,7 +30,7 @@ use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
 use phong_core::mesh::facet_normal;
 use phong_core::{Color, Image, Interpolation, Object, Output, Scene, Shading, SurfacePoint, View, shade};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 const ONE: f32 = (1u32 << SUBPIXEL_BITS) as f32;
@@ -40,6 +40,9 @@ const SETUP_CHUNK: usize = 4096;
 /// Low bits of a triangle id that index within its setup chunk (4096 · 7 < 2^15).
 const ID_INDEX_BITS: u32 = 15;
 const HALF: i64 = 1 << (SUBPIXEL_BITS - 1);
+/// Gouraud vertices lit together: a group is lit when any of its vertices is used (the
+/// kernel's 16 lanes).
+const LIGHT_GROUP: usize = 16;
 
 /// CPU time of the tiles' stages, summed over threads, in nanoseconds.
 #[derive(Default)]
@@ -267,6 +270,21 @@ struct Chunk {
     /// face; Gouraud: the colour seen), same index; empty for scalar-shaded objects.
     planes: Vec<Planes>,
     corners: Vec<Corners>,
+    /// Gouraud triangles whose planes wait for their vertices' colours (see [`Pending`]).
+    pending: Vec<Pending>,
+}
+
+/// A Gouraud triangle set up before its vertices were lit: what its plane equations need
+/// besides its edges (in the chunk's triangle `slot`), filled in once the colours exist.
+struct Pending {
+    slot: u32,
+    /// Input vertices, in the set-up order.
+    idx: [u32; 3],
+    /// Vertex 0's snapped window position.
+    origin: (i64, i64),
+    inv_w: [f32; 3],
+    area: u64,
+    front: bool,
 }
 
 /// Working memory kept between frames by a [`Renderer`](crate::Renderer): emptied, never
@@ -276,6 +294,8 @@ pub(crate) struct Scratch {
     /// The fast setup's per-vertex buffers (one object at a time).
     vertices: Vec<FastVertex>,
     colors: Vec<[Vec3; 2]>,
+    /// Gouraud: whether a vertex is used by a drawn triangle (only those are lit).
+    used: Vec<AtomicBool>,
     /// Chunks of set-up triangles, emptied, for the next frame's setup tasks.
     chunks: Vec<Chunk>,
     bins: Vec<Vec<u32>>,
@@ -289,6 +309,7 @@ impl Chunk {
             tris: Vec::new(),
             planes: Vec::new(),
             corners: Vec::new(),
+            pending: Vec::new(),
         });
         c.object = object as u32;
         c.tris.reserve(n);
@@ -389,6 +410,7 @@ impl<'a> Frame<'a> {
             chunk.tris.clear();
             chunk.planes.clear();
             chunk.corners.clear();
+            chunk.pending.clear();
             scratch.chunks.push(chunk);
         }
         scratch.bins = self.bins;
@@ -432,54 +454,50 @@ impl<'a> Frame<'a> {
                     *o = FastVertex { p, code };
                 }
             });
-        // Gouraud: the colour seen from the front and (two-sided) from the back, 8 vertices at a
-        // time by the kernel.
-        let colors = &mut scratch.colors;
-        colors.clear();
-        if let Mode::Gouraud = mode {
-            let lit = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
-            let prep = Prepared::new(
-                &self.scene.lighting,
-                &obj.material,
-                &obj.shading.options,
-                self.views[oi],
-            );
-            colors.resize(positions.len(), [Vec3::ZERO; 2]);
-            colors
-                .par_chunks_mut(SETUP_CHUNK)
-                .zip(positions.par_chunks(SETUP_CHUNK))
-                .zip(normals.par_chunks(SETUP_CHUNK))
-                .for_each(|((out, ps), ns)| {
-                    let mut lit_colors = vec![Vec3::ZERO; ps.len()];
-                    for (side, flip) in [(0, false), (1, true)].into_iter().take(if two_sided { 2 } else { 1 }) {
-                        light_vertices(self.avx2, &prep, lit, ps, ns, flip, &mut lit_colors);
-                        for (o, c) in out.iter_mut().zip(&lit_colors) {
-                            o[side] = *c;
-                        }
-                    }
-                });
+        // Gouraud: the colour seen from the front and (two-sided) from the back, lit by the
+        // kernel after the triangles are set up, and only for the vertices of drawn triangles
+        // (a sphere's back half is culled). Lighting a vertex alone or among others gives the
+        // same bits (the kernel's lanes are independent).
+        let gouraud = matches!(mode, Mode::Gouraud);
+        let lit = lit_term(obj.shading.output);
+        let prep = Prepared::new(
+            &self.scene.lighting,
+            &obj.material,
+            &obj.shading.options,
+            self.views[oi],
+        );
+        let sides = if two_sided { 2 } else { 1 };
+        let light = |ps: &[Vec3], ns: &[Vec3], out: &mut [[Vec3; 2]]| {
+            let mut lit_colors = [Vec3::ZERO; LIGHT_GROUP];
+            for (side, flip) in [(0, false), (1, true)].into_iter().take(sides) {
+                let term = lit.expect("Gouraud mode is a lit output");
+                light_vertices(self.avx2, &prep, term, ps, ns, flip, &mut lit_colors[..ps.len()]);
+                for (o, c) in out.iter_mut().zip(&lit_colors) {
+                    o[side] = *c;
+                }
+            }
+        };
+        let used = &mut scratch.used;
+        if gouraud {
+            used.truncate(positions.len());
+            used.par_iter().for_each(|u| u.store(false, Ordering::Relaxed));
+            used.resize_with(positions.len(), || AtomicBool::new(false));
         }
-        let (vertices, colors) = (&*vertices, &*colors);
-        // The planes of a set-up triangle from its input vertices' indices.
-        let planes = |s: &Setup, idx: [u32; 3]| -> Planes {
+        let (vertices, used) = (&*vertices, &*used);
+        let mark = |idx: [u32; 3]| {
+            for i in idx {
+                used[i as usize].store(true, Ordering::Relaxed);
+            }
+        };
+        // The planes of a set-up triangle from its input vertices' indices (Phong).
+        let phong_planes = |s: &Setup, idx: [u32; 3]| -> Planes {
             let idx = each3(|k| idx[s.order[k]] as usize);
-            let attrs = match mode {
-                Mode::Gouraud => {
-                    let side = usize::from(!s.front);
-                    [
-                        [colors[idx[0]][side], colors[idx[1]][side], colors[idx[2]][side]],
-                        [Vec3::ZERO; 3],
-                    ]
-                }
-                _ => {
-                    let sign = if s.front { 1.0 } else { -1.0 };
-                    [
-                        [positions[idx[0]], positions[idx[1]], positions[idx[2]]],
-                        [normals[idx[0]] * sign, normals[idx[1]] * sign, normals[idx[2]] * sign],
-                    ]
-                }
-            };
-            plane_equations(&s.xy, &s.tri, s.area, s.inv_w, attrs, matches!(mode, Mode::Gouraud))
+            let sign = if s.front { 1.0 } else { -1.0 };
+            let attrs = [
+                [positions[idx[0]], positions[idx[1]], positions[idx[2]]],
+                [normals[idx[0]] * sign, normals[idx[1]] * sign, normals[idx[2]] * sign],
+            ];
+            plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
         };
         let setup_chunk = |chunk: &[[u32; 3]]| {
             let mut out = Chunk::reuse(spare, oi, chunk.len());
@@ -496,21 +514,39 @@ impl<'a> Frame<'a> {
                 }
                 if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
                     if let Some(s) = self.setup_edges([v[0].p, v[1].p, v[2].p], two_sided) {
-                        out.planes.push(planes(&s, tri));
+                        if gouraud {
+                            mark(tri);
+                            out.pending.push(Pending {
+                                slot: out.tris.len() as u32,
+                                idx: each3(|k| tri[s.order[k]]),
+                                origin: s.xy[0],
+                                inv_w: s.inv_w,
+                                area: s.area,
+                                front: s.front,
+                            });
+                            out.planes.push(Planes::default());
+                        } else {
+                            out.planes.push(phong_planes(&s, tri));
+                        }
                         out.tris.push(s.tri);
                     }
                     continue;
                 }
-                // Rare: clip, with the vertices in full.
-                let t = tri.map(|i| {
-                    let i = i as usize;
-                    let [color, color_back] = colors.get(i).copied().unwrap_or([Vec3::ZERO; 2]);
+                // Rare: clip, with the vertices in full (Gouraud: lit here).
+                let mut lit3 = [[Vec3::ZERO; 2]; 3];
+                if gouraud {
+                    let ps = tri.map(|i| positions[i as usize]);
+                    let ns = tri.map(|i| normals[i as usize]);
+                    light(&ps, &ns, &mut lit3);
+                }
+                let t = each3(|k| {
+                    let i = tri[k] as usize;
                     ClipVertex {
                         clip: clip_from_world * Vec4::from((positions[i], 1.0)),
                         world: positions[i],
                         normal: normals[i],
-                        color,
-                        color_back,
+                        color: lit3[k][0],
+                        color_back: lit3[k][1],
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {
@@ -531,7 +567,48 @@ impl<'a> Frame<'a> {
             }
             out
         };
-        mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+        let mut chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
+        if gouraud {
+            let colors = &mut scratch.colors;
+            colors.clear();
+            colors.resize(positions.len(), [Vec3::ZERO; 2]);
+            colors
+                .par_chunks_mut(SETUP_CHUNK)
+                .zip(positions.par_chunks(SETUP_CHUNK))
+                .zip(normals.par_chunks(SETUP_CHUNK))
+                .zip(used.par_chunks(SETUP_CHUNK))
+                .for_each(|(((out, ps), ns), us)| {
+                    for (((o, p), n), u) in out
+                        .chunks_mut(LIGHT_GROUP)
+                        .zip(ps.chunks(LIGHT_GROUP))
+                        .zip(ns.chunks(LIGHT_GROUP))
+                        .zip(us.chunks(LIGHT_GROUP))
+                    {
+                        if u.iter().any(|u| u.load(Ordering::Relaxed)) {
+                            light(p, n, o);
+                        }
+                    }
+                });
+            let colors = &*colors;
+            chunks.par_iter_mut().for_each(|chunk| {
+                let Chunk {
+                    tris, planes, pending, ..
+                } = chunk;
+                for p in pending.iter() {
+                    let side = usize::from(!p.front);
+                    let c = each3(|k| colors[p.idx[k] as usize][side]);
+                    planes[p.slot as usize] = plane_equations(
+                        p.origin,
+                        &tris[p.slot as usize],
+                        p.area,
+                        p.inv_w,
+                        [c, [Vec3::ZERO; 3]],
+                        true,
+                    );
+                }
+            });
+        }
+        chunks
     }
 
     /// The setup of an object for the reference path, or for the fast path's scalar shading
@@ -587,6 +664,7 @@ impl<'a> Frame<'a> {
                 tris: Vec::with_capacity(chunk.len()),
                 planes: Vec::new(),
                 corners: Vec::new(),
+                pending: Vec::new(),
             };
             let mut push = |r: Option<(Tri, Planes, Option<Corners>)>| {
                 if let Some((t, _, c)) = r {
@@ -738,13 +816,13 @@ pub(crate) fn render(
 }
 
 /// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
-/// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with snapped vertices `xy` (1/256
+/// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with vertex 0 snapped at `origin` (1/256
 /// pixel) and twice its area `area`: the barycentric `λ_i` is `E_i / area`, so
 /// `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and `q = q_0` at vertex 0.
 /// Computed in `f64`, stored in `f32`.
 #[inline(always)]
 fn plane_equations(
-    xy: &[(i64, i64); 3],
+    origin: (i64, i64),
     t: &Tri,
     area: u64,
     inv_w: [f32; 3],
@@ -766,7 +844,7 @@ fn plane_equations(
         }
     }
     Planes {
-        origin: [xy[0].0 as f32 / ONE, xy[0].1 as f32 / ONE],
+        origin: [origin.0 as f32 / ONE, origin.1 as f32 / ONE],
         inv_w: plane(inv_w),
         attr,
         pad: 0.0,
@@ -917,11 +995,11 @@ impl Frame<'_> {
             Mode::Phong(..) => {
                 let sign = if s.front { 1.0 } else { -1.0 };
                 let attrs = [v.map(|v| v.world), v.map(|v| v.normal * sign)];
-                plane_equations(&s.xy, &s.tri, s.area, s.inv_w, attrs, false)
+                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
             }
             Mode::Gouraud => {
                 let c = v.map(|v| if s.front { v.color } else { v.color_back });
-                plane_equations(&s.xy, &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
+                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
             }
         };
         Some((s.tri, planes, None))
