@@ -459,19 +459,26 @@ impl<'a> Frame<'a> {
         // (a sphere's back half is culled). Lighting a vertex alone or among others gives the
         // same bits (the kernel's lanes are independent).
         let gouraud = matches!(mode, Mode::Gouraud);
-        let lit = lit_term(obj.shading.output);
-        let prep = Prepared::new(
-            &self.scene.lighting,
-            &obj.material,
-            &obj.shading.options,
-            self.views[oi],
-        );
+        // Gouraud's lighting: the object's prepared constants and the term it shows (made only
+        // for Gouraud objects; Phong ones have theirs in their `Mode`).
+        let vertex_lighting = gouraud.then(|| {
+            let prep = Prepared::new(
+                &self.scene.lighting,
+                &obj.material,
+                &obj.shading.options,
+                self.views[oi],
+            );
+            (
+                prep,
+                lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
+            )
+        });
         let sides = if two_sided { 2 } else { 1 };
         let light = |ps: &[Vec3], ns: &[Vec3], out: &mut [[Vec3; 2]]| {
+            let (prep, term) = vertex_lighting.as_ref().expect("only Gouraud objects light vertices");
             let mut lit_colors = [Vec3::ZERO; LIGHT_GROUP];
             for (side, flip) in [(0, false), (1, true)].into_iter().take(sides) {
-                let term = lit.expect("Gouraud mode is a lit output");
-                light_vertices(self.avx2, &prep, term, ps, ns, flip, &mut lit_colors[..ps.len()]);
+                light_vertices(self.avx2, prep, *term, ps, ns, flip, &mut lit_colors[..ps.len()]);
                 for (o, c) in out.iter_mut().zip(&lit_colors) {
                     o[side] = *c;
                 }
@@ -1559,6 +1566,16 @@ impl Frame<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The record sizes the docs and BENCHMARKS.md state (per vertex and per drawn triangle).
+    #[test]
+    fn record_sizes() {
+        use std::mem::size_of;
+        assert_eq!(size_of::<FastVertex>(), 20);
+        assert_eq!(size_of::<Tri>(), 80);
+        assert_eq!(size_of::<Planes>(), 96);
+        assert_eq!(size_of::<Pending>(), 56);
+    }
 
     /// Binning's trivial reject never drops a tile where a sample of any pattern is covered,
     /// and does drop some (random triangles up to 2.5 tiles across, in a 4×4-tile image).

@@ -241,18 +241,6 @@ pub struct Shaded8 {
     pub color: [[f32; LANES]; 3],
 }
 
-impl Shaded8 {
-    /// The channels of `term`.
-    pub fn term(&self, term: Term) -> [[f32; LANES]; 3] {
-        match term {
-            Term::Ambient => self.ambient,
-            Term::Diffuse => self.diffuse,
-            Term::Specular => self.specular,
-            Term::Color => self.color,
-        }
-    }
-}
-
 /// The four terms, per channel, in vectors.
 #[derive(Clone, Copy)]
 pub(crate) struct Terms<V> {

@@ -28,6 +28,17 @@ pub fn avx2_available() -> bool {
     }
 }
 
+/// Panics unless the CPU has AVX2 and FMA: every entry point checks this before calling into
+/// its AVX2 build (the callers decide `avx2` once per frame from [`avx2_available`]).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn require_avx2() {
+    assert!(
+        avx2_available(),
+        "the AVX2 build asked for on a CPU without AVX2 and FMA"
+    );
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn shade8_avx2(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
@@ -40,11 +51,8 @@ fn shade8_avx2(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -
 pub fn shade8(avx2: bool, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        assert!(
-            avx2_available(),
-            "the AVX2 build asked for on a CPU without AVX2 and FMA"
-        );
-        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
         return unsafe { shade8_avx2(p, position, normal) };
     }
     let _ = avx2;
@@ -74,11 +82,8 @@ pub fn shade_batch<'p>(
 ) {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        assert!(
-            avx2_available(),
-            "the AVX2 build asked for on a CPU without AVX2 and FMA"
-        );
-        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
         unsafe { shade_batch_avx2(batch, n, lane, out) };
         return;
     }
@@ -107,11 +112,8 @@ pub fn light_vertices(
     assert!(positions.len() == normals.len() && out.len() == positions.len());
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        assert!(
-            avx2_available(),
-            "the AVX2 build asked for on a CPU without AVX2 and FMA"
-        );
-        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
         return unsafe { light_vertices_avx2(p, term, positions, normals, flip, out) };
     }
     let _ = avx2;
@@ -120,11 +122,12 @@ pub fn light_vertices(
 
 /// The lanes of [`shade_group`]'s vectors: it shades whole vectors only.
 pub fn group_lanes(avx2: bool) -> usize {
-    if avx2 && cfg!(target_arch = "x86_64") {
-        16
-    } else {
-        LANES
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        return <vector::Avx2x2 as vector::Vf32>::N;
     }
+    let _ = avx2;
+    <vector::Portable as vector::Vf32>::N
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -154,11 +157,8 @@ pub fn shade_group(
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        assert!(
-            avx2_available(),
-            "the AVX2 build asked for on a CPU without AVX2 and FMA"
-        );
-        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
         return unsafe { shade_group_avx2(batch, planes, origin, pixels, out) };
     }
     let _ = avx2;
@@ -177,11 +177,8 @@ fn gouraud_row_avx2(planes: &Planes, at: (u32, u32), mask: u64, out: &mut [[f32;
 pub fn gouraud_row(avx2: bool, planes: &Planes, at: (u32, u32), mask: u64, out: &mut [[f32; 4]]) {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
-        assert!(
-            avx2_available(),
-            "the AVX2 build asked for on a CPU without AVX2 and FMA"
-        );
-        // SAFETY: the CPU has AVX2 and FMA (asserted above).
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
         return unsafe { gouraud_row_avx2(planes, at, mask, out) };
     }
     let _ = avx2;
