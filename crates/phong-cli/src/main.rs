@@ -78,8 +78,13 @@ impl RunArgs {
                 bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
             }
         }
-        if self.threads == Some(0) {
-            bail!(InputError("--threads must be at least 1".into()));
+        if let Some(t) = self.threads
+            && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
+        {
+            bail!(InputError(format!(
+                "--threads must be from 1 to {}, got {t}",
+                phong_core::limits::MAX_THREADS
+            )));
         }
         let loaded = phong_scene::load(&self.input)?;
         for w in &loaded.warnings {

@@ -169,6 +169,21 @@ fn bad_input_exits_2_with_location() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--width must be from 1 to 16384"));
+    // Thread counts: none, and more than any machine has (100 000 used to exhaust memory
+    // spawning them, then abort).
+    for (cmd, t) in [("render", "0"), ("bench", "100000")] {
+        let mut args = vec![cmd, "examples/scenes/tour.toml", "--threads", t];
+        if cmd == "render" {
+            args.extend(["-o", out.to_str().unwrap()]);
+        }
+        let o = phong(&args);
+        assert_eq!(o.status.code(), Some(2), "{cmd} --threads {t}");
+        assert!(
+            stderr(&o).contains(&format!("--threads must be from 1 to 1024, got {t}")),
+            "{}",
+            stderr(&o)
+        );
+    }
     let o = phong(&[
         "render",
         "examples/scenes/tour.toml",

@@ -28,6 +28,11 @@ pub const GUARD_BAND: f32 = 4.0;
 /// and depth samples (64·64·16·20 bytes at 16 samples) in L2.
 pub const TILE_SIZE: u32 = 64;
 
+/// Most rendering threads one may ask for: a thread per core of the largest machines, far
+/// below where spawning fails (100 000 threads exhausted this machine's memory instead of
+/// returning an error).
+pub const MAX_THREADS: usize = 1024;
+
 /// Most lights in one scene (the GPU backend's storage buffer is sized from it).
 pub const MAX_LIGHTS: usize = 1024;
 

@@ -56,6 +56,9 @@ pub enum Error {
         /// Samples per pixel.
         samples: u32,
     },
+    /// More threads than [`MAX_THREADS`](phong_core::limits::MAX_THREADS), or none.
+    #[error("threads must be from 1 to {max}, got {0}", max = phong_core::limits::MAX_THREADS)]
+    ThreadCount(usize),
     /// The thread pool could not be built.
     #[error("could not start {threads} rendering threads: {source}")]
     Threads {
@@ -72,7 +75,8 @@ pub enum Error {
 /// How to render (what the scene does not say).
 #[derive(Default)]
 pub struct RenderOptions<'a> {
-    /// Worker threads; `None`: all cores (rayon's global pool).
+    /// Worker threads, 1 to [`MAX_THREADS`](phong_core::limits::MAX_THREADS); `None`: all cores
+    /// (rayon's global pool).
     pub threads: Option<usize>,
     /// Called with (tiles done, tiles in all) as tiles finish, from any thread.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
@@ -173,6 +177,11 @@ fn render_into(
             height: h,
             samples: s,
         });
+    }
+    if let Some(n) = options.threads
+        && !(1..=phong_core::limits::MAX_THREADS).contains(&n)
+    {
+        return Err(Error::ThreadCount(n));
     }
     if image.as_ref().is_none_or(|i| (i.width(), i.height()) != (w, h)) {
         // Zeroed (the allocator's zero pages, no fill): the tiles write every pixel.

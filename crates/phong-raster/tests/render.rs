@@ -658,3 +658,28 @@ fn two_sided_lighting_follows_polygon_facing() {
         }
     }
 }
+
+/// Thread counts outside 1 to `MAX_THREADS` are an error, before anything is spawned.
+#[test]
+fn thread_count_out_of_range_is_an_error() {
+    let scene = phong_scene::parse_scene(
+        "[image]\nwidth = 8\nheight = 8\n[[object]]\nshape = \"sphere\"\nmaterial = \"gold\"\n",
+        std::path::Path::new("t.toml"),
+    )
+    .unwrap()
+    .scene;
+    for n in [0, phong_core::limits::MAX_THREADS + 1, 100_000] {
+        let options = RenderOptions {
+            threads: Some(n),
+            ..Default::default()
+        };
+        let e = render(&scene, &options).unwrap_err();
+        assert!(matches!(e, phong_raster::Error::ThreadCount(m) if m == n), "{e}");
+        assert!(e.to_string().contains("from 1 to 1024"), "{e}");
+    }
+    let options = RenderOptions {
+        threads: Some(phong_core::limits::MAX_THREADS.min(4)),
+        ..Default::default()
+    };
+    assert!(render(&scene, &options).is_ok());
+}
