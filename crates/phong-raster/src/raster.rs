@@ -143,7 +143,7 @@ fn lit_term(output: Output) -> Option<Term> {
 
 /// A vertex in the window: snapped `x`, `y` (1/256 pixel; the guard band keeps them below
 /// 2^24), depth, `1/w`.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Projected(i32, i32, f32, f32);
 
 /// A vertex of the fast path's setup: its projection (where inside the clipping planes) and
@@ -328,6 +328,8 @@ struct Frame<'a> {
     w: u32,
     h: u32,
     pattern: Vec<(i64, i64)>,
+    /// The pattern's bounds, for the triangles' bounding boxes (see [`SampleSpan`]).
+    span: SampleSpan,
     /// Set-up triangles, in the chunks the parallel setup made them (not copied into one
     /// vector: a 1M-triangle Gouraud frame's setup went 190 → 108 ms without that copy); ids
     /// pack (chunk, index), see [`Frame::tri`].
@@ -351,7 +353,8 @@ impl<'a> Frame<'a> {
         let pattern = sample_pattern(scene.image.samples)
             .into_iter()
             .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
-            .collect();
+            .collect::<Vec<_>>();
+        let span = SampleSpan::of(&pattern);
         let modes = scene
             .objects
             .iter()
@@ -382,6 +385,7 @@ impl<'a> Frame<'a> {
             w,
             h,
             pattern,
+            span,
             tris: Vec::new(),
             tiles_x: w.div_ceil(TILE_SIZE),
             bins: std::mem::take(&mut scratch.bins),
@@ -902,13 +906,33 @@ impl Frame<'_> {
     /// culled (a back face of a one-sided object), degenerate or covers no pixel.
     #[inline]
     fn setup_edges(&self, proj: [Projected; 3], two_sided: bool) -> Option<Setup> {
-        setup_edges(proj, two_sided, self.w, self.h)
+        setup_edges(proj, two_sided, self.w, self.h, self.span)
+    }
+}
+
+/// The bounds of a sample pattern's offsets within a pixel, in 1/256 pixel: `(min x, max x,
+/// min y, max y)`. A triangle's bounding box holds the pixels with a sample inside its
+/// vertices' bounds, not every pixel those bounds touch: a 1M-triangle sphere's triangles span
+/// two or three pixels, and many cover no pixel centre at all.
+#[derive(Clone, Copy, Debug)]
+struct SampleSpan(i64, i64, i64, i64);
+
+impl SampleSpan {
+    fn of(pattern: &[(i64, i64)]) -> SampleSpan {
+        let xs = pattern.iter().map(|p| p.0);
+        let ys = pattern.iter().map(|p| p.1);
+        SampleSpan(
+            xs.clone().min().unwrap_or(HALF),
+            xs.max().unwrap_or(HALF),
+            ys.clone().min().unwrap_or(HALF),
+            ys.max().unwrap_or(HALF),
+        )
     }
 }
 
 /// [`Frame::setup_edges`] for an image of `w × h` pixels.
 #[inline(always)]
-fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32) -> Option<Setup> {
+fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32, span: SampleSpan) -> Option<Setup> {
     {
         // Explicit arrays here and below, not `[T; 3]::map`: those calls were not inlined
         // (`try_map` was 5% of a 1M-triangle frame).
@@ -930,10 +954,14 @@ fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32) -> Option<
         let xy = [xy[order[0]], xy[order[1]], xy[order[2]]];
         let (min_x, max_x) = (xy[0].0.min(xy[1].0).min(xy[2].0), xy[0].0.max(xy[1].0).max(xy[2].0));
         let (min_y, max_y) = (xy[0].1.min(xy[1].1).min(xy[2].1), xy[0].1.max(xy[1].1).max(xy[2].1));
-        let px0 = (min_x >> SUBPIXEL_BITS).max(0);
-        let py0 = (min_y >> SUBPIXEL_BITS).max(0);
-        let px1 = ((max_x >> SUBPIXEL_BITS) + 1).min(i64::from(w));
-        let py1 = ((max_y >> SUBPIXEL_BITS) + 1).min(i64::from(h));
+        // Pixel p's samples lie at p·256 + offset: the first pixel with one at or right of
+        // min_x is ⌈(min_x − max offset) / 256⌉, the last at or left of max_x is
+        // ⌊(max_x − min offset) / 256⌋ (shifts round down, negatives included).
+        let one = (1i64 << SUBPIXEL_BITS) - 1;
+        let px0 = ((min_x - span.1 + one) >> SUBPIXEL_BITS).max(0);
+        let py0 = ((min_y - span.3 + one) >> SUBPIXEL_BITS).max(0);
+        let px1 = (((max_x - span.0) >> SUBPIXEL_BITS) + 1).min(i64::from(w));
+        let py1 = (((max_y - span.2) >> SUBPIXEL_BITS) + 1).min(i64::from(h));
         if px0 >= px1 || py0 >= py1 {
             return None;
         }
@@ -1598,6 +1626,7 @@ mod tests {
                     .collect()
             })
             .collect();
+        let all = SampleSpan::of(&patterns.concat());
         let mut rejected = 0;
         for _ in 0..400 {
             let span = i64::from(TILE_SIZE) * 160 * 2;
@@ -1610,7 +1639,7 @@ mod tests {
                     1.0,
                 )
             });
-            let Some(s) = setup_edges(proj, true, w, h) else {
+            let Some(s) = setup_edges(proj, true, w, h, all) else {
                 continue;
             };
             let t = &s.tri;
@@ -1638,6 +1667,93 @@ mod tests {
             }
         }
         assert!(rejected > 100, "only {rejected} tiles rejected");
+    }
+
+    /// A triangle's bounding box holds every sample it covers, for each pattern, checked pixel
+    /// by pixel around its vertices (tiny triangles, most of them, and larger ones, some across
+    /// the image's edges); and it is tight: exactly the pixels whose samples' span meets the
+    /// vertices' bounds (with one sample, those with their sample inside), found by search.
+    #[test]
+    fn bounding_box_holds_every_covered_sample() {
+        let (w, h) = (40u32, 30u32);
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |range: i64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % range as u64) as i64
+        };
+        let (mut culled, mut tight) = (0, 0usize);
+        for n in [1, 4, 16] {
+            let pattern: Vec<(i64, i64)> = sample_pattern(n)
+                .iter()
+                .map(|&(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
+                .collect();
+            for k in 0..3000 {
+                // Half of them within about two pixels, the rest up to 12 pixels across.
+                let size = if k % 2 == 0 { 2 * 256 } else { 12 * 256 };
+                let (cx, cy) = (next(i64::from(w + 4) * 256) - 512, next(i64::from(h + 4) * 256) - 512);
+                let proj = [0; 3].map(|_| Projected((cx + next(size)) as i32, (cy + next(size)) as i32, 0.5, 1.0));
+                let covered = |px: i64, py: i64| {
+                    let t = setup_edges(proj, true, w, h, SampleSpan(0, 255, 0, 255)).map(|s| s.tri);
+                    pattern.iter().any(|&(ox, oy)| {
+                        t.as_ref().is_some_and(|t| {
+                            Frame::covers(t, (px << SUBPIXEL_BITS) + ox, (py << SUBPIXEL_BITS) + oy).is_some()
+                        })
+                    })
+                };
+                let (x0, y0) = (cx >> SUBPIXEL_BITS, cy >> SUBPIXEL_BITS);
+                let mut hits = Vec::new();
+                for py in (y0 - 1).max(0)..(y0 + 14).min(i64::from(h)) {
+                    for px in (x0 - 1).max(0)..(x0 + 14).min(i64::from(w)) {
+                        if covered(px, py) {
+                            hits.push((px, py));
+                        }
+                    }
+                }
+                let Some(s) = setup_edges(proj, true, w, h, SampleSpan::of(&pattern)) else {
+                    assert!(hits.is_empty(), "culled, yet covers {hits:?}");
+                    culled += 1;
+                    continue;
+                };
+                let [bx0, by0, bx1, by1] = s.tri.bbox().map(i64::from);
+                for &(px, py) in &hits {
+                    assert!(
+                        (bx0..bx1).contains(&px) && (by0..by1).contains(&py),
+                        "({px}, {py}) outside {:?}",
+                        s.tri.bbox()
+                    );
+                }
+                // Tight: exactly the pixels with a sample inside the vertices' bounds, by search.
+                let bounds = |v: [i64; 3], o: &dyn Fn(&(i64, i64)) -> i64, size: u32| {
+                    let (lo, hi) = (
+                        v.iter().min().copied().unwrap_or(0),
+                        v.iter().max().copied().unwrap_or(0),
+                    );
+                    // Pixel p's samples span [p·256 + min offset, p·256 + max offset] (one
+                    // sample: exactly the pixels with a sample inside).
+                    let (omin, omax) = (
+                        pattern.iter().map(o).min().unwrap_or(0),
+                        pattern.iter().map(o).max().unwrap_or(0),
+                    );
+                    let inside = |p: i64| (p << SUBPIXEL_BITS) + omin <= hi && (p << SUBPIXEL_BITS) + omax >= lo;
+                    let mut ps = (0..i64::from(size)).filter(|&p| inside(p));
+                    let first = ps.next();
+                    (first, ps.last().or(first))
+                };
+                let xs = bounds(proj.map(|p| i64::from(p.0)), &|q| q.0, w);
+                let ys = bounds(proj.map(|p| i64::from(p.1)), &|q| q.1, h);
+                assert_eq!((xs.0, xs.1.map(|x| x + 1)), (Some(bx0), Some(bx1)), "{proj:?}");
+                assert_eq!((ys.0, ys.1.map(|y| y + 1)), (Some(by0), Some(by1)), "{proj:?}");
+                tight += usize::from(hits.is_empty());
+            }
+        }
+        // Many small triangles cover no sample: most are culled, the rest have samples in
+        // their bounds, outside their edges.
+        assert!(
+            culled > 1000 && tight > 0,
+            "{culled} culled, {tight} kept with no sample"
+        );
     }
 
     #[test]
