@@ -1739,7 +1739,7 @@ mod tests {
                     let inside = |p: i64| (p << SUBPIXEL_BITS) + omin <= hi && (p << SUBPIXEL_BITS) + omax >= lo;
                     let mut ps = (0..i64::from(size)).filter(|&p| inside(p));
                     let first = ps.next();
-                    (first, ps.last().or(first))
+                    (first, ps.next_back().or(first))
                 };
                 let xs = bounds(proj.map(|p| i64::from(p.0)), &|q| q.0, w);
                 let ys = bounds(proj.map(|p| i64::from(p.1)), &|q| q.1, h);
