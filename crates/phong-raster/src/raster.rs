@@ -21,8 +21,8 @@
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
-    Batch, Planes, Prepared, Term, avx2_available, gouraud_row, group_lanes, light_vertices, shade_batch, shade_group,
-    stream_fence, stream_fill,
+    Batch, Planes, Prepared, Term, avx2_available, group_lanes, light_vertices, shade_batch, shade_group, stream_fence,
+    stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -213,19 +213,48 @@ const FORWARD: u32 = u32::MAX - 1;
 
 /// Gouraud on the fast path with one sample: colours written into the tile's rows as pixels
 /// pass the depth test, from the triangle's colour planes.
-struct Forward<'p, 'r, 'i> {
-    planes: &'p Planes,
+struct Forward<'r, 'i> {
+    planes: ColorPlanes,
     rows: &'r mut [&'i mut [[f32; 4]]],
 }
 
-/// The Gouraud colour at the centre of pixel `(px, py)`: `q_c / q_w` from the planes, as
-/// [`gouraud_row`] in scalar `f32` (without fused multiply-adds).
-#[inline(always)]
-fn gouraud_color(p: &Planes, px: u32, py: u32) -> [f32; 4] {
-    let (dx, dy) = (px as f32 + 0.5 - p.origin[0], py as f32 + 0.5 - p.origin[1]);
-    let eval = |[c, gx, gy]: [f32; 3]| c + gx * dx + gy * dy;
-    let w = 1.0 / eval(p.inv_w);
-    [eval(p.attr[0]) * w, eval(p.attr[1]) * w, eval(p.attr[2]) * w, 1.0]
+/// A triangle's Gouraud planes (see [`Planes`]) as columns of four, `[r/w, g/w, b/w, 1/w]`, so
+/// that a pixel's colour is one 4-wide vector from start to store (SSE on x86-64), the layout
+/// of the `[f32; 4]` pixel it is written to.
+///
+/// Measured (100k-triangle Gouraud sphere, 1080p, 1 thread): colouring its 830k pixels with the
+/// 8-lane kernel, one call per row of a triangle (most rows have 3 to 6 pixels: the lanes went
+/// through memory to be written as pixels), took 4.5 of the tiles' 12.5 ms.
+#[derive(Clone, Copy)]
+struct ColorPlanes {
+    c: [f32; 4],
+    gx: [f32; 4],
+    gy: [f32; 4],
+    origin: [f32; 2],
+}
+
+impl ColorPlanes {
+    #[inline(always)]
+    fn new(p: &Planes) -> ColorPlanes {
+        let column = |k: usize| [p.attr[0][k], p.attr[1][k], p.attr[2][k], p.inv_w[k]];
+        ColorPlanes {
+            c: column(0),
+            gx: column(1),
+            gy: column(2),
+            origin: p.origin,
+        }
+    }
+
+    /// The colour at the centre of pixel `(px, py)`: `q_c / q_w`, each `q = c + gx·dx + gy·dy`
+    /// in `f32` (no fused multiply-adds), an exact division: the arithmetic of the reference's
+    /// interpolation of Gouraud colours.
+    #[inline(always)]
+    fn at(&self, px: u32, py: u32) -> [f32; 4] {
+        let (dx, dy) = (px as f32 + 0.5 - self.origin[0], py as f32 + 0.5 - self.origin[1]);
+        let q: [f32; 4] = std::array::from_fn(|i| self.c[i] + self.gx[i] * dx + self.gy[i] * dy);
+        let w = 1.0 / q[3];
+        [q[0] * w, q[1] * w, q[2] * w, 1.0]
+    }
 }
 
 /// How the fast path shades an object's pixels.
@@ -1212,7 +1241,7 @@ impl Frame<'_> {
                 let tile = (x0, y0, tw, y1);
                 if matches!(self.modes[self.object(ti)], Mode::Gouraud) {
                     let forward = Forward {
-                        planes: self.planes(ti),
+                        planes: ColorPlanes::new(self.planes(ti)),
                         rows: &mut *rows,
                     };
                     self.visible_single(
@@ -1409,17 +1438,11 @@ impl Frame<'_> {
                 && passed != 0
             {
                 let row = &mut f.rows[(py - y0) as usize][(bx0 - x0) as usize..(bx1 - x0) as usize];
-                if passed.count_ones() <= 2 {
-                    // One or two pixels (the rows of a 1M-triangle mesh): in scalar code, not a
-                    // call into the vector kernel.
-                    let mut m = passed;
-                    while m != 0 {
-                        let j = m.trailing_zeros();
-                        row[j as usize] = gouraud_color(f.planes, bx0 + j, py);
-                        m &= m - 1;
-                    }
-                } else {
-                    gouraud_row(self.avx2, f.planes, (bx0, py), passed, row);
+                let mut m = passed;
+                while m != 0 {
+                    let j = m.trailing_zeros();
+                    row[j as usize] = f.planes.at(bx0 + j, py);
+                    m &= m - 1;
                 }
             }
         }

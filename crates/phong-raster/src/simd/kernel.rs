@@ -622,40 +622,6 @@ pub(crate) fn shade_group<V: Vf32>(
     full
 }
 
-/// Gouraud colours on one row of a triangle, written as they passed the depth test: for each
-/// bit `j` of `mask`, `out[j]` becomes the colour at the centre of pixel `(px0 + j, py)`,
-/// `[r, g, b, 1]`, with the triangle's `planes` broadcast (the interpolation of
-/// [`shade_group`]).
-#[inline(always)]
-pub(crate) fn gouraud_row<V: Vf32>(planes: &Planes, (px0, py): (u32, u32), mask: u64, out: &mut [[f32; 4]]) {
-    let f = bytemuck::cast_ref::<_, [f32; 24]>(planes);
-    let k: [V; 14] = core::array::from_fn(|i| V::splat(f[i]));
-    let dy = V::splat(py as f32 + 0.5).sub(k[1]);
-    let mut iota = V::A::default();
-    for (i, x) in iota.as_mut().iter_mut().enumerate() {
-        *x = i as f32;
-    }
-    let iota = V::from_array(iota);
-    let lanes = (1u64 << V::N) - 1;
-    let mut j0 = 0;
-    while j0 < out.len() {
-        let m = (mask >> j0) & lanes;
-        if m != 0 {
-            // (px + ½) − ox per lane: `px0 + j0 + i` and the half are exact in `f32` here.
-            let dx = V::splat((px0 + j0 as u32) as f32 + 0.5).add(iota).sub(k[0]);
-            let plane = |i: usize| k[i + 2].mul_add(dy, k[i + 1].mul_add(dx, k[i]));
-            let w = plane(2).recip();
-            let rgb = [plane(5).mul(w), plane(8).mul(w), plane(11).mul(w)].map(V::to_array);
-            for (i, o) in out[j0..].iter_mut().enumerate().take(V::N) {
-                if m >> i & 1 != 0 {
-                    *o = [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i], 1.0];
-                }
-            }
-        }
-        j0 += V::N;
-    }
-}
-
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
 #[inline(always)]
 fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {

@@ -165,26 +165,6 @@ pub fn shade_group(
     kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn gouraud_row_avx2(planes: &Planes, at: (u32, u32), mask: u64, out: &mut [[f32; 4]]) {
-    kernel::gouraud_row::<vector::Avx2>(planes, at, mask, out)
-}
-
-/// Gouraud colours of the pixels `at.0 + j` (bit `j` of `mask`) on row `at.1` into `out[j]`,
-/// from one triangle's colour [`Planes`]. AVX2 build when `avx2` is true.
-#[inline]
-pub fn gouraud_row(avx2: bool, planes: &Planes, at: (u32, u32), mask: u64, out: &mut [[f32; 4]]) {
-    #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
-        return unsafe { gouraud_row_avx2(planes, at, mask, out) };
-    }
-    let _ = avx2;
-    kernel::gouraud_row::<vector::Portable>(planes, at, mask, out)
-}
-
 /// Fills `dst` with `value` by non-temporal stores where `dst` is 16-byte aligned (on x86-64),
 /// else by plain stores: the background of a tile is written once and not read back by the
 /// renderer, so its cache lines need not be fetched before being written. Call
