@@ -21,8 +21,8 @@
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
-    Batch, Planes, Prepared, Term, avx2_available, group_lanes, light_vertices, shade_batch, shade_group, stream_fence,
-    stream_fill,
+    Batch, Planes, Prepared, Term, avx2_available, group_lanes, light_vertices, project_vertices, shade_batch,
+    shade_group, stream_fence, stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -478,18 +478,7 @@ impl<'a> Frame<'a> {
         vertices
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
-            .for_each(|(out, ps)| {
-                for (o, &p) in out.iter_mut().zip(ps) {
-                    let clip = clip_from_world * Vec4::from((p, 1.0));
-                    let code = outcode(clip);
-                    let p = if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
-                        self.project(clip)
-                    } else {
-                        Projected::default()
-                    };
-                    *o = FastVertex { p, code };
-                }
-            });
+            .for_each(|(out, ps)| self.project_vertices(clip_from_world, ps, out));
         // Gouraud: the colour seen from the front and (two-sided) from the back, lit by the
         // kernel after the triangles are set up, and only for the vertices of drawn triangles
         // (a sphere's back half is culled). Lighting a vertex alone or among others gives the
@@ -925,16 +914,12 @@ impl Frame<'_> {
     /// and `1/w`.
     #[inline]
     fn project(&self, c: Vec4) -> Projected {
-        let (wf, hf) = (self.w as f32, self.h as f32);
-        let iw = 1.0 / c.w;
-        let sx = (c.x * iw * 0.5 + 0.5) * wf;
-        let sy = (0.5 - c.y * iw * 0.5) * hf;
-        Projected(
-            round_i64(sx * ONE) as i32,
-            round_i64(sy * ONE) as i32,
-            c.z * iw * 0.5 + 0.5,
-            iw,
-        )
+        project(c, self.w, self.h)
+    }
+
+    /// The fast setup's vertex records of `positions` into `out` (see [`fast_vertices`]).
+    fn project_vertices(&self, clip_from_world: glam::Mat4, positions: &[Vec3], out: &mut [FastVertex]) {
+        fast_vertices(self.avx2, clip_from_world, (self.w, self.h), positions, out)
     }
 
     /// Culls and sets up the edges of a triangle from its projected vertices; `None` when it is
@@ -963,6 +948,55 @@ impl SampleSpan {
             ys.max().unwrap_or(HALF),
         )
     }
+}
+
+/// [`Frame::project`] for an image of `w × h` pixels.
+#[inline]
+fn project(c: Vec4, w: u32, h: u32) -> Projected {
+    let (wf, hf) = (w as f32, h as f32);
+    let iw = 1.0 / c.w;
+    let sx = (c.x * iw * 0.5 + 0.5) * wf;
+    let sy = (0.5 - c.y * iw * 0.5) * hf;
+    Projected(
+        round_i64(sx * ONE) as i32,
+        round_i64(sy * ONE) as i32,
+        c.z * iw * 0.5 + 0.5,
+        iw,
+    )
+}
+
+/// The fast setup's vertex records of `positions` into `out`, for a `w × h` image: clip-space
+/// transform, outcode and (inside the clip volume) window projection; by the AVX2 kernel with
+/// `avx2`, the same bits (see `simd/project.rs`).
+fn fast_vertices(
+    avx2: bool,
+    clip_from_world: glam::Mat4,
+    (w, h): (u32, u32),
+    positions: &[Vec3],
+    out: &mut [FastVertex],
+) {
+    let scalar = |p: Vec3| {
+        let clip = clip_from_world * Vec4::from((p, 1.0));
+        let code = outcode(clip);
+        let p = if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+            project(clip, w, h)
+        } else {
+            Projected::default()
+        };
+        FastVertex { p, code }
+    };
+    project_vertices(
+        avx2,
+        &clip_from_world,
+        (w as f32, h as f32, ONE),
+        positions,
+        out,
+        |([x, y], z, inv_w, code)| FastVertex {
+            p: Projected(x, y, z, inv_w),
+            code,
+        },
+        scalar,
+    );
 }
 
 /// [`Frame::setup_edges`] for an image of `w × h` pixels.
@@ -1802,6 +1836,79 @@ mod tests {
             culled > 1000 && tight > 0,
             "{culled} culled, {tight} kept with no sample"
         );
+    }
+
+    /// The AVX2 vertex stage gives the scalar one's records bit for bit: vertices in front of,
+    /// across and behind a perspective camera, in and far beyond the guard band, at the eye
+    /// (`w = 0`), NaN and infinite, in groups of 8 and a remainder; and through a degenerate
+    /// transform whose every vertex is "inside" at `w = 0`.
+    #[test]
+    fn vector_vertex_stage_matches_scalar() {
+        if !avx2_available() {
+            eprintln!("no AVX2: the vector vertex stage is not used on this CPU");
+            return;
+        }
+        let camera = phong_core::Camera::new(
+            Vec3::new(0.3, 0.2, 3.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            phong_core::Projection::Perspective { fov_y_deg: 50.0 },
+            0.1,
+            50.0,
+        )
+        .expect("a valid camera");
+        let clip_from_world = camera.clip_from_world(16.0 / 9.0);
+        let mut seed = 0x0123_4567_89ab_cdefu64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut positions: Vec<Vec3> = (0..20_000)
+            .map(|i| {
+                let scale = [1.5, 6.0, 400.0][i % 3];
+                Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale
+            })
+            .collect();
+        for (i, p) in [
+            Vec3::new(0.3, 0.2, 3.0),
+            Vec3::new(0.3, 0.2, 2.95),
+            Vec3::new(f32::NAN, 0.0, 0.0),
+            Vec3::new(0.0, f32::INFINITY, 0.0),
+            Vec3::new(1e30, -1e30, 0.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            positions[i * 37 + 5] = p;
+        }
+        positions.truncate(19_997);
+        let vertex = FastVertex::default();
+        let (mut fast, mut slow) = (vec![vertex; positions.len()], vec![vertex; positions.len()]);
+        for (w, h) in [(1920, 1080), (333, 517)] {
+            fast_vertices(true, clip_from_world, (w, h), &positions, &mut fast);
+            fast_vertices(false, clip_from_world, (w, h), &positions, &mut slow);
+            let bits = |v: &FastVertex| (v.p.0, v.p.1, v.p.2.to_bits(), v.p.3.to_bits(), v.code);
+            let mut inside = 0;
+            for (i, (a, b)) in fast.iter().zip(&slow).enumerate() {
+                assert_eq!(bits(a), bits(b), "vertex {i} at {}", positions[i]);
+                inside += usize::from(b.code & (OUTSIDE_CLIP | NOT_FINITE) == 0);
+            }
+            assert!(
+                inside > 2_000 && inside < 18_000,
+                "{inside} of the vertices inside the clip volume"
+            );
+        }
+        // A degenerate transform: every vertex at clip-space (0, 0, 0, 0), inside every plane,
+        // projected through 1/0 to NaN: the kernel's groups go to the scalar code's casts.
+        let zero = glam::Mat4::ZERO;
+        fast_vertices(true, zero, (64, 64), &positions[..20], &mut fast[..20]);
+        fast_vertices(false, zero, (64, 64), &positions[..20], &mut slow[..20]);
+        for (a, b) in fast[..20].iter().zip(&slow[..20]) {
+            assert_eq!((a.p.0, a.p.1, a.code), (b.p.0, b.p.1, b.code));
+            assert_eq!((a.p.2.is_nan(), a.p.3.to_bits()), (b.p.2.is_nan(), b.p.3.to_bits()));
+        }
     }
 
     #[test]

@@ -11,10 +11,12 @@
 
 pub mod kernel;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
+mod project;
 mod vector;
 
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
+pub use project::WindowVertex;
 
 /// Whether the AVX2 build may be used: the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {
@@ -163,6 +165,32 @@ pub fn shade_group(
     }
     let _ = avx2;
     kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
+}
+
+/// The fast setup's vertex stage (see `project.rs`): `out[i] = make(vertex)` for each vertex
+/// of `positions`, its window position (in 1/`one` pixel, for a `w × h` window), depth, `1/w`
+/// and outcode after `clip_from_world`, bit for bit `scalar(position)`'s, which makes the
+/// vertices the vector kernel leaves and every vertex without AVX2.
+#[inline]
+pub fn project_vertices<O>(
+    avx2: bool,
+    clip_from_world: &glam::Mat4,
+    (w, h, one): (f32, f32, f32),
+    positions: &[Vec3],
+    out: &mut [O],
+    make: impl Fn(WindowVertex) -> O,
+    scalar: impl Fn(Vec3) -> O,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+        return unsafe { project::project_avx2(clip_from_world, (w, h, one), positions, out, make, scalar) };
+    }
+    let _ = (avx2, clip_from_world, w, h, one, make);
+    for (o, &p) in out.iter_mut().zip(positions) {
+        *o = scalar(p);
+    }
 }
 
 /// Fills `dst` with `value` by non-temporal stores where `dst` is 16-byte aligned (on x86-64),
