@@ -22,7 +22,7 @@
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
     Batch, Planes, Prepared, Term, avx2_available, group_lanes, light_vertices, project_vertices, shade_batch,
-    shade_group, stream_fence, stream_fill,
+    shade_group, stream_copy, stream_fence, stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -821,19 +821,34 @@ pub(crate) fn render(
                     tiles[tx].push(piece);
                 }
             }
-            tiles.into_par_iter().enumerate().for_each(|(tx, mut rows)| {
-                let tile = ty as u32 * frame.tiles_x + tx as u32;
-                let n = if options.reference {
-                    frame.tile(tile, bg, &clock, &mut rows)
-                } else {
-                    frame.tile_visible(tile, bg, &clock, &mut rows)
-                };
-                shaded.fetch_add(n, Ordering::Relaxed);
-                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                if let Some(p) = options.progress {
-                    p(d, total);
-                }
-            });
+            // A tile of several triangles is drawn into a local buffer (cache-resident, kept by
+            // the task), then streamed into the image (see `stream_copy`).
+            let local = || vec![[0f32; 4]; (TILE_SIZE * TILE_SIZE) as usize];
+            tiles
+                .into_par_iter()
+                .enumerate()
+                .for_each_init(local, |local, (tx, mut rows)| {
+                    let tile = ty as u32 * frame.tiles_x + tx as u32;
+                    let n = if options.reference {
+                        frame.tile(tile, bg, &clock, &mut rows)
+                    } else if frame.bins[tile as usize].len() > 1 {
+                        let tw = rows[0].len();
+                        let mut buffer: Vec<&mut [[f32; 4]]> = local.chunks_mut(tw).take(rows.len()).collect();
+                        let n = frame.tile_visible(tile, bg, &clock, &mut buffer, false);
+                        for (dst, src) in rows.iter_mut().zip(&buffer) {
+                            stream_copy(dst, src);
+                        }
+                        stream_fence();
+                        n
+                    } else {
+                        frame.tile_visible(tile, bg, &clock, &mut rows, true)
+                    };
+                    shaded.fetch_add(n, Ordering::Relaxed);
+                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if let Some(p) = options.progress {
+                        p(d, total);
+                    }
+                });
         });
     let triangles_drawn = frame.tris.iter().map(|c| c.tris.len()).sum();
     frame.recycle(scratch);
@@ -1266,7 +1281,14 @@ impl Frame<'_> {
     /// only triangle skips visibility, Gouraud pixels are coloured during it, and the rest go
     /// to [`Frame::shade_single`]; with several, one job per visible (pixel, triangle) and the
     /// reference's resolve.
-    fn tile_visible(&self, tile: u32, bg: [f32; 4], clock: &StageClock, rows: &mut [&mut [[f32; 4]]]) -> u64 {
+    fn tile_visible(
+        &self,
+        tile: u32,
+        bg: [f32; 4],
+        clock: &StageClock,
+        rows: &mut [&mut [[f32; 4]]],
+        image: bool,
+    ) -> u64 {
         let t_start = Instant::now();
         let (x0, y0, x1, y1) = self.tile_rect(tile);
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
@@ -1278,7 +1300,7 @@ impl Frame<'_> {
             // buffer): no edge, depth or sorting work. Most tiles of a large triangle.
             let t_shade = Instant::now();
             let ids = vec![0u32; tw * th];
-            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows);
+            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows, image);
         }
         let mut depth = vec![f32::INFINITY; tw * th * ns];
         let mut ids = vec![u32::MAX; tw * th * ns];
@@ -1345,7 +1367,7 @@ impl Frame<'_> {
         }
         let t_shade = Instant::now();
         if ns == 1 {
-            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows);
+            return self.shade_single(bin, ids, (x0, y0, tw, th), bg, clock, (t_start, t_shade), rows, image);
         }
         // One job per visible (pixel, triangle), the pixel as `row << 16 | column` in the tile
         // (no division to find it again: per-lane integer divisions were 1% of fill); a
@@ -1523,6 +1545,7 @@ impl Frame<'_> {
         clock: &StageClock,
         (t_start, t_shade): (Instant, Instant),
         out: &mut [&mut [[f32; 4]]],
+        image: bool,
     ) -> u64 {
         let background = resolve(std::iter::once(bg), 1, bg);
         // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
@@ -1539,7 +1562,11 @@ impl Frame<'_> {
                 let k = ids[col];
                 let len = ids[col..].iter().take_while(|&&id| id == k).count();
                 if k == u32::MAX {
-                    stream_fill(&mut line[col..col + len], background);
+                    if image {
+                        stream_fill(&mut line[col..col + len], background);
+                    } else {
+                        line[col..col + len].fill(background);
+                    }
                 } else if k == FORWARD {
                     // Coloured during visibility.
                     shaded += len as u32;

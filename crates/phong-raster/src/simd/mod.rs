@@ -213,7 +213,28 @@ pub fn stream_fill(dst: &mut [[f32; 4]], value: [f32; 4]) {
     dst.fill(value);
 }
 
-/// Orders earlier non-temporal stores ([`stream_fill`]) before later stores.
+/// Copies `src` into `dst` (the same length) by non-temporal stores where `dst` is 16-byte
+/// aligned (on x86-64), else by plain stores: a tile drawn in a cache-resident buffer reaches
+/// the image without its cache lines being fetched first (1080p, 2 threads, 5 interleaved
+/// runs: 100k Gouraud sphere 8.6 → 8.0 ms, 1M 30.9 → 27.9 ms, medians). Call
+/// [`stream_fence`] before the image is read.
+pub fn stream_copy(dst: &mut [[f32; 4]], src: &[[f32; 4]]) {
+    assert_eq!(dst.len(), src.len());
+    #[cfg(target_arch = "x86_64")]
+    if (dst.as_ptr() as usize).is_multiple_of(16) {
+        use core::arch::x86_64::{_mm_loadu_ps, _mm_stream_ps};
+        for (d, s) in dst.iter_mut().zip(src) {
+            // SAFETY: SSE is part of x86-64; `s` is 4 readable f32, `d` 4 writable f32 at a
+            // 16-byte aligned address (every element of a 16-byte aligned slice of `[f32; 4]`
+            // is).
+            unsafe { _mm_stream_ps(d.as_mut_ptr(), _mm_loadu_ps(s.as_ptr())) };
+        }
+        return;
+    }
+    dst.copy_from_slice(src);
+}
+
+/// Orders earlier non-temporal stores ([`stream_fill`], [`stream_copy`]) before later stores.
 pub fn stream_fence() {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: SSE is part of x86-64.
@@ -226,6 +247,24 @@ pub fn stream_fence() {
 mod tests {
     /// Aligned (streamed) and unaligned (plain) destinations are both filled, and nothing
     /// outside them.
+    /// Aligned (streamed) and unaligned (plain) destinations get exactly the source.
+    #[test]
+    fn stream_copy_copies_exactly_its_slice() {
+        let src: Vec<[f32; 4]> = (0..32).map(|i| [i as f32, 0.5, -1.5 * i as f32, 1.0]).collect();
+        let mut buf = vec![0f32; 4 * 40 + 8];
+        for offset in 0..4 {
+            buf.fill(-1.0);
+            let pixels: &mut [[f32; 4]] = bytemuck::cast_slice_mut(&mut buf[offset..offset + 4 * 37]);
+            super::stream_copy(&mut pixels[3..35], &src);
+            super::stream_fence();
+            for (i, p) in pixels.iter().enumerate() {
+                let want = if (3..35).contains(&i) { src[i - 3] } else { [-1.0; 4] };
+                assert_eq!(*p, want, "offset {offset}, pixel {i}");
+            }
+            assert!(buf[offset + 4 * 37..].iter().all(|&x| x == -1.0));
+        }
+    }
+
     #[test]
     fn stream_fill_fills_exactly_its_slice() {
         let mut buf = vec![0f32; 4 * 40 + 8];
