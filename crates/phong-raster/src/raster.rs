@@ -301,6 +301,9 @@ struct Chunk {
     corners: Vec<Corners>,
     /// Gouraud triangles whose planes wait for their vertices' colours (see [`Pending`]).
     pending: Vec<Pending>,
+    /// Gouraud: the planes of clipped triangles, by slot (the others' are in `pending`
+    /// until their vertices are lit).
+    clipped: Vec<(u32, Planes)>,
     /// `(tile, index)` for each tile each triangle is binned into, in triangle order (see
     /// [`Frame::bin_chunks`]).
     binned: Vec<(u32, u32)>,
@@ -342,6 +345,7 @@ impl Chunk {
             planes: Vec::new(),
             corners: Vec::new(),
             pending: Vec::new(),
+            clipped: Vec::new(),
             binned: Vec::new(),
         });
         c.object = object as u32;
@@ -447,6 +451,7 @@ impl<'a> Frame<'a> {
             chunk.corners.clear();
             chunk.pending.clear();
             chunk.binned.clear();
+            chunk.clipped.clear();
             scratch.chunks.push(chunk);
         }
         scratch.bins = self.bins;
@@ -556,7 +561,6 @@ impl<'a> Frame<'a> {
                                 area: s.area,
                                 front: s.front,
                             });
-                            out.planes.push(Planes::default());
                         } else {
                             out.planes.push(phong_planes(&s, tri));
                         }
@@ -583,8 +587,12 @@ impl<'a> Frame<'a> {
                 });
                 let mut push = |t: [ClipVertex; 3]| {
                     if let Some((tri, p, _)) = self.setup(t, None, None, oi as u32, false) {
+                        if gouraud {
+                            out.clipped.push((out.tris.len() as u32, p));
+                        } else {
+                            out.planes.push(p);
+                        }
                         out.tris.push(tri);
-                        out.planes.push(p);
                     }
                 };
                 match clip_triangle(&t) {
@@ -625,20 +633,33 @@ impl<'a> Frame<'a> {
             let colors = &*colors;
             chunks.par_iter_mut().for_each(|chunk| {
                 let Chunk {
-                    tris, planes, pending, ..
+                    tris,
+                    planes,
+                    pending,
+                    clipped,
+                    ..
                 } = chunk;
-                for p in pending.iter() {
-                    let side = usize::from(!p.front);
-                    let c = each3(|k| colors[p.idx[k] as usize][side]);
-                    planes[p.slot as usize] = plane_equations(
-                        p.origin,
-                        &tris[p.slot as usize],
-                        p.area,
-                        p.inv_w,
-                        [c, [Vec3::ZERO; 3]],
-                        true,
-                    );
-                }
+                // In slot order: the pending triangles' planes made here, the clipped ones'
+                // taken (no default planes written first: 96 bytes a triangle).
+                let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
+                planes.extend((0..tris.len() as u32).map(|slot| {
+                    if let Some(p) = pending.next_if(|p| p.slot == slot) {
+                        let side = usize::from(!p.front);
+                        let c = each3(|k| colors[p.idx[k] as usize][side]);
+                        plane_equations(
+                            p.origin,
+                            &tris[slot as usize],
+                            p.area,
+                            p.inv_w,
+                            [c, [Vec3::ZERO; 3]],
+                            true,
+                        )
+                    } else {
+                        let c = clipped.next();
+                        debug_assert_eq!(c.map(|c| c.0), Some(slot), "every slot is pending or clipped");
+                        c.map(|c| c.1).unwrap_or_default()
+                    }
+                }));
             });
         }
         chunks
@@ -698,6 +719,7 @@ impl<'a> Frame<'a> {
                 planes: Vec::new(),
                 corners: Vec::new(),
                 pending: Vec::new(),
+                clipped: Vec::new(),
                 binned: Vec::new(),
             };
             let mut push = |r: Option<(Tri, Planes, Option<Corners>)>| {
