@@ -208,6 +208,26 @@ struct Setup {
     front: bool,
 }
 
+/// How many of `ids` from the start equal `k`: 8 compared at a time (a branch-free mask
+/// LLVM vectorises; the element-by-element `take_while` was a ninth of a 100k-triangle Gouraud
+/// frame, scanning tiles whose pixels are all coloured or all background).
+#[inline]
+fn run_length(ids: &[u32], k: u32) -> usize {
+    let mut chunks = ids.chunks_exact(8);
+    let mut n = 0;
+    for c in &mut chunks {
+        let mut differ = 0u32;
+        for (i, &id) in c.iter().enumerate() {
+            differ |= u32::from(id != k) << i;
+        }
+        if differ != 0 {
+            return n + differ.trailing_zeros() as usize;
+        }
+        n += 8;
+    }
+    n + chunks.remainder().iter().take_while(|&&id| id == k).count()
+}
+
 /// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
 const FORWARD: u32 = u32::MAX - 1;
 
@@ -1582,7 +1602,7 @@ impl Frame<'_> {
             let mut col = 0;
             while col < tw {
                 let k = ids[col];
-                let len = ids[col..].iter().take_while(|&&id| id == k).count();
+                let len = run_length(&ids[col..], k);
                 if k == u32::MAX {
                     if image {
                         stream_fill(&mut line[col..col + len], background);
@@ -1957,6 +1977,22 @@ mod tests {
         for (a, b) in fast[..20].iter().zip(&slow[..20]) {
             assert_eq!((a.p.0, a.p.1, a.code), (b.p.0, b.p.1, b.code));
             assert_eq!((a.p.2.is_nan(), a.p.3.to_bits()), (b.p.2.is_nan(), b.p.3.to_bits()));
+        }
+    }
+
+    /// `run_length` counts the leading run exactly, at every length and position around its
+    /// blocks of 8.
+    #[test]
+    fn run_length_counts_the_leading_run() {
+        for len in 0..40 {
+            for run in 0..=len {
+                let mut ids = vec![7u32; len];
+                if run < len {
+                    ids[run] = 3;
+                }
+                assert_eq!(run_length(&ids, 7), run, "length {len}");
+                assert_eq!(run_length(&ids, 3), usize::from(run == 0 && len > 0), "length {len}");
+            }
         }
     }
 
