@@ -1336,6 +1336,22 @@ impl Frame<'_> {
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let ns = self.pattern.len();
         let bin = &self.bins[tile as usize];
+        if bin.is_empty() {
+            // Background only (most tiles around a model): no depth, ids or scan; the resolve
+            // of `ns` background samples, as the other paths compute it.
+            let background = resolve(std::iter::repeat_n(bg, ns), ns, bg);
+            for line in rows.iter_mut() {
+                if image {
+                    stream_fill(line, background);
+                } else {
+                    line.fill(background);
+                }
+            }
+            stream_fence();
+            let t_end = Instant::now();
+            clock.add(t_start, t_end, t_end, t_end);
+            return 0;
+        }
         if ns == 1 && bin.len() == 1 && self.covers_rect(bin[0], (x0, y0, x1, y1)) {
             // Trivial accept: the tile's only triangle covers all of it, so every pixel sees it
             // (its depth, finite inside the clipped volume, passes the test against the cleared
