@@ -11,9 +11,21 @@
 //! measured effects. Measured dead ends, not kept:
 //! - shading each triangle's pixels alone in vectors, remainders included: a 1M-triangle
 //!   sphere has one or two pixels per triangle, and its shading took twice as long;
-//! - rendering a tile into a local buffer streamed into the image: slower than writing the
-//!   image directly (100k Gouraud sphere, 1 thread, 19.9 → 22.0 ms); only the background is
-//!   streamed;
+//! - rendering every tile into a local buffer, allocated per tile, streamed into the image:
+//!   slower than writing the image directly (100k Gouraud sphere, 1 thread, 19.9 → 22.0 ms).
+//!   Kept per task and used only for tiles of several triangles it is faster (a later
+//!   session: 100k Gouraud, 2 threads, 8.6 → 8.0 ms; 1M 30.9 → 27.9 ms): the image's lines
+//!   are no longer read for ownership before being written;
+//! - the depth tests of a small triangle's rows 8 pixels at a time (AVX2, 32-bit edges,
+//!   bit-identical depths), one call per triangle: first slower (Zen 3's masked stores, then
+//!   loads stalled behind unaligned overlapping stores of neighbouring triangles), then,
+//!   with whole aligned vectors written back, within noise on the 100k sphere and slower on
+//!   the 1M one (its triangles cover two or three pixels: the call and the vector setup cost
+//!   what the tests save), with or without a minimum triangle size;
+//! - four Gouraud pixels' divisions issued together: within noise (the division's latency
+//!   was not the colour's cost, the image writes were);
+//! - software prefetch of the bin's next triangles and planes: within noise (1M Gouraud,
+//!   1 thread, 7 runs: median 56.3 → 52.4 ms in a period when single runs spread 47–72 ms);
 //! - per-light skips of zero ambient colours and unit normalisation factors in the kernel:
 //!   exact, but the fill frame went 50 → 53 ms (register allocation), reverted;
 //! - sorting the pixels of a Gouraud tile for a deferred pass instead of colouring them during
