@@ -1791,18 +1791,23 @@ mod tests {
         assert_eq!(size_of::<Pending>(), 56);
     }
 
+    /// A xorshift64 generator: the tests' reproducible random numbers.
+    fn xorshift(mut seed: u64) -> impl FnMut() -> u64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        }
+    }
+
     /// Binning's trivial reject never drops a tile where a sample of any pattern is covered,
     /// and does drop some (random triangles up to 2.5 tiles across, in a 4×4-tile image).
     #[test]
     fn tile_reject_is_conservative() {
         let (w, h) = (4 * TILE_SIZE, 4 * TILE_SIZE);
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |range: i64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % range as u64) as i64
-        };
+        let mut bits = xorshift(0x2545_f491_4f6c_dd1du64);
+        let mut next = |range: i64| (bits() % range as u64) as i64;
         let patterns: Vec<Vec<(i64, i64)>> = [1, 4, 16]
             .iter()
             .map(|&n| {
@@ -1862,13 +1867,8 @@ mod tests {
     #[test]
     fn bounding_box_holds_every_covered_sample() {
         let (w, h) = (40u32, 30u32);
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |range: i64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % range as u64) as i64
-        };
+        let mut bits = xorshift(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = |range: i64| (bits() % range as u64) as i64;
         let (mut culled, mut tight) = (0, 0usize);
         for n in [1, 4, 16] {
             let pattern: Vec<(i64, i64)> = sample_pattern(n)
@@ -1962,13 +1962,8 @@ mod tests {
         )
         .expect("a valid camera");
         let clip_from_world = camera.clip_from_world(16.0 / 9.0);
-        let mut seed = 0x0123_4567_89ab_cdefu64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut bits = xorshift(0x0123_4567_89ab_cdef);
+        let mut next = || (bits() >> 40) as f32 / (1u64 << 24) as f32;
         let mut positions: Vec<Vec3> = (0..20_000)
             .map(|i| {
                 let scale = [1.5, 6.0, 400.0][i % 3];
