@@ -240,6 +240,17 @@ fn run_length(ids: &[u32], k: u32) -> usize {
     n + chunks.remainder().iter().take_while(|&&id| id == k).count()
 }
 
+/// Background pixels: streamed past the caches into the image (`image`), plain stores into a
+/// task's cache-resident tile buffer (see [`TileBuffers`]).
+#[inline]
+fn fill_background(line: &mut [[f32; 4]], value: [f32; 4], image: bool) {
+    if image {
+        stream_fill(line, value);
+    } else {
+        line.fill(value);
+    }
+}
+
 /// A tile task's working memory, reused from tile to tile: its own buffer for the image's
 /// pixels (see `stream_copy`), and the depth and triangle of each sample, not allocated and
 /// zeroed per tile (1M Gouraud sphere, 2 threads: page faults per frame 140 → 77).
@@ -264,9 +275,11 @@ struct Forward<'r, 'i> {
 /// that a pixel's colour is one 4-wide vector from start to store (SSE on x86-64), the layout
 /// of the `[f32; 4]` pixel it is written to.
 ///
-/// Measured (100k-triangle Gouraud sphere, 1080p, 1 thread): colouring its 830k pixels with the
-/// 8-lane kernel, one call per row of a triangle (most rows have 3 to 6 pixels: the lanes went
-/// through memory to be written as pixels), took 4.5 of the tiles' 12.5 ms.
+/// Measured (Gouraud spheres, 1080p, 1 thread): skipping the colouring altogether took the
+/// 100k sphere's tiles from about 12.5 to 7.5 ms (planes read, interpolation and image writes
+/// together). Against the 8-lane kernel it replaced (one call per row of a triangle; most rows
+/// have 3 to 6 pixels, whose lanes went through memory to become pixels), this layout was
+/// within noise on the 100k sphere and 56.8 → 54.2 ms (medians of 5) on the 1M one.
 #[derive(Clone, Copy)]
 struct ColorPlanes {
     c: [f32; 4],
@@ -525,7 +538,7 @@ impl<'a> Frame<'a> {
         vertices
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
-            .for_each(|(out, ps)| self.project_vertices(clip_from_world, ps, out));
+            .for_each(|(out, ps)| fast_vertices(self.avx2, clip_from_world, (self.w, self.h), ps, out));
         // Gouraud: the colour seen from the front and (two-sided) from the back, lit by the
         // kernel after the triangles are set up, and only for the vertices of drawn triangles
         // (a sphere's back half is culled). Lighting a vertex alone or among others gives the
@@ -997,11 +1010,6 @@ impl Frame<'_> {
         project(c, self.w, self.h)
     }
 
-    /// The fast setup's vertex records of `positions` into `out` (see [`fast_vertices`]).
-    fn project_vertices(&self, clip_from_world: glam::Mat4, positions: &[Vec3], out: &mut [FastVertex]) {
-        fast_vertices(self.avx2, clip_from_world, (self.w, self.h), positions, out)
-    }
-
     /// Culls and sets up the edges of a triangle from its projected vertices; `None` when it is
     /// culled (a back face of a one-sided object), degenerate or covers no pixel.
     #[inline]
@@ -1366,11 +1374,7 @@ impl Frame<'_> {
             // of `ns` background samples, as the other paths compute it.
             let background = resolve(std::iter::repeat_n(bg, ns), ns, bg);
             for line in rows.iter_mut() {
-                if image {
-                    stream_fill(line, background);
-                } else {
-                    line.fill(background);
-                }
+                fill_background(line, background, image);
             }
             stream_fence();
             let t_end = Instant::now();
@@ -1639,11 +1643,7 @@ impl Frame<'_> {
                 let k = ids[col];
                 let len = run_length(&ids[col..], k);
                 if k == u32::MAX {
-                    if image {
-                        stream_fill(&mut line[col..col + len], background);
-                    } else {
-                        line[col..col + len].fill(background);
-                    }
+                    fill_background(&mut line[col..col + len], background, image);
                 } else if k == FORWARD {
                     // Coloured during visibility.
                     shaded += len as u32;
