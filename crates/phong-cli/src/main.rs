@@ -42,6 +42,16 @@ enum Backend {
     Auto,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum GpuPathArg {
+    /// The compute rasterizer where it can draw the frame, else the pipeline.
+    Auto,
+    /// The GPU's render pipeline (its own rasterizer).
+    Pipeline,
+    /// The compute rasterizer (an error where it cannot draw the frame).
+    Compute,
+}
+
 /// What `render` and `bench` share: the input, its overrides and how to render it.
 #[derive(clap::Args)]
 struct RunArgs {
@@ -59,6 +69,9 @@ struct RunArgs {
     /// Renderer.
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     backend: Backend,
+    /// GPU: how frames are drawn.
+    #[arg(long, value_enum, default_value_t = GpuPathArg::Auto)]
+    gpu_path: GpuPathArg,
     /// CPU: the scalar reference path instead of the fast path.
     #[arg(long)]
     reference: bool,
@@ -185,29 +198,45 @@ fn main() -> ExitCode {
 }
 
 /// The GPU when asked for (an error if there is none), or for `auto` when one is found.
-fn open_gpu(backend: Backend) -> Result<Option<phong_gpu::Gpu>> {
-    match backend {
-        Backend::Cpu => Ok(None),
-        Backend::Gpu => Ok(Some(phong_gpu::Gpu::new().context("--backend gpu")?)),
-        Backend::Auto => Ok(phong_gpu::Gpu::new().ok()),
+fn open_gpu(backend: Backend, path: GpuPathArg) -> Result<Option<phong_gpu::Gpu>> {
+    let mut gpu = match backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(phong_gpu::Gpu::new().context("--backend gpu")?),
+        Backend::Auto => phong_gpu::Gpu::new().ok(),
+    };
+    if let Some(g) = &mut gpu {
+        g.set_path(match path {
+            GpuPathArg::Auto => phong_gpu::GpuPath::Auto,
+            GpuPathArg::Pipeline => phong_gpu::GpuPath::Pipeline,
+            GpuPathArg::Compute => phong_gpu::GpuPath::Compute,
+        });
     }
+    Ok(gpu)
 }
 
-/// Times of one render: (setup or upload, raster or GPU render pass, read-back).
+/// One render: the image, times (setup or upload, raster or GPU render pass, read-back, then
+/// the CPU's stage times), triangles drawn, pixels shaded, and whether the GPU's compute
+/// rasterizer drew it.
 fn render_once(
     scene: &phong_core::Scene,
     gpu: Option<&phong_gpu::Gpu>,
     options: &RenderOptions,
-) -> Result<(phong_core::Image, [Duration; 6], usize, u64)> {
+) -> Result<(phong_core::Image, [Duration; 6], usize, u64, bool)> {
     Ok(match gpu {
         Some(g) => {
             let (img, st) = g.render(scene)?;
             let z = Duration::ZERO;
-            (img, [st.upload, st.render, st.readback, z, z, z], st.triangles, 0)
+            (
+                img,
+                [st.upload, st.render, st.readback, z, z, z],
+                st.triangles,
+                0,
+                st.compute,
+            )
         }
         None => {
             let (img, st) = render_with_stats(scene, options)?;
-            (img, cpu_times(&st), st.triangles_drawn, st.pixels_shaded)
+            (img, cpu_times(&st), st.triangles_drawn, st.pixels_shaded, false)
         }
     })
 }
@@ -271,7 +300,7 @@ fn render(a: RenderArgs) -> Result<()> {
     }
     let t_load = t0.elapsed();
 
-    let gpu = open_gpu(a.run.backend)?;
+    let gpu = open_gpu(a.run.backend, a.run.gpu_path)?;
     let bar = ProgressBar::hidden();
     bar.set_style(ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed}").expect("valid template"));
     let tty = std::io::stderr().is_terminal();
@@ -286,7 +315,7 @@ fn render(a: RenderArgs) -> Result<()> {
         bar.set_position(done);
     };
     let options = a.run.options(Some(&progress));
-    let (mut image, times, triangles, shaded) =
+    let (mut image, times, triangles, shaded, gpu_compute) =
         render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.run.input.display()))?;
     bar.finish_and_clear();
     phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
@@ -295,7 +324,15 @@ fn render(a: RenderArgs) -> Result<()> {
     let t_write = t_write.elapsed();
     if a.run.verbose {
         let backend = match &gpu {
-            Some(g) => format!("gpu, {}", g.adapter_name()),
+            Some(g) => format!(
+                "gpu, {}, {}",
+                g.adapter_name(),
+                if gpu_compute {
+                    "compute rasterizer"
+                } else {
+                    "render pipeline"
+                }
+            ),
             None => {
                 let n = a
                     .run
@@ -343,15 +380,36 @@ fn bench(a: BenchArgs) -> Result<()> {
         bail!(InputError("--frames must be at least 1".into()));
     }
     let scene = a.run.load()?;
-    let gpu = open_gpu(a.run.backend)?;
+    let gpu = open_gpu(a.run.backend, a.run.gpu_path)?;
     let mut sum = [Duration::ZERO; 6];
+    // The GPU's own time of the pass (timestamp queries), where every frame had one.
+    let mut gpu_pass = Some(Duration::ZERO);
+    // GPU: uploaded once and drawn `frames` times (as the CPU renderer's buffers are kept);
+    // read back from the first few frames.
+    let mut gpu_path = "";
+    let reads = a.frames.min(3);
     match &gpu {
         Some(g) => {
-            g.render(&scene)?;
-            for _ in 0..a.frames {
-                let st = g.render(&scene)?.1;
-                for (k, d) in [st.upload, st.render, st.readback].into_iter().enumerate() {
-                    sum[k] += d;
+            let t0 = Instant::now();
+            let mut prepared = g.prepare(&scene)?;
+            if g.draw(&prepared)?.overflowed {
+                prepared = g.prepare_path(&scene, phong_gpu::GpuPath::Pipeline)?;
+                g.draw(&prepared)?;
+            }
+            sum[0] = t0.elapsed() * a.frames;
+            gpu_path = if prepared.is_compute() {
+                "compute rasterizer"
+            } else {
+                "render pipeline"
+            };
+            for frame in 0..a.frames {
+                let drawn = g.draw(&prepared)?;
+                sum[1] += drawn.wall;
+                gpu_pass = gpu_pass.zip(drawn.gpu).map(|(a, b)| a + b);
+                if frame < reads {
+                    let t = Instant::now();
+                    g.read(&prepared)?;
+                    sum[2] += t.elapsed();
                 }
             }
         }
@@ -396,11 +454,13 @@ fn bench(a: BenchArgs) -> Result<()> {
         let ms = |d: Duration| d.as_secs_f64() * 1e3 / f64::from(a.frames);
         match &gpu {
             Some(g) => eprintln!(
-                "phong: gpu ({}) per frame: upload={:.2}ms render={:.2}ms readback={:.2}ms",
+                "phong: gpu ({}, {gpu_path}) upload (once)={:.2}ms per frame: render={:.3}ms (on the GPU: {}) \
+                 readback={:.2}ms",
                 g.adapter_name(),
                 ms(sum[0]),
                 ms(sum[1]),
-                ms(sum[2])
+                gpu_pass.map_or("no timestamps".into(), |d| format!("pass={:.3}ms", ms(d))),
+                sum[2].as_secs_f64() * 1e3 / f64::from(reads)
             ),
             None => eprintln!(
                 "phong: cpu per frame: setup+binning={:.2}ms raster+shade+resolve={:.2}ms \

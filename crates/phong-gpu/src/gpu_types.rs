@@ -1,4 +1,4 @@
-//! `#[repr(C)]` mirrors of the WGSL structs in `shade.wgsl`, `render.wgsl` and `compute.wgsl`,
+//! `#[repr(C)]` mirrors of the WGSL structs in `shade.wgsl`, `frame.wgsl`, `raster.wgsl` and `compute.wgsl`,
 //! all made of 16-byte vectors so that Rust and WGSL layouts agree without padding rules.
 
 use bytemuck::{Pod, Zeroable};
@@ -156,4 +156,16 @@ pub struct GpuGlobals {
     pub ambient: [f32; 4],
     /// x: lights, y: cases.
     pub counts: [u32; 4],
+}
+
+/// WGSL `Raster` (raster.wgsl): the compute rasterizer's frame constants.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRaster {
+    /// Width, height, vertices, triangles.
+    pub size: [u32; 4],
+    /// The premultiplied background.
+    pub background: [f32; 4],
+    /// x: the tile item capacity.
+    pub items: [u32; 4],
 }

@@ -25,7 +25,7 @@
 
 mod gpu_types;
 
-pub use gpu_types::{GpuCase, GpuFrame, GpuGlobals, GpuLight, GpuObject, GpuVertex};
+pub use gpu_types::{GpuCase, GpuFrame, GpuGlobals, GpuLight, GpuObject, GpuRaster, GpuVertex};
 
 use phong_core::mesh::facet_normal;
 use phong_core::{
@@ -39,7 +39,19 @@ use wgpu::util::DeviceExt;
 
 /// The WGSL shading function (a port of `phong_core::shade`).
 pub const SHADE_WGSL: &str = include_str!("shade.wgsl");
-const RENDER_WGSL: &str = concat!(include_str!("shade.wgsl"), include_str!("render.wgsl"));
+const RENDER_WGSL: &str = concat!(
+    include_str!("shade.wgsl"),
+    include_str!("frame.wgsl"),
+    include_str!("render.wgsl")
+);
+const RASTER_WGSL: &str = concat!(
+    include_str!("shade.wgsl"),
+    include_str!("frame.wgsl"),
+    include_str!("raster.wgsl")
+);
+/// Tile items (triangle, 16×16 tile) the compute rasterizer holds per frame (8 bytes each): a
+/// frame that needs more is drawn again by the pipeline.
+const ITEM_CAPACITY: u32 = 1 << 22;
 const COMPUTE_WGSL: &str = concat!(include_str!("shade.wgsl"), include_str!("compute.wgsl"));
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -84,6 +96,9 @@ pub enum Error {
         /// The device's report.
         reason: String,
     },
+    /// The compute rasterizer was asked for and cannot draw the frame.
+    #[error("the compute rasterizer cannot draw this frame: {0}; use the pipeline path")]
+    Compute(String),
     /// Samples per pixel other than 1, 4 or 16.
     #[error("antialias must be 1, 4 or 16 samples per pixel, got {0}")]
     Samples(u32),
@@ -97,12 +112,155 @@ pub enum Error {
 pub struct GpuStats {
     /// Building and uploading vertex, index, light and object buffers.
     pub upload: Duration,
-    /// Submitting the render pass and waiting for it to finish.
+    /// Submitting the render pass and waiting for it to finish (wall clock).
     pub render: Duration,
+    /// The render pass's own time on the GPU, from timestamp queries (`None` when the adapter
+    /// has no `TIMESTAMP_QUERY`).
+    pub gpu_pass: Option<Duration>,
     /// Copying the resolved image to a buffer, mapping and converting it.
     pub readback: Duration,
     /// Triangles drawn.
     pub triangles: usize,
+    /// Drawn by the compute rasterizer (else by the render pipeline).
+    pub compute: bool,
+}
+
+/// How the GPU draws a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GpuPath {
+    /// The compute rasterizer where it can draw the frame ([`Gpu::compute_reason`]), else the
+    /// render pipeline.
+    #[default]
+    Auto,
+    /// The render pipeline: the GPU's own rasterizer, MSAA, any geometry.
+    Pipeline,
+    /// The compute rasterizer (raster.wgsl); an error where it cannot draw the frame.
+    Compute,
+}
+
+/// A frame uploaded by [`Gpu::prepare`]: buffers, targets and bind groups, drawn by
+/// [`Gpu::draw`] as often as asked and read back by [`Gpu::read`].
+pub struct Prepared {
+    width: u32,
+    height: u32,
+    background: [f32; 4],
+    premultiplied: [f32; 4],
+    triangles: usize,
+    item_capacity: u32,
+    resolved: wgpu::Texture,
+    resolved_view: wgpu::TextureView,
+    /// Timestamps of the pass and the buffer they are resolved into.
+    timing: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Mapped after each draw: the two timestamps, then the compute path's item count.
+    feedback: wgpu::Buffer,
+    drawing: Drawing,
+}
+
+impl Prepared {
+    /// Whether this frame is drawn by the compute rasterizer.
+    pub fn is_compute(&self) -> bool {
+        matches!(self.drawing, Drawing::Compute { .. })
+    }
+}
+
+enum Drawing {
+    Pipeline {
+        vb: wgpu::Buffer,
+        ib: wgpu::Buffer,
+        bind: wgpu::BindGroup,
+        msaa_view: Option<wgpu::TextureView>,
+        depth_view: wgpu::TextureView,
+        /// Each object's index range and whether back faces are culled.
+        draws: Vec<(std::ops::Range<u32>, bool)>,
+        pipelines: [wgpu::RenderPipeline; 2],
+    },
+    Compute {
+        stages: Vec<ComputeStage>,
+        counter: wgpu::Buffer,
+        dispatch: wgpu::Buffer,
+        /// Kept alive with the bind groups that use them.
+        _buffers: Vec<wgpu::Buffer>,
+    },
+}
+
+/// One dispatch of the compute rasterizer: workgroups `(x, y)`, or indirect (the tiles).
+struct ComputeStage {
+    pipeline: wgpu::ComputePipeline,
+    bind: wgpu::BindGroup,
+    groups: Option<(u32, u32)>,
+}
+
+/// The compute rasterizer's entry points, in dispatch order.
+#[derive(Clone, Copy)]
+enum Kernel {
+    Clear,
+    Vertex,
+    Raster,
+    Args,
+    Tiles,
+    Shade,
+}
+
+impl Kernel {
+    const ALL: [Kernel; 6] = [
+        Kernel::Clear,
+        Kernel::Vertex,
+        Kernel::Raster,
+        Kernel::Args,
+        Kernel::Tiles,
+        Kernel::Shade,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Kernel::Clear => "cs_clear",
+            Kernel::Vertex => "cs_vertex",
+            Kernel::Raster => "cs_raster",
+            Kernel::Args => "cs_args",
+            Kernel::Tiles => "cs_tiles",
+            Kernel::Shade => "cs_shade",
+        }
+    }
+
+    /// The bindings its entry point uses (its automatic layout holds exactly these).
+    fn bindings(self) -> &'static [u32] {
+        match self {
+            Kernel::Clear => &[3, 11, 13],
+            Kernel::Vertex => &[0, 1, 2, 3, 4, 5, 7, 8],
+            Kernel::Raster => &[2, 3, 5, 6, 7, 9, 10, 11],
+            Kernel::Args => &[3, 11, 12],
+            Kernel::Tiles => &[2, 3, 5, 6, 7, 9, 10, 11],
+            Kernel::Shade => &[0, 1, 2, 3, 4, 5, 6, 7, 8, 13, 14],
+        }
+    }
+}
+
+struct Kernels([wgpu::ComputePipeline; 6]);
+
+impl Kernels {
+    fn get(&self, k: Kernel) -> &wgpu::ComputePipeline {
+        &self.0[k as usize]
+    }
+}
+
+/// What [`Gpu::draw`] measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Drawn {
+    /// Submitting the frame and waiting for it (wall clock).
+    pub wall: Duration,
+    /// The pass's own time on the GPU (timestamp queries), where the adapter has them.
+    pub gpu: Option<Duration>,
+    /// The compute rasterizer's tile list overflowed: the image is incomplete.
+    pub overflowed: bool,
+}
+
+/// Workgroups `(x, y)` for `n` threads of `size` per group, `x` at most `max`: the shaders'
+/// `linear_id` is `gid.x + gid.y · x · size`. `None` when even `max²` groups are too few.
+fn dispatch_groups(n: u64, size: u32, max: u32) -> Option<(u32, u32)> {
+    let groups = n.div_ceil(u64::from(size)).max(1);
+    let x = groups.min(u64::from(max));
+    let y = groups.div_ceil(x);
+    (y <= u64::from(max)).then_some((x as u32, y as u32))
 }
 
 /// A GPU device ready to render scenes.
@@ -115,6 +273,9 @@ pub struct Gpu {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<(u32, bool), wgpu::RenderPipeline>>,
+    kernels: std::sync::OnceLock<Result<Kernels, String>>,
+    path: GpuPath,
+    item_capacity: u32,
     lost: std::sync::Arc<Mutex<Option<String>>>,
 }
 
@@ -200,6 +361,12 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("phong"),
             required_limits: limits.clone(),
+            // Timestamps time the render pass on the GPU itself, where the adapter has them.
+            // and 64-bit integers and atomics make the compute rasterizer.
+            required_features: adapter.features()
+                & (wgpu::Features::TIMESTAMP_QUERY
+                    | wgpu::Features::SHADER_INT64
+                    | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
             ..Default::default()
         }))
         .map_err(|e| Error::Device {
@@ -244,6 +411,9 @@ impl Gpu {
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
+            kernels: std::sync::OnceLock::new(),
+            path: GpuPath::Auto,
+            item_capacity: ITEM_CAPACITY,
             lost,
         })
     }
@@ -254,6 +424,23 @@ impl Gpu {
             "{} ({:?}, {:?})",
             self.info.name, self.info.backend, self.info.device_type
         )
+    }
+
+    /// Chooses how frames are drawn from now on (default [`GpuPath::Auto`]).
+    pub fn set_path(&mut self, path: GpuPath) {
+        self.path = path;
+    }
+
+    /// Sets the compute rasterizer's tile item capacity (for tests of its overflow).
+    #[doc(hidden)]
+    pub fn set_item_capacity(&mut self, items: u32) {
+        self.item_capacity = items.max(1);
+    }
+
+    /// Whether renders time their pass on the GPU ([`GpuStats::gpu_pass`]): the adapter has
+    /// timestamp queries.
+    pub fn has_timestamps(&self) -> bool {
+        self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY)
     }
 
     fn fail(&self, doing: &'static str, reason: String) -> Error {
@@ -348,9 +535,49 @@ impl Gpu {
     }
 
     /// Renders `scene` into a linear RGBA image (labels are not drawn: the caller does, as
-    /// for the CPU renderer).
+    /// for the CPU renderer): [`Gpu::prepare`], [`Gpu::draw`], [`Gpu::read`]. Where the
+    /// compute rasterizer's tile list overflows, the frame is drawn again by the pipeline
+    /// ([`GpuPath::Auto`]) or the render fails ([`GpuPath::Compute`]).
     pub fn render(&self, scene: &Scene) -> Result<(Image, GpuStats), Error> {
         let t0 = Instant::now();
+        let mut prepared = self.prepare(scene)?;
+        let mut upload = t0.elapsed();
+        let mut drawn = self.draw(&prepared)?;
+        if drawn.overflowed {
+            if self.path == GpuPath::Compute {
+                return Err(Error::Compute(format!(
+                    "its list of large triangles' tiles overflowed (capacity {})",
+                    self.item_capacity
+                )));
+            }
+            let t0 = Instant::now();
+            prepared = self.prepare_path(scene, GpuPath::Pipeline)?;
+            upload += t0.elapsed();
+            drawn = self.draw(&prepared)?;
+        }
+        let t2 = Instant::now();
+        let image = self.read(&prepared)?;
+        Ok((
+            image,
+            GpuStats {
+                upload,
+                render: drawn.wall,
+                gpu_pass: drawn.gpu,
+                readback: t2.elapsed(),
+                triangles: prepared.triangles,
+                compute: prepared.is_compute(),
+            },
+        ))
+    }
+
+    /// Uploads `scene` (buffers, targets, bind groups) for [`Gpu::draw`], on the path set by
+    /// [`Gpu::set_path`].
+    pub fn prepare(&self, scene: &Scene) -> Result<Prepared, Error> {
+        self.prepare_path(scene, self.path)
+    }
+
+    /// [`Gpu::prepare`] on the given path.
+    pub fn prepare_path(&self, scene: &Scene, path: GpuPath) -> Result<Prepared, Error> {
         let samples = scene.image.samples;
         if !phong_core::limits::SAMPLE_COUNTS.contains(&samples) {
             return Err(Error::Samples(samples));
@@ -381,14 +608,25 @@ impl Gpu {
         self.check_limit("image width", u64::from(w), max_tex)?;
         self.check_limit("image height", u64::from(h), max_tex)?;
         self.check_lost("starting a render")?;
+        let clip_from_world = scene.camera.clip_from_world(w as f32 / h as f32);
+        let compute = match path {
+            GpuPath::Pipeline => false,
+            // A driver that cannot build the compute rasterizer leaves the pipeline.
+            GpuPath::Auto => self.compute_reason(scene, &clip_from_world).is_none() && self.kernels().is_ok(),
+            GpuPath::Compute => match self.compute_reason(scene, &clip_from_world) {
+                None => true,
+                Some(why) => return Err(Error::Compute(why)),
+            },
+        };
 
-        // Geometry: smooth objects indexed, flat objects de-indexed with centroids.
+        // Geometry: smooth objects indexed, flat objects de-indexed with centroids; indices
+        // absolute (one vertex buffer for all objects).
         let mut vertices: Vec<GpuVertex> = Vec::new();
+        let mut vertex_object: Vec<u32> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
-        let mut draws: Vec<(std::ops::Range<u32>, i32, bool)> = Vec::new();
+        let mut draws: Vec<(std::ops::Range<u32>, bool)> = Vec::new();
         let mut objects = Vec::with_capacity(scene.objects.len());
-        let mut triangles = 0usize;
-        for o in &scene.objects {
+        for (i, o) in scene.objects.iter().enumerate() {
             let view = scene.camera.view(o.shading.viewer);
             objects.push(GpuObject::new(&o.material, &o.shading, &view));
             let m = &o.mesh;
@@ -400,7 +638,7 @@ impl Gpu {
                     let n = facet_normal(a, b, c).to_array();
                     let centroid = ((a + b + c) / 3.0).to_array();
                     for p in [a, b, c] {
-                        indices.push((vertices.len() - base) as u32);
+                        indices.push(vertices.len() as u32);
                         vertices.push(GpuVertex {
                             position: p.to_array(),
                             normal: n,
@@ -414,35 +652,41 @@ impl Gpu {
                     normal: n.to_array(),
                     centroid: p.to_array(),
                 }));
-                indices.extend(m.triangles().iter().flatten());
+                indices.extend(m.triangles().iter().flatten().map(|&k| k + base as u32));
             }
-            triangles += m.triangles().len();
-            draws.push((first..indices.len() as u32, base as i32, !o.shading.options.two_sided));
+            vertex_object.resize(vertices.len(), i as u32);
+            draws.push((first..indices.len() as u32, !o.shading.options.two_sided));
         }
+        let triangles = indices.len() / 3;
         let max_buf = self
             .limits
             .max_buffer_size
             .min(self.limits.max_storage_buffer_binding_size);
+        let vertex_limit = if compute { max_buf } else { self.limits.max_buffer_size };
         self.check_limit(
             "vertex buffer bytes",
             (vertices.len() * size_of::<GpuVertex>()) as u64,
-            self.limits.max_buffer_size,
+            vertex_limit,
         )?;
-        self.check_limit(
-            "index buffer bytes",
-            (indices.len() * 4) as u64,
-            self.limits.max_buffer_size,
-        )?;
+        self.check_limit("index buffer bytes", (indices.len() * 4) as u64, vertex_limit)?;
         self.check_limit(
             "lights",
             scene.lighting.lights().len() as u64 * size_of::<GpuLight>() as u64,
             max_buf,
         )?;
+        if compute {
+            self.check_limit("visibility buffer bytes", u64::from(w) * u64::from(h) * 8, max_buf)?;
+            self.check_limit(
+                "per-vertex colour bytes",
+                vertices.len() as u64 * size_of::<[[f32; 4]; 4]>() as u64,
+                max_buf,
+            )?;
+        }
 
         let lights: Vec<GpuLight> = scene.lighting.lights().iter().map(GpuLight::from).collect();
         let cam = &scene.camera;
         let frame = GpuFrame {
-            clip_from_world: cam.clip_from_world(w as f32 / h as f32).to_cols_array(),
+            clip_from_world: clip_from_world.to_cols_array(),
             eye: [cam.eye().x, cam.eye().y, cam.eye().z, cam.near()],
             forward: [cam.forward().x, cam.forward().y, cam.forward().z, cam.far()],
             ambient: [
@@ -453,6 +697,8 @@ impl Gpu {
             ],
             counts: [lights.len() as u32, 0, 0, 0],
         };
+        let bg = scene.image.background;
+        let premultiplied = [bg[0] * bg[3], bg[1] * bg[3], bg[2] * bg[3], bg[3]];
 
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -464,16 +710,18 @@ impl Gpu {
                 usage,
             })
         };
-        let vb = buf("vertices", &non_empty(&vertices), wgpu::BufferUsages::VERTEX);
-        let ib = buf("indices", &non_empty(&indices), wgpu::BufferUsages::INDEX);
+        let empty = |label, size: u64, usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
         let fb = buf("frame", bytemuck::bytes_of(&frame), wgpu::BufferUsages::UNIFORM);
-        let lb = buf("lights", &non_empty(&lights), wgpu::BufferUsages::STORAGE);
-        let ob = buf("objects", &non_empty(&objects), wgpu::BufferUsages::STORAGE);
-        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("phong frame"),
-            layout: &self.layout,
-            entries: &entries(&[&fb, &lb, &ob]),
-        });
+        let lb = buf("lights", &non_empty(&lights), storage);
+        let ob = buf("objects", &non_empty(&objects), storage);
         let size = wgpu::Extent3d {
             width: w,
             height: h,
@@ -495,67 +743,359 @@ impl Gpu {
             "resolved",
             COLOR_FORMAT,
             1,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            wgpu::TextureUsages::COPY_SRC
+                | if compute {
+                    wgpu::TextureUsages::STORAGE_BINDING
+                } else {
+                    wgpu::TextureUsages::RENDER_ATTACHMENT
+                },
         );
-        let msaa =
-            (samples > 1).then(|| texture("msaa", COLOR_FORMAT, samples, wgpu::TextureUsages::RENDER_ATTACHMENT));
-        let depth = texture("depth", DEPTH_FORMAT, samples, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let resolved_view = resolved.create_view(&Default::default());
-        let msaa_view = msaa.as_ref().map(|t| t.create_view(&Default::default()));
-        let depth_view = depth.create_view(&Default::default());
-        let pipelines = [self.pipeline(samples, false), self.pipeline(samples, true)];
-        let bg = scene.image.background;
-        let upload = t0.elapsed();
-
-        let t1 = Instant::now();
-        let mut enc = d.create_command_encoder(&Default::default());
-        {
-            let (view, resolve_target) = match &msaa_view {
-                Some(m) => (m, Some(&resolved_view)),
-                None => (&resolved_view, None),
-            };
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("phong"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: f64::from(bg[0] * bg[3]),
-                            g: f64::from(bg[1] * bg[3]),
-                            b: f64::from(bg[2] * bg[3]),
-                            a: f64::from(bg[3]),
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                ..Default::default()
+        let timing = self.has_timestamps().then(|| {
+            let set = d.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("phong pass time"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
             });
-            pass.set_bind_group(0, &bind, &[]);
-            pass.set_vertex_buffer(0, vb.slice(..));
-            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-            for (i, (range, base, cull)) in draws.iter().enumerate() {
-                if range.is_empty() {
-                    continue;
+            let resolved = empty(
+                "pass time",
+                16,
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            );
+            (set, resolved)
+        });
+        let feedback = empty(
+            "feedback",
+            32,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        );
+
+        let drawing = if compute {
+            let kernels = self.kernels()?;
+            let raster = GpuRaster {
+                size: [w, h, vertices.len() as u32, triangles as u32],
+                background: premultiplied,
+                items: [self.item_capacity, 0, 0, 0],
+            };
+            let rb = buf("raster", bytemuck::bytes_of(&raster), wgpu::BufferUsages::UNIFORM);
+            let vb = buf("vertices", &non_empty(&vertices), storage);
+            let vob = buf("vertex objects", &non_empty(&vertex_object), storage);
+            let ib = buf("indices", &non_empty(&indices), storage);
+            let projected = empty("projected", vertices.len() as u64 * 16, storage);
+            let colors = empty("vertex colours", vertices.len() as u64 * 64, storage);
+            let visibility = empty("visibility", u64::from(w) * u64::from(h) * 8, storage);
+            let items = empty("items", u64::from(self.item_capacity) * 8, storage);
+            let counter = empty("item count", 16, storage | wgpu::BufferUsages::COPY_SRC);
+            let dispatch = empty("item dispatch", 16, storage | wgpu::BufferUsages::INDIRECT);
+            let resources: [(u32, wgpu::BindingResource); 15] = [
+                (0, fb.as_entire_binding()),
+                (1, lb.as_entire_binding()),
+                (2, ob.as_entire_binding()),
+                (3, rb.as_entire_binding()),
+                (4, vb.as_entire_binding()),
+                (5, vob.as_entire_binding()),
+                (6, ib.as_entire_binding()),
+                (7, projected.as_entire_binding()),
+                (8, colors.as_entire_binding()),
+                (9, visibility.as_entire_binding()),
+                (10, items.as_entire_binding()),
+                (11, counter.as_entire_binding()),
+                (12, dispatch.as_entire_binding()),
+                (13, visibility.as_entire_binding()),
+                (14, wgpu::BindingResource::TextureView(&resolved_view)),
+            ];
+            let max_groups = self.limits.max_compute_workgroups_per_dimension;
+            let stage = |k: Kernel, threads: Option<(u64, u32)>| -> Result<ComputeStage, Error> {
+                let pipeline = kernels.get(k).clone();
+                let used = k.bindings();
+                let entries: Vec<wgpu::BindGroupEntry> = resources
+                    .iter()
+                    .filter(|(b, _)| used.contains(b))
+                    .map(|(b, r)| wgpu::BindGroupEntry {
+                        binding: *b,
+                        resource: r.clone(),
+                    })
+                    .collect();
+                let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(k.name()),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                });
+                let groups = match threads {
+                    None => None,
+                    Some((n, size)) => Some(
+                        dispatch_groups(n, size, max_groups)
+                            .ok_or_else(|| self.fail("preparing the compute rasterizer", format!("{n} threads")))?,
+                    ),
+                };
+                Ok(ComputeStage { pipeline, bind, groups })
+            };
+            let pixels = u64::from(w) * u64::from(h);
+            let stages = vec![
+                stage(Kernel::Clear, Some((pixels, 64)))?,
+                stage(Kernel::Vertex, Some((vertices.len() as u64, 64)))?,
+                stage(Kernel::Raster, Some((triangles as u64, 64)))?,
+                stage(Kernel::Args, Some((1, 1)))?,
+                stage(Kernel::Tiles, None)?,
+                ComputeStage {
+                    groups: Some((w.div_ceil(8), h.div_ceil(8))),
+                    ..stage(Kernel::Shade, None)?
+                },
+            ];
+            Drawing::Compute {
+                stages,
+                counter,
+                dispatch,
+                _buffers: vec![fb, lb, ob, rb, vb, vob, ib, projected, colors, visibility, items],
+            }
+        } else {
+            let vb = buf("vertices", &non_empty(&vertices), wgpu::BufferUsages::VERTEX);
+            let ib = buf("indices", &non_empty(&indices), wgpu::BufferUsages::INDEX);
+            let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("phong frame"),
+                layout: &self.layout,
+                entries: &entries(&[&fb, &lb, &ob]),
+            });
+            let msaa =
+                (samples > 1).then(|| texture("msaa", COLOR_FORMAT, samples, wgpu::TextureUsages::RENDER_ATTACHMENT));
+            let depth = texture("depth", DEPTH_FORMAT, samples, wgpu::TextureUsages::RENDER_ATTACHMENT);
+            Drawing::Pipeline {
+                vb,
+                ib,
+                bind,
+                msaa_view: msaa.as_ref().map(|t| t.create_view(&Default::default())),
+                depth_view: depth.create_view(&Default::default()),
+                draws,
+                pipelines: [self.pipeline(samples, false), self.pipeline(samples, true)],
+            }
+        };
+        if let Some(e) = pollster::block_on(validation.pop()) {
+            return Err(self.fail("preparing the frame", e.to_string()));
+        }
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(self.fail("preparing the frame (out of memory)", e.to_string()));
+        }
+        Ok(Prepared {
+            width: w,
+            height: h,
+            background: bg,
+            premultiplied,
+            triangles,
+            item_capacity: self.item_capacity,
+            resolved,
+            resolved_view,
+            timing,
+            feedback,
+            drawing,
+        })
+    }
+
+    /// Why the compute rasterizer cannot draw `scene` (`None`: it can): it needs one sample
+    /// per pixel, 64-bit atomics, and every object's bounding box in front of the near plane,
+    /// behind the far plane and within ±32768 pixels of the window (so that no triangle needs
+    /// clipping and snapped coordinates fit its integers).
+    pub fn compute_reason(&self, scene: &Scene, clip_from_world: &glam::Mat4) -> Option<String> {
+        let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
+        if !self.device.features().contains(needed) {
+            return Some(format!("the adapter {} has no 64-bit atomics", self.info.name));
+        }
+        if scene.image.samples != 1 {
+            return Some(format!(
+                "it draws one sample per pixel (antialias = {})",
+                scene.image.samples
+            ));
+        }
+        let (w, h) = (scene.image.width as f32, scene.image.height as f32);
+        for (i, o) in scene.objects.iter().enumerate() {
+            let Some((lo, hi)) = o.mesh.bounds() else { continue };
+            for k in 0..8 {
+                let p = glam::Vec3::new(
+                    if k & 1 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 4 == 0 { lo.z } else { hi.z },
+                );
+                let c = *clip_from_world * p.extend(1.0);
+                let sx = (c.x / c.w * 0.5 + 0.5) * w;
+                let sy = (0.5 - c.y / c.w * 0.5) * h;
+                let inside =
+                    c.w > 0.0 && c.z >= -c.w && c.z <= c.w && sx.abs() <= 32768.0 - w && sy.abs() <= 32768.0 - h;
+                if !inside {
+                    return Some(format!(
+                        "object {} reaches outside the view volume (near or far plane, or far off screen)",
+                        i + 1
+                    ));
                 }
-                pass.set_pipeline(&pipelines[usize::from(*cull)]);
-                pass.draw_indexed(range.clone(), *base, i as u32..i as u32 + 1);
             }
         }
-        self.queue.submit([enc.finish()]);
-        self.wait("rendering")?;
-        let render = t1.elapsed();
+        None
+    }
 
-        let t2 = Instant::now();
+    fn kernels(&self) -> Result<&Kernels, Error> {
+        self.kernels
+            .get_or_init(|| {
+                let d = &self.device;
+                let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+                let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("phong compute rasterizer"),
+                    source: wgpu::ShaderSource::Wgsl(RASTER_WGSL.into()),
+                });
+                let make = |k: Kernel| {
+                    d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(k.name()),
+                        layout: None,
+                        module: &module,
+                        entry_point: Some(k.name()),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                };
+                let kernels = Kernels(Kernel::ALL.map(make));
+                match pollster::block_on(scope.pop()) {
+                    Some(e) => Err(e.to_string()),
+                    None => Ok(kernels),
+                }
+            })
+            .as_ref()
+            .map_err(|e| self.fail("building the compute rasterizer", e.clone()))
+    }
+
+    /// Draws a prepared frame and waits for it: wall-clock time, the GPU's own time, and
+    /// whether the compute rasterizer's tile list overflowed (the image is then incomplete).
+    pub fn draw(&self, p: &Prepared) -> Result<Drawn, Error> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let t1 = Instant::now();
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        match &p.drawing {
+            Drawing::Pipeline {
+                vb,
+                ib,
+                bind,
+                msaa_view,
+                depth_view,
+                draws,
+                pipelines,
+            } => {
+                let (view, resolve_target) = match msaa_view {
+                    Some(m) => (m, Some(&p.resolved_view)),
+                    None => (&p.resolved_view, None),
+                };
+                let bg = p.premultiplied.map(f64::from);
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("phong"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: bg[0],
+                                g: bg[1],
+                                b: bg[2],
+                                a: bg[3],
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: depth_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Discard,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: p.timing.as_ref().map(|(set, _)| wgpu::RenderPassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }),
+                    ..Default::default()
+                });
+                pass.set_bind_group(0, bind, &[]);
+                pass.set_vertex_buffer(0, vb.slice(..));
+                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                for (i, (range, cull)) in draws.iter().enumerate() {
+                    if range.is_empty() {
+                        continue;
+                    }
+                    pass.set_pipeline(&pipelines[usize::from(*cull)]);
+                    pass.draw_indexed(range.clone(), 0, i as u32..i as u32 + 1);
+                }
+            }
+            Drawing::Compute {
+                stages,
+                counter,
+                dispatch,
+                ..
+            } => {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("phong compute rasterizer"),
+                    timestamp_writes: p.timing.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }),
+                });
+                for s in stages {
+                    pass.set_pipeline(&s.pipeline);
+                    pass.set_bind_group(0, &s.bind, &[]);
+                    match s.groups {
+                        Some((x, y)) => pass.dispatch_workgroups(x, y, 1),
+                        None => pass.dispatch_workgroups_indirect(dispatch, 0),
+                    }
+                }
+                drop(pass);
+                enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 16, 4);
+            }
+        }
+        if let Some((set, resolved)) = &p.timing {
+            enc.resolve_query_set(set, 0..2, resolved, 0);
+            enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 0, 16);
+        }
+        self.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        p.feedback.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait("rendering")?;
+        let wall = t1.elapsed();
+        if let Some(e) = pollster::block_on(validation.pop()) {
+            return Err(self.fail("rendering", e.to_string()));
+        }
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(self.fail("rendering (out of memory)", e.to_string()));
+        }
+        rx.recv()
+            .map_err(|e| self.fail("rendering", e.to_string()))?
+            .map_err(|e| self.fail("rendering", e.to_string()))?;
+        let words: [u32; 8] = {
+            let data = p
+                .feedback
+                .get_mapped_range(..)
+                .map_err(|e| self.fail("rendering", e.to_string()))?;
+            bytemuck::pod_read_unaligned(&data[..32])
+        };
+        p.feedback.unmap();
+        // Ticks × period (ns per tick); a counter that went backwards gives none.
+        let ticks = [
+            u64::from(words[0]) | u64::from(words[1]) << 32,
+            u64::from(words[2]) | u64::from(words[3]) << 32,
+        ];
+        let gpu = p.timing.as_ref().and_then(|_| {
+            let ns = ticks[1].checked_sub(ticks[0])? as f64 * f64::from(self.queue.get_timestamp_period());
+            Some(Duration::from_secs_f64(ns * 1e-9))
+        });
+        let overflowed = matches!(p.drawing, Drawing::Compute { .. }) && words[4] > p.item_capacity;
+        Ok(Drawn { wall, gpu, overflowed })
+    }
+
+    /// Reads a drawn frame back into a straight-alpha linear image.
+    pub fn read(&self, p: &Prepared) -> Result<Image, Error> {
+        let (w, h) = (p.width, p.height);
+        let d = &self.device;
+        let scope = d.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = d.push_error_scope(wgpu::ErrorFilter::Validation);
         let row = u64::from(w) * 8;
         let align = u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let padded = row.div_ceil(align) * align;
@@ -573,7 +1113,7 @@ impl Gpu {
         let mut enc = d.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
-                texture: &resolved,
+                texture: &p.resolved,
                 mip_level: 0,
                 origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
@@ -586,7 +1126,11 @@ impl Gpu {
                     rows_per_image: Some(h),
                 },
             },
-            size,
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
         );
         self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -595,43 +1139,35 @@ impl Gpu {
         });
         self.wait("reading the image back")?;
         if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(self.fail("rendering", e.to_string()));
+            return Err(self.fail("reading the image back", e.to_string()));
         }
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(self.fail("rendering (out of memory)", e.to_string()));
+            return Err(self.fail("reading the image back (out of memory)", e.to_string()));
         }
         rx.recv()
             .map_err(|e| self.fail("reading the image back", e.to_string()))?
             .map_err(|e| self.fail("reading the image back", e.to_string()))?;
-        let pixels = {
-            let data = out
-                .get_mapped_range(..)
-                .map_err(|e| self.fail("reading the image back", e.to_string()))?;
-            let mut pixels = Vec::with_capacity(w as usize * h as usize);
-            for y in 0..h as usize {
-                let line = &data[y * padded as usize..y * padded as usize + row as usize];
-                for px in line.chunks_exact(8) {
-                    let c = [0, 1, 2, 3].map(|k| f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]])));
-                    pixels.push(if c[3] > 0.0 {
-                        [c[0] / c[3], c[1] / c[3], c[2] / c[3], c[3]]
-                    } else {
-                        [bg[0], bg[1], bg[2], 0.0]
-                    });
-                }
-            }
-            pixels
-        };
+        // One copy out of the mapping first: it may be uncached memory, slow to read in
+        // small pieces.
+        let data = out
+            .get_mapped_range(..)
+            .map_err(|e| self.fail("reading the image back", e.to_string()))?
+            .to_vec();
         out.unmap();
-        let image = Image::from_pixels(w, h, pixels)?;
-        Ok((
-            image,
-            GpuStats {
-                upload,
-                render,
-                readback: t2.elapsed(),
-                triangles,
-            },
-        ))
+        let bg = p.background;
+        let mut pixels = Vec::with_capacity(w as usize * h as usize);
+        for y in 0..h as usize {
+            let line = &data[y * padded as usize..y * padded as usize + row as usize];
+            for px in line.chunks_exact(8) {
+                let c = [0, 1, 2, 3].map(|k| f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]])));
+                pixels.push(if c[3] > 0.0 {
+                    [c[0] / c[3], c[1] / c[3], c[2] / c[3], c[3]]
+                } else {
+                    [bg[0], bg[1], bg[2], 0.0]
+                });
+            }
+        }
+        Ok(Image::from_pixels(w, h, pixels)?)
     }
 
     /// Runs the WGSL shading function on `cases` in a compute pass: case `i` shades point
@@ -726,5 +1262,35 @@ impl Gpu {
                 color: c(k * 16 + 12),
             })
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every thread has a group, `x` within the limit, and no whole row of groups is idle.
+    #[test]
+    fn dispatch_groups_cover_every_thread() {
+        for (n, size, max) in [
+            (0u64, 64u32, 65535u32),
+            (1, 64, 65535),
+            (64, 64, 65535),
+            (65, 64, 65535),
+            (999_000, 64, 65535),
+            (65535 * 64, 64, 65535),
+            (65535 * 64 + 1, 64, 65535),
+            (16_000_000, 64, 65535),
+            (40, 1, 7),
+        ] {
+            let (x, y) = dispatch_groups(n, size, max).unwrap();
+            assert!(x <= max && x >= 1 && y >= 1, "{n} {size} {max}: {x} {y}");
+            assert!(u64::from(x) * u64::from(y) * u64::from(size) >= n, "{n}: {x} {y}");
+            assert!(
+                u64::from(x) * u64::from(y - 1) * u64::from(size) < n.max(1),
+                "{n}: {x} {y}"
+            );
+        }
+        assert_eq!(dispatch_groups(50, 1, 7), None);
     }
 }

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use phong_core::*;
-use phong_gpu::Gpu;
+use phong_gpu::{Gpu, GpuPath};
 use std::path::Path;
 
 fn gpu() -> Option<Gpu> {
@@ -149,12 +149,8 @@ fn load(name: &str) -> Scene {
     phong_scene::load(&p).unwrap().scene
 }
 
-/// Every example scene on both backends: at least 99.5% of pixels within 2/255 per channel
-/// (8-bit encoded), the rest on silhouettes and edges. On failure the GPU image and a
-/// difference image are written to the temporary directory.
-#[test]
-fn example_scenes_match_the_cpu() {
-    let Some(gpu) = gpu() else { return };
+/// The example scenes' file names.
+fn example_names() -> Vec<String> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
     let mut names: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
@@ -165,49 +161,156 @@ fn example_scenes_match_the_cpu() {
         .collect();
     names.sort();
     assert!(names.len() >= 7);
-    for name in names {
+    names
+}
+
+/// Pixels of the GPU image `gimg` more than `tolerance`/255 from the CPU image of `scene`
+/// in some channel (8-bit encoded), and the largest difference. Above `max_fraction` of the
+/// pixels, the GPU image and a difference image are written to the temporary directory and
+/// the test fails.
+fn compare(name: &str, scene: &Scene, gimg: &Image, tolerance: u8, max_fraction: f64) -> (usize, u8) {
+    let cpu = phong_raster::render(scene, &Default::default()).unwrap();
+    let enc = scene.image.encoding;
+    let alpha = cpu.has_transparency();
+    let (a, b) = (cpu.to_bytes(enc, alpha), gimg.to_bytes(enc, alpha));
+    let ch = if alpha { 4 } else { 3 };
+    let worst = a.iter().zip(&b).map(|(p, q)| p.abs_diff(*q)).max().unwrap_or(0);
+    let bad = a
+        .chunks(ch)
+        .zip(b.chunks(ch))
+        .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > tolerance))
+        .count();
+    let total = (scene.image.width * scene.image.height) as usize;
+    let frac = bad as f64 / total as f64;
+    eprintln!(
+        "{name}: {bad} of {total} pixels differ by more than {tolerance}/255 ({:.3}%), at most {worst}/255",
+        frac * 100.0
+    );
+    if frac > max_fraction {
+        let out = std::env::temp_dir();
+        let write = |file: &str, data: &[u8]| {
+            let f = std::fs::File::create(out.join(file)).unwrap();
+            let mut e = png::Encoder::new(f, scene.image.width, scene.image.height);
+            e.set_color(if alpha {
+                png::ColorType::Rgba
+            } else {
+                png::ColorType::Rgb
+            });
+            e.write_header().unwrap().write_image_data(data).unwrap();
+        };
+        write(&format!("{name}.gpu.png"), &b);
+        let diff: Vec<u8> = a
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| p.abs_diff(*q).saturating_mul(32))
+            .collect();
+        write(&format!("{name}.diff.png"), &diff);
+        panic!("{name}: {bad} pixels differ; images in {}", out.display());
+    }
+    (bad, worst)
+}
+
+/// Every example scene on both backends, through the render pipeline: at least 99.5% of
+/// pixels within 2/255 per channel (8-bit encoded), the rest on silhouettes and edges. On
+/// failure the GPU image and a difference image are written to the temporary directory.
+#[test]
+fn example_scenes_match_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    gpu.set_path(GpuPath::Pipeline);
+    for name in example_names() {
         let mut scene = load(&name);
         scene.image.width = 320;
         scene.image.height = 200;
-        let cpu = phong_raster::render(&scene, &Default::default()).unwrap();
-        let (gimg, _) = gpu.render(&scene).unwrap();
-        let enc = scene.image.encoding;
-        let alpha = cpu.has_transparency();
-        let (a, b) = (cpu.to_bytes(enc, alpha), gimg.to_bytes(enc, alpha));
-        let ch = if alpha { 4 } else { 3 };
-        let bad = a
-            .chunks(ch)
-            .zip(b.chunks(ch))
-            .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| p.abs_diff(*q) > 2))
-            .count();
-        let total = (scene.image.width * scene.image.height) as usize;
-        let frac = bad as f64 / total as f64;
-        eprintln!(
-            "{name}: {bad} of {total} pixels differ by more than 2/255 ({:.3}%)",
-            frac * 100.0
-        );
-        if frac > 0.005 {
-            let out = std::env::temp_dir();
-            let write = |file: &str, data: &[u8]| {
-                let f = std::fs::File::create(out.join(file)).unwrap();
-                let mut e = png::Encoder::new(f, scene.image.width, scene.image.height);
-                e.set_color(if alpha {
-                    png::ColorType::Rgba
-                } else {
-                    png::ColorType::Rgb
-                });
-                e.write_header().unwrap().write_image_data(data).unwrap();
-            };
-            write(&format!("{name}.gpu.png"), &b);
-            let diff: Vec<u8> = a
-                .iter()
-                .zip(&b)
-                .map(|(p, q)| p.abs_diff(*q).saturating_mul(32))
-                .collect();
-            write(&format!("{name}.diff.png"), &diff);
-            panic!("{name}: {bad} pixels differ; images in {}", out.display());
-        }
+        let (gimg, stats) = gpu.render(&scene).unwrap();
+        assert!(!stats.compute);
+        compare(&name, &scene, &gimg, 2, 0.005);
     }
+}
+
+/// The compute rasterizer does the CPU's arithmetic (snapping, 64-bit edges, top-left rule,
+/// depth ties to the first triangle), so it is held closer: every example scene it can draw
+/// (one sample per pixel) at least 99.9% of pixels within 1/255 (lavapipe: all of them). Scenes it cannot draw are
+/// named; at least half of the examples must be drawn by it.
+#[test]
+fn compute_rasterizer_matches_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    gpu.set_path(GpuPath::Compute);
+    let names = example_names();
+    let mut drawn = 0;
+    for name in &names {
+        let mut scene = load(name);
+        scene.image.width = 320;
+        scene.image.height = 200;
+        scene.image.samples = 1;
+        let m = scene.camera.clip_from_world(320.0 / 200.0);
+        if let Some(why) = gpu.compute_reason(&scene, &m) {
+            if why.contains("64-bit atomics") {
+                eprintln!("skipped: {why}");
+                return;
+            }
+            eprintln!("{name}: not drawn by the compute rasterizer: {why}");
+            assert!(gpu.render(&scene).unwrap_err().to_string().contains(&why));
+            continue;
+        }
+        let (gimg, stats) = gpu.render(&scene).unwrap();
+        assert!(stats.compute);
+        compare(name, &scene, &gimg, 1, 0.001);
+        drawn += 1;
+    }
+    assert!(2 * drawn >= names.len(), "{drawn} of {}", names.len());
+}
+
+/// A frame whose large triangles' tiles overflow the compute rasterizer's list is drawn again
+/// by the pipeline (automatic path), or is an error (compute path asked for).
+#[test]
+fn compute_overflow_falls_back_to_the_pipeline() {
+    let Some(mut gpu) = gpu() else { return };
+    // A full-screen quad of two triangles, each boxing the whole image: 2 × 20 × 13 tiles of
+    // 16×16 at 320×200.
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/scenes/fill_4lights.toml");
+    let mut scene = phong_scene::load(&p).unwrap().scene;
+    scene.image.width = 320;
+    scene.image.height = 200;
+    scene.image.samples = 1;
+    let m = scene.camera.clip_from_world(320.0 / 200.0);
+    if let Some(why) = gpu.compute_reason(&scene, &m) {
+        eprintln!("skipped: {why}");
+        return;
+    }
+    // With room for every tile: drawn by the compute rasterizer.
+    gpu.set_item_capacity(520);
+    let (gimg, stats) = gpu.render(&scene).unwrap();
+    assert!(stats.compute);
+    compare("fill_4lights.toml (compute)", &scene, &gimg, 1, 0.0);
+    gpu.set_item_capacity(519);
+    let (gimg, stats) = gpu.render(&scene).unwrap();
+    assert!(!stats.compute);
+    compare("fill_4lights.toml (fallen back)", &scene, &gimg, 2, 0.005);
+    gpu.set_path(GpuPath::Compute);
+    let e = gpu.render(&scene).unwrap_err().to_string();
+    assert!(e.contains("overflowed"), "{e}");
+}
+
+/// Where the adapter has timestamp queries, each render reports its pass's GPU time, and that
+/// time lies inside the wall-clock interval from submitting the pass to its completion.
+#[test]
+fn pass_time_lies_within_the_render() {
+    let Some(gpu) = gpu() else { return };
+    let scene = load("terms.toml");
+    let (_, stats) = gpu.render(&scene).unwrap();
+    if !gpu.has_timestamps() {
+        assert!(stats.gpu_pass.is_none());
+        eprintln!("skipped: the adapter has no timestamp queries");
+        return;
+    }
+    let pass = stats.gpu_pass.expect("a timed pass");
+    assert!(pass > std::time::Duration::ZERO, "{pass:?}");
+    // 1 ms of slack for the GPU's clock against the CPU's.
+    assert!(
+        pass <= stats.render + std::time::Duration::from_millis(1),
+        "{pass:?} > {:?}",
+        stats.render
+    );
 }
 
 #[test]
