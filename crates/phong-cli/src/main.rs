@@ -387,6 +387,8 @@ fn bench(a: BenchArgs) -> Result<()> {
     // GPU: uploaded once and drawn `frames` times (as the CPU renderer's buffers are kept);
     // read back from the first few frames.
     let mut gpu_path = "";
+    // The compute rasterizer's kernels on the GPU, summed over frames.
+    let mut gpu_stages: Vec<(&str, Duration)> = Vec::new();
     let reads = a.frames.min(3);
     match &gpu {
         Some(g) => {
@@ -406,6 +408,12 @@ fn bench(a: BenchArgs) -> Result<()> {
                 let drawn = g.draw(&prepared)?;
                 sum[1] += drawn.wall;
                 gpu_pass = gpu_pass.zip(drawn.gpu).map(|(a, b)| a + b);
+                if gpu_stages.is_empty() {
+                    gpu_stages = drawn.stages.iter().map(|&(k, _)| (k, Duration::ZERO)).collect();
+                }
+                for (total, (_, d)) in gpu_stages.iter_mut().zip(&drawn.stages) {
+                    total.1 += *d;
+                }
                 if frame < reads {
                     let t = Instant::now();
                     g.read(&prepared)?;
@@ -453,15 +461,24 @@ fn bench(a: BenchArgs) -> Result<()> {
     if a.run.verbose {
         let ms = |d: Duration| d.as_secs_f64() * 1e3 / f64::from(a.frames);
         match &gpu {
-            Some(g) => eprintln!(
-                "phong: gpu ({}, {gpu_path}) upload (once)={:.2}ms per frame: render={:.3}ms (on the GPU: {}) \
-                 readback={:.2}ms",
-                g.adapter_name(),
-                ms(sum[0]),
-                ms(sum[1]),
-                gpu_pass.map_or("no timestamps".into(), |d| format!("pass={:.3}ms", ms(d))),
-                sum[2].as_secs_f64() * 1e3 / f64::from(reads)
-            ),
+            Some(g) => {
+                eprintln!(
+                    "phong: gpu ({}, {gpu_path}) upload (once)={:.2}ms per frame: render={:.3}ms (on the GPU: {}) \
+                     readback={:.2}ms",
+                    g.adapter_name(),
+                    ms(sum[0]),
+                    ms(sum[1]),
+                    gpu_pass.map_or("no timestamps".into(), |d| format!("pass={:.3}ms", ms(d))),
+                    sum[2].as_secs_f64() * 1e3 / f64::from(reads)
+                );
+                if !gpu_stages.is_empty() {
+                    let list: Vec<String> = gpu_stages
+                        .iter()
+                        .map(|(k, d)| format!("{}={:.3}ms", k.trim_start_matches("cs_"), ms(*d)))
+                        .collect();
+                    eprintln!("phong: gpu kernels per frame: {}", list.join(" "));
+                }
+            }
             None => eprintln!(
                 "phong: cpu per frame: setup+binning={:.2}ms raster+shade+resolve={:.2}ms \
                  (in the tiles, CPU time over all threads: rasterisation={:.2}ms shading={:.2}ms resolve={:.2}ms)",

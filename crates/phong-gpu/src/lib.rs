@@ -27,6 +27,7 @@ mod gpu_types;
 
 pub use gpu_types::{GpuCase, GpuFrame, GpuGlobals, GpuLight, GpuObject, GpuRaster, GpuVertex};
 
+use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
 use phong_core::mesh::facet_normal;
 use phong_core::{
     Color, Image, Interpolation, Lighting, Material, Scene, Shading, ShadingSettings, SurfacePoint, View,
@@ -51,7 +52,7 @@ const RASTER_WGSL: &str = concat!(
 );
 /// Tile items (triangle, 16×16 tile) the compute rasterizer holds per frame (8 bytes each): a
 /// frame that needs more is drawn again by the pipeline.
-const ITEM_CAPACITY: u32 = 1 << 22;
+const ITEM_CAPACITY: u32 = 1 << 21;
 const COMPUTE_WGSL: &str = concat!(include_str!("shade.wgsl"), include_str!("compute.wgsl"));
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -149,10 +150,12 @@ pub struct Prepared {
     item_capacity: u32,
     resolved: wgpu::Texture,
     resolved_view: wgpu::TextureView,
-    /// Timestamps of the pass and the buffer they are resolved into.
+    /// Timestamps (the start and end of each pass) and the buffer they are resolved into.
     timing: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    /// Mapped after each draw: the two timestamps, then the compute path's item count.
+    /// Mapped after each draw: the compute path's item count (16 bytes), then the timestamps.
     feedback: wgpu::Buffer,
+    /// Passes drawn: one (the pipeline's) or one per compute kernel.
+    passes: u32,
     drawing: Drawing,
 }
 
@@ -183,11 +186,12 @@ enum Drawing {
     },
 }
 
-/// One dispatch of the compute rasterizer: workgroups `(x, y)`, or indirect (the tiles).
+/// One dispatch of the compute rasterizer: workgroups `(x, y)`, or indirect from this offset
+/// of the dispatch buffer (large triangles, tiles).
 struct ComputeStage {
     pipeline: wgpu::ComputePipeline,
     bind: wgpu::BindGroup,
-    groups: Option<(u32, u32)>,
+    groups: Result<(u32, u32), u64>,
 }
 
 /// The compute rasterizer's entry points, in dispatch order.
@@ -197,16 +201,18 @@ enum Kernel {
     Vertex,
     Raster,
     Args,
+    Expand,
     Tiles,
     Shade,
 }
 
 impl Kernel {
-    const ALL: [Kernel; 6] = [
+    const ALL: [Kernel; 7] = [
         Kernel::Clear,
         Kernel::Vertex,
         Kernel::Raster,
         Kernel::Args,
+        Kernel::Expand,
         Kernel::Tiles,
         Kernel::Shade,
     ];
@@ -217,6 +223,7 @@ impl Kernel {
             Kernel::Vertex => "cs_vertex",
             Kernel::Raster => "cs_raster",
             Kernel::Args => "cs_args",
+            Kernel::Expand => "cs_expand",
             Kernel::Tiles => "cs_tiles",
             Kernel::Shade => "cs_shade",
         }
@@ -227,15 +234,16 @@ impl Kernel {
         match self {
             Kernel::Clear => &[3, 11, 13],
             Kernel::Vertex => &[0, 1, 2, 3, 4, 5, 7, 8],
-            Kernel::Raster => &[2, 3, 5, 6, 7, 9, 10, 11],
+            Kernel::Raster => &[2, 3, 5, 6, 7, 9, 11, 15],
             Kernel::Args => &[3, 11, 12],
+            Kernel::Expand => &[10, 11, 15],
             Kernel::Tiles => &[2, 3, 5, 6, 7, 9, 10, 11],
             Kernel::Shade => &[0, 1, 2, 3, 4, 5, 6, 7, 8, 13, 14],
         }
     }
 }
 
-struct Kernels([wgpu::ComputePipeline; 6]);
+struct Kernels([wgpu::ComputePipeline; 7]);
 
 impl Kernels {
     fn get(&self, k: Kernel) -> &wgpu::ComputePipeline {
@@ -244,12 +252,15 @@ impl Kernels {
 }
 
 /// What [`Gpu::draw`] measured.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Drawn {
     /// Submitting the frame and waiting for it (wall clock).
     pub wall: Duration,
-    /// The pass's own time on the GPU (timestamp queries), where the adapter has them.
+    /// The frame's time on the GPU, from the start of its first pass to the end of its last
+    /// (timestamp queries), where the adapter has them.
     pub gpu: Option<Duration>,
+    /// The compute rasterizer's kernels' times on the GPU (with timestamps), in order.
+    pub stages: Vec<(&'static str, Duration)>,
     /// The compute rasterizer's tile list overflowed: the image is incomplete.
     pub overflowed: bool,
 }
@@ -323,24 +334,6 @@ fn non_empty<T: bytemuck::Pod + bytemuck::Zeroable>(v: &[T]) -> Vec<u8> {
         bytemuck::bytes_of(&T::zeroed()).to_vec()
     } else {
         bytemuck::cast_slice(v).to_vec()
-    }
-}
-
-/// IEEE half to f32.
-fn f16_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exp = i32::from((h >> 10) & 0x1f);
-    let frac = f32::from(h & 0x3ff);
-    sign * match exp {
-        0 => frac * (2.0f32).powi(-24),
-        31 => {
-            if frac == 0.0 {
-                f32::INFINITY
-            } else {
-                f32::NAN
-            }
-        }
-        _ => (1.0 + frac / 1024.0) * (2.0f32).powi(exp - 15),
     }
 }
 
@@ -751,22 +744,23 @@ impl Gpu {
                 },
         );
         let resolved_view = resolved.create_view(&Default::default());
+        let passes = if compute { Kernel::ALL.len() as u32 } else { 1 };
         let timing = self.has_timestamps().then(|| {
             let set = d.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("phong pass time"),
+                label: Some("phong pass times"),
                 ty: wgpu::QueryType::Timestamp,
-                count: 2,
+                count: 2 * passes,
             });
             let resolved = empty(
-                "pass time",
-                16,
+                "pass times",
+                16 * u64::from(passes),
                 wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             );
             (set, resolved)
         });
         let feedback = empty(
             "feedback",
-            32,
+            16 + 16 * u64::from(passes),
             wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         );
 
@@ -786,8 +780,9 @@ impl Gpu {
             let visibility = empty("visibility", u64::from(w) * u64::from(h) * 8, storage);
             let items = empty("items", u64::from(self.item_capacity) * 8, storage);
             let counter = empty("item count", 16, storage | wgpu::BufferUsages::COPY_SRC);
-            let dispatch = empty("item dispatch", 16, storage | wgpu::BufferUsages::INDIRECT);
-            let resources: [(u32, wgpu::BindingResource); 15] = [
+            let dispatch = empty("dispatches", 32, storage | wgpu::BufferUsages::INDIRECT);
+            let large = empty("large triangles", u64::from(self.item_capacity / 2 + 1) * 16, storage);
+            let resources: [(u32, wgpu::BindingResource); 16] = [
                 (0, fb.as_entire_binding()),
                 (1, lb.as_entire_binding()),
                 (2, ob.as_entire_binding()),
@@ -803,9 +798,10 @@ impl Gpu {
                 (12, dispatch.as_entire_binding()),
                 (13, visibility.as_entire_binding()),
                 (14, wgpu::BindingResource::TextureView(&resolved_view)),
+                (15, large.as_entire_binding()),
             ];
             let max_groups = self.limits.max_compute_workgroups_per_dimension;
-            let stage = |k: Kernel, threads: Option<(u64, u32)>| -> Result<ComputeStage, Error> {
+            let stage = |k: Kernel, threads: Result<(u64, u32), u64>| -> Result<ComputeStage, Error> {
                 let pipeline = kernels.get(k).clone();
                 let used = k.bindings();
                 let entries: Vec<wgpu::BindGroupEntry> = resources
@@ -822,31 +818,30 @@ impl Gpu {
                     entries: &entries,
                 });
                 let groups = match threads {
-                    None => None,
-                    Some((n, size)) => Some(
-                        dispatch_groups(n, size, max_groups)
-                            .ok_or_else(|| self.fail("preparing the compute rasterizer", format!("{n} threads")))?,
-                    ),
+                    Err(offset) => Err(offset),
+                    Ok((n, size)) => Ok(dispatch_groups(n, size, max_groups)
+                        .ok_or_else(|| self.fail("preparing the compute rasterizer", format!("{n} threads")))?),
                 };
                 Ok(ComputeStage { pipeline, bind, groups })
             };
             let pixels = u64::from(w) * u64::from(h);
             let stages = vec![
-                stage(Kernel::Clear, Some((pixels, 64)))?,
-                stage(Kernel::Vertex, Some((vertices.len() as u64, 64)))?,
-                stage(Kernel::Raster, Some((triangles as u64, 64)))?,
-                stage(Kernel::Args, Some((1, 1)))?,
-                stage(Kernel::Tiles, None)?,
+                stage(Kernel::Clear, Ok((pixels, 64)))?,
+                stage(Kernel::Vertex, Ok((vertices.len() as u64, 64)))?,
+                stage(Kernel::Raster, Ok((triangles as u64, 64)))?,
+                stage(Kernel::Args, Ok((1, 1)))?,
+                stage(Kernel::Expand, Err(0))?,
+                stage(Kernel::Tiles, Err(16))?,
                 ComputeStage {
-                    groups: Some((w.div_ceil(8), h.div_ceil(8))),
-                    ..stage(Kernel::Shade, None)?
+                    groups: Ok((w.div_ceil(8), h.div_ceil(8))),
+                    ..stage(Kernel::Shade, Err(0))?
                 },
             ];
             Drawing::Compute {
                 stages,
                 counter,
                 dispatch,
-                _buffers: vec![fb, lb, ob, rb, vb, vob, ib, projected, colors, visibility, items],
+                _buffers: vec![fb, lb, ob, rb, vb, vob, ib, projected, colors, visibility, items, large],
             }
         } else {
             let vb = buf("vertices", &non_empty(&vertices), wgpu::BufferUsages::VERTEX);
@@ -886,6 +881,7 @@ impl Gpu {
             resolved_view,
             timing,
             feedback,
+            passes,
             drawing,
         })
     }
@@ -1029,29 +1025,30 @@ impl Gpu {
                 dispatch,
                 ..
             } => {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("phong compute rasterizer"),
-                    timestamp_writes: p.timing.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }),
-                });
-                for s in stages {
+                // One pass per kernel, each timed (the passes' boundaries are the barriers
+                // the dispatches need anyway).
+                for (i, s) in (0u32..).zip(stages) {
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(Kernel::ALL[i as usize].name()),
+                        timestamp_writes: p.timing.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                            query_set: set,
+                            beginning_of_pass_write_index: Some(2 * i),
+                            end_of_pass_write_index: Some(2 * i + 1),
+                        }),
+                    });
                     pass.set_pipeline(&s.pipeline);
                     pass.set_bind_group(0, &s.bind, &[]);
                     match s.groups {
-                        Some((x, y)) => pass.dispatch_workgroups(x, y, 1),
-                        None => pass.dispatch_workgroups_indirect(dispatch, 0),
+                        Ok((x, y)) => pass.dispatch_workgroups(x, y, 1),
+                        Err(offset) => pass.dispatch_workgroups_indirect(dispatch, offset),
                     }
                 }
-                drop(pass);
-                enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 16, 4);
+                enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 0, 4);
             }
         }
         if let Some((set, resolved)) = &p.timing {
-            enc.resolve_query_set(set, 0..2, resolved, 0);
-            enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 0, 16);
+            enc.resolve_query_set(set, 0..2 * p.passes, resolved, 0);
+            enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 16, 16 * u64::from(p.passes));
         }
         self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -1069,25 +1066,41 @@ impl Gpu {
         rx.recv()
             .map_err(|e| self.fail("rendering", e.to_string()))?
             .map_err(|e| self.fail("rendering", e.to_string()))?;
-        let words: [u32; 8] = {
+        let (count, ticks): (u32, Vec<u64>) = {
             let data = p
                 .feedback
                 .get_mapped_range(..)
                 .map_err(|e| self.fail("rendering", e.to_string()))?;
-            bytemuck::pod_read_unaligned(&data[..32])
+            (
+                bytemuck::pod_read_unaligned(&data[..4]),
+                bytemuck::pod_collect_to_vec(&data[16..]),
+            )
         };
         p.feedback.unmap();
         // Ticks × period (ns per tick); a counter that went backwards gives none.
-        let ticks = [
-            u64::from(words[0]) | u64::from(words[1]) << 32,
-            u64::from(words[2]) | u64::from(words[3]) << 32,
-        ];
-        let gpu = p.timing.as_ref().and_then(|_| {
-            let ns = ticks[1].checked_sub(ticks[0])? as f64 * f64::from(self.queue.get_timestamp_period());
-            Some(Duration::from_secs_f64(ns * 1e-9))
-        });
-        let overflowed = matches!(p.drawing, Drawing::Compute { .. }) && words[4] > p.item_capacity;
-        Ok(Drawn { wall, gpu, overflowed })
+        let period = f64::from(self.queue.get_timestamp_period());
+        let span = |a: u64, b: u64| Some(Duration::from_secs_f64(b.checked_sub(a)? as f64 * period * 1e-9));
+        let (gpu, stages) = match &p.timing {
+            None => (None, Vec::new()),
+            Some(_) => {
+                let stages = match p.drawing {
+                    Drawing::Compute { .. } => Kernel::ALL
+                        .iter()
+                        .zip(ticks.chunks_exact(2))
+                        .filter_map(|(k, t)| Some((k.name(), span(t[0], t[1])?)))
+                        .collect(),
+                    Drawing::Pipeline { .. } => Vec::new(),
+                };
+                (span(ticks[0], ticks[ticks.len() - 1]), stages)
+            }
+        };
+        let overflowed = matches!(p.drawing, Drawing::Compute { .. }) && count > p.item_capacity;
+        Ok(Drawn {
+            wall,
+            gpu,
+            stages,
+            overflowed,
+        })
     }
 
     /// Reads a drawn frame back into a straight-alpha linear image.
@@ -1147,19 +1160,23 @@ impl Gpu {
         rx.recv()
             .map_err(|e| self.fail("reading the image back", e.to_string()))?
             .map_err(|e| self.fail("reading the image back", e.to_string()))?;
-        // One copy out of the mapping first: it may be uncached memory, slow to read in
-        // small pieces.
-        let data = out
-            .get_mapped_range(..)
-            .map_err(|e| self.fail("reading the image back", e.to_string()))?
-            .to_vec();
+        // The halves out of the mapping in one copy, then converted by `half` (F16C where the
+        // processor has it): a 4K frame's conversion channel by channel in scalar code took
+        // about 300 ms on an H100 machine's Xeon.
+        let halves: Vec<u16> = {
+            let data = out
+                .get_mapped_range(..)
+                .map_err(|e| self.fail("reading the image back", e.to_string()))?;
+            bytemuck::pod_collect_to_vec(&data[..])
+        };
         out.unmap();
+        let mut floats = vec![0f32; halves.len()];
+        halves.reinterpret_cast::<half::f16>().convert_to_f32_slice(&mut floats);
         let bg = p.background;
+        let stride = padded as usize / 2;
         let mut pixels = Vec::with_capacity(w as usize * h as usize);
         for y in 0..h as usize {
-            let line = &data[y * padded as usize..y * padded as usize + row as usize];
-            for px in line.chunks_exact(8) {
-                let c = [0, 1, 2, 3].map(|k| f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]])));
+            for c in floats[y * stride..y * stride + 4 * w as usize].chunks_exact(4) {
                 pixels.push(if c[3] > 0.0 {
                     [c[0] / c[3], c[1] / c[3], c[2] / c[3], c[3]]
                 } else {

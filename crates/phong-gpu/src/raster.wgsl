@@ -8,11 +8,12 @@
 // the pipeline (frame.wgsl), interpolated perspective-correctly.
 //
 // 1. cs_vertex: per vertex, window position and (Gouraud, flat) colours.
-// 2. cs_raster: per triangle; small ones test their pixels here, large ones append one item
-//    per 16×16 tile of their box.
-// 3. cs_args: the indirect dispatch of the items. 4. cs_tiles: one workgroup per item.
+// 2. cs_raster: per triangle; small ones test their pixels here, large ones reserve one item
+//    per 16×16 tile of their box and are listed.
+// 3. cs_args: the indirect dispatches of the next two. 4. cs_expand: one workgroup per large
+//    triangle writes its items. 5. cs_tiles: one workgroup per item tests its pixels.
 //    Both tests keep max(~depth << 32 | ~triangle) per pixel (64-bit atomic max).
-// 5. cs_shade: per pixel, the visible triangle's barycentrics, the fragment stage, the image.
+// 6. cs_shade: per pixel, the visible triangle's barycentrics, the fragment stage, the image.
 
 struct Raster {
     // x: width, y: height, z: vertices, w: triangles.
@@ -40,12 +41,15 @@ struct Colors {
 @group(0) @binding(8) var<storage, read_write> colors: array<Colors>;
 @group(0) @binding(9) var<storage, read_write> visibility: array<atomic<u64>>;
 @group(0) @binding(10) var<storage, read_write> items: array<vec2<u32>>;
-// x: items appended (may exceed the capacity: then the frame is drawn again by the pipeline).
+// [0]: items reserved (may exceed the capacity: then the frame is drawn again by the
+// pipeline); [1]: large triangles listed.
 @group(0) @binding(11) var<storage, read_write> counter: array<atomic<u32>>;
 @group(0) @binding(12) var<storage, read_write> dispatch: array<u32>;
 // The visibility buffer's words, for clearing and shading.
 @group(0) @binding(13) var<storage, read_write> visibility_words: array<vec2<u32>>;
 @group(0) @binding(14) var image: texture_storage_2d<rgba16float, write>;
+// Large triangles: triangle, first item, first tile (x | y << 16), tiles across | down << 16.
+@group(0) @binding(15) var<storage, read_write> large: array<vec4<u32>>;
 
 const SUBPIXEL: i64 = 256li;
 const HALF: i64 = 128li;
@@ -75,6 +79,7 @@ fn cs_clear(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     let i = linear_id(gid, nwg, 64u);
     if (i == 0u) {
         atomicStore(&counter[0], 0u);
+        atomicStore(&counter[1], 0u);
     }
     if (i < raster.size.x * raster.size.y) {
         visibility_words[i] = vec2<u32>(0u);
@@ -253,30 +258,45 @@ fn cs_raster(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         }
         return;
     }
-    let t0 = s.box_min / TILE;
-    let t1 = (s.box_max - vec2<i32>(1)) / TILE;
-    let n = u32((t1.x - t0.x + 1) * (t1.y - t0.y + 1));
+    let t0 = vec2<u32>(s.box_min / TILE);
+    let span = vec2<u32>((s.box_max - vec2<i32>(1)) / TILE) - t0 + vec2<u32>(1u);
+    let n = span.x * span.y;
     let first = atomicAdd(&counter[0], n);
-    if (first >= raster.items.x) {
+    if (first + n > raster.items.x) {
         return;
     }
-    var k = first;
-    for (var ty = t0.y; ty <= t1.y; ty++) {
-        for (var tx = t0.x; tx <= t1.x; tx++) {
-            if (k < raster.items.x) {
-                items[k] = vec2<u32>(t, u32(tx) | (u32(ty) << 16u));
-            }
-            k++;
-        }
-    }
+    // Every large triangle has at least two tiles, so no more than capacity / 2 are listed.
+    let b = atomicAdd(&counter[1], 1u);
+    large[b] = vec4<u32>(t, first, t0.x | (t0.y << 16u), span.x | (span.y << 16u));
+}
+
+// Workgroups for `n` groups' worth of work, at most MAX_GROUPS across (read back as
+// wid.x + wid.y · MAX_GROUPS).
+fn write_args(at: u32, n: u32) {
+    dispatch[at] = min(n, MAX_GROUPS);
+    dispatch[at + 1u] = (n + MAX_GROUPS - 1u) / MAX_GROUPS;
+    dispatch[at + 2u] = 1u;
 }
 
 @compute @workgroup_size(1)
 fn cs_args() {
-    let n = min(atomicLoad(&counter[0]), raster.items.x);
-    dispatch[0] = min(n, MAX_GROUPS);
-    dispatch[1] = (n + MAX_GROUPS - 1u) / MAX_GROUPS;
-    dispatch[2] = 1u;
+    write_args(0u, atomicLoad(&counter[1]));
+    write_args(4u, min(atomicLoad(&counter[0]), raster.items.x));
+}
+
+@compute @workgroup_size(256)
+fn cs_expand(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let b = wid.x + wid.y * MAX_GROUPS;
+    if (b >= atomicLoad(&counter[1])) {
+        return;
+    }
+    let e = large[b];
+    let t0 = vec2<u32>(e.z & 0xffffu, e.z >> 16u);
+    let span = vec2<u32>(e.w & 0xffffu, e.w >> 16u);
+    for (var j = lid; j < span.x * span.y; j += 256u) {
+        let tile = t0 + vec2<u32>(j % span.x, j / span.x);
+        items[e.y + j] = vec2<u32>(e.x, tile.x | (tile.y << 16u));
+    }
 }
 
 @compute @workgroup_size(16, 16)
