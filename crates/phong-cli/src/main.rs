@@ -408,16 +408,21 @@ fn bench(a: BenchArgs) -> Result<()> {
                 let drawn = g.draw(&prepared)?;
                 sum[1] += drawn.wall;
                 gpu_pass = gpu_pass.zip(drawn.gpu).map(|(a, b)| a + b);
+                if frame < reads {
+                    let t = Instant::now();
+                    g.read(&prepared)?;
+                    sum[2] += t.elapsed();
+                }
+            }
+            // -v: the compute kernels' times, from as many frames again, each kernel in its
+            // own timed pass (not in the frame times above: the passes cost time of their own).
+            for _ in 0..if a.run.verbose { a.frames } else { 0 } {
+                let drawn = g.draw_stages(&prepared)?;
                 if gpu_stages.is_empty() {
                     gpu_stages = drawn.stages.iter().map(|&(k, _)| (k, Duration::ZERO)).collect();
                 }
                 for (total, (_, d)) in gpu_stages.iter_mut().zip(&drawn.stages) {
                     total.1 += *d;
-                }
-                if frame < reads {
-                    let t = Instant::now();
-                    g.read(&prepared)?;
-                    sum[2] += t.elapsed();
                 }
             }
         }
@@ -476,7 +481,10 @@ fn bench(a: BenchArgs) -> Result<()> {
                         .iter()
                         .map(|(k, d)| format!("{}={:.3}ms", k.trim_start_matches("cs_"), ms(*d)))
                         .collect();
-                    eprintln!("phong: gpu kernels per frame: {}", list.join(" "));
+                    eprintln!(
+                        "phong: gpu kernels per frame (each timed in its own pass): {}",
+                        list.join(" ")
+                    );
                 }
             }
             None => eprintln!(

@@ -154,7 +154,7 @@ pub struct Prepared {
     timing: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     /// Mapped after each draw: the compute path's item count (16 bytes), then the timestamps.
     feedback: wgpu::Buffer,
-    /// Passes drawn: one (the pipeline's) or one per compute kernel.
+    /// Timed passes at most: one (the pipeline's) or one per compute kernel.
     passes: u32,
     drawing: Drawing,
 }
@@ -259,7 +259,8 @@ pub struct Drawn {
     /// The frame's time on the GPU, from the start of its first pass to the end of its last
     /// (timestamp queries), where the adapter has them.
     pub gpu: Option<Duration>,
-    /// The compute rasterizer's kernels' times on the GPU (with timestamps), in order.
+    /// The compute rasterizer's kernels' times on the GPU, in order ([`Gpu::draw_stages`] with
+    /// timestamps; empty otherwise).
     pub stages: Vec<(&'static str, Duration)>,
     /// The compute rasterizer's tile list overflowed: the image is incomplete.
     pub overflowed: bool,
@@ -958,6 +959,19 @@ impl Gpu {
     /// Draws a prepared frame and waits for it: wall-clock time, the GPU's own time, and
     /// whether the compute rasterizer's tile list overflowed (the image is then incomplete).
     pub fn draw(&self, p: &Prepared) -> Result<Drawn, Error> {
+        self.draw_timed(p, false)
+    }
+
+    /// [`Gpu::draw`], the compute rasterizer's kernels each in its own timed pass
+    /// ([`Drawn::stages`]). The passes' boundaries cost time of their own (about 0.08 ms of a
+    /// 4K frame on an H100), so frames are timed whole by [`Gpu::draw`].
+    pub fn draw_stages(&self, p: &Prepared) -> Result<Drawn, Error> {
+        self.draw_timed(p, true)
+    }
+
+    fn draw_timed(&self, p: &Prepared, per_kernel: bool) -> Result<Drawn, Error> {
+        let per_kernel = per_kernel && matches!(p.drawing, Drawing::Compute { .. });
+        let passes = if per_kernel { p.passes } else { 1 };
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let t1 = Instant::now();
@@ -1025,30 +1039,36 @@ impl Gpu {
                 dispatch,
                 ..
             } => {
-                // One pass per kernel, each timed (the passes' boundaries are the barriers
-                // the dispatches need anyway).
-                for (i, s) in (0u32..).zip(stages) {
+                // One pass (wgpu puts barriers between its dispatches), or one per kernel.
+                let groups: Vec<&[ComputeStage]> = if per_kernel {
+                    stages.chunks(1).collect()
+                } else {
+                    vec![&stages[..]]
+                };
+                for (i, group) in (0u32..).zip(groups) {
                     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some(Kernel::ALL[i as usize].name()),
+                        label: Some("phong compute rasterizer"),
                         timestamp_writes: p.timing.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
                             query_set: set,
                             beginning_of_pass_write_index: Some(2 * i),
                             end_of_pass_write_index: Some(2 * i + 1),
                         }),
                     });
-                    pass.set_pipeline(&s.pipeline);
-                    pass.set_bind_group(0, &s.bind, &[]);
-                    match s.groups {
-                        Ok((x, y)) => pass.dispatch_workgroups(x, y, 1),
-                        Err(offset) => pass.dispatch_workgroups_indirect(dispatch, offset),
+                    for s in group {
+                        pass.set_pipeline(&s.pipeline);
+                        pass.set_bind_group(0, &s.bind, &[]);
+                        match s.groups {
+                            Ok((x, y)) => pass.dispatch_workgroups(x, y, 1),
+                            Err(offset) => pass.dispatch_workgroups_indirect(dispatch, offset),
+                        }
                     }
                 }
                 enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 0, 4);
             }
         }
         if let Some((set, resolved)) = &p.timing {
-            enc.resolve_query_set(set, 0..2 * p.passes, resolved, 0);
-            enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 16, 16 * u64::from(p.passes));
+            enc.resolve_query_set(set, 0..2 * passes, resolved, 0);
+            enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 16, 16 * u64::from(passes));
         }
         self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -1083,13 +1103,15 @@ impl Gpu {
         let (gpu, stages) = match &p.timing {
             None => (None, Vec::new()),
             Some(_) => {
-                let stages = match p.drawing {
-                    Drawing::Compute { .. } => Kernel::ALL
+                let ticks = &ticks[..2 * passes as usize];
+                let stages = if per_kernel {
+                    Kernel::ALL
                         .iter()
                         .zip(ticks.chunks_exact(2))
                         .filter_map(|(k, t)| Some((k.name(), span(t[0], t[1])?)))
-                        .collect(),
-                    Drawing::Pipeline { .. } => Vec::new(),
+                        .collect()
+                } else {
+                    Vec::new()
                 };
                 (span(ticks[0], ticks[ticks.len() - 1]), stages)
             }

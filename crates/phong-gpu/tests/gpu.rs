@@ -306,11 +306,38 @@ fn pass_time_lies_within_the_render() {
     let pass = stats.gpu_pass.expect("a timed pass");
     assert!(pass > std::time::Duration::ZERO, "{pass:?}");
     // 1 ms of slack for the GPU's clock against the CPU's.
-    assert!(
-        pass <= stats.render + std::time::Duration::from_millis(1),
-        "{pass:?} > {:?}",
-        stats.render
-    );
+    let slack = std::time::Duration::from_millis(1);
+    assert!(pass <= stats.render + slack, "{pass:?} > {:?}", stats.render);
+    // The compute rasterizer's kernels, each in its own pass: all seven, in order, within the
+    // frame's span on the GPU, itself within the wall-clock draw.
+    let mut scene = scene;
+    scene.image.samples = 1;
+    let m = scene
+        .camera
+        .clip_from_world(scene.image.width as f32 / scene.image.height as f32);
+    if gpu.compute_reason(&scene, &m).is_none() {
+        let prepared = gpu.prepare(&scene).unwrap();
+        assert!(prepared.is_compute());
+        assert!(gpu.draw(&prepared).unwrap().stages.is_empty());
+        let drawn = gpu.draw_stages(&prepared).unwrap();
+        let names: Vec<&str> = drawn.stages.iter().map(|s| s.0).collect();
+        assert_eq!(
+            names,
+            [
+                "cs_clear",
+                "cs_vertex",
+                "cs_raster",
+                "cs_args",
+                "cs_expand",
+                "cs_tiles",
+                "cs_shade"
+            ]
+        );
+        let total = drawn.gpu.unwrap();
+        let sum: std::time::Duration = drawn.stages.iter().map(|s| s.1).sum();
+        assert!(sum <= total, "{sum:?} > {total:?}");
+        assert!(total <= drawn.wall + slack, "{total:?} > {:?}", drawn.wall);
+    }
 }
 
 #[test]
