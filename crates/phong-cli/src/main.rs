@@ -185,7 +185,12 @@ fn main() -> ExitCode {
                     || c.downcast_ref::<phong_core::Error>().is_some()
                     || matches!(
                         c.downcast_ref::<phong_gpu::Error>(),
-                        Some(phong_gpu::Error::Samples(_) | phong_gpu::Error::Limit { .. } | phong_gpu::Error::Core(_))
+                        Some(
+                            phong_gpu::Error::Samples(_)
+                                | phong_gpu::Error::Limit { .. }
+                                | phong_gpu::Error::Core(_)
+                                | phong_gpu::Error::Compute(_)
+                        )
                     )
                     || matches!(
                         c.downcast_ref::<phong_raster::Error>(),

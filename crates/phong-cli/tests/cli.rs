@@ -324,7 +324,7 @@ fn golden_images() {
 }
 
 /// `--backend gpu` with no Vulkan driver: a clear error and exit code 1; `auto` falls back to
-/// the CPU. With a driver (lavapipe in CI), `--backend gpu` renders.
+/// the CPU. With a driver (lavapipe in CI), `--backend gpu` renders, by the path asked for.
 #[test]
 fn gpu_backend_selection() {
     let out = tmp("gpu.png");
@@ -363,6 +363,49 @@ fn gpu_backend_selection() {
     if o.status.success() {
         assert!(stderr(&o).contains("backend gpu"), "{}", stderr(&o));
         assert_eq!(read_png(&out).0, 120);
+        // How the GPU drew it, as asked; the compute rasterizer refuses MSAA (exit 2, input).
+        for (path, said) in [("pipeline", "render pipeline"), ("compute", "compute rasterizer")] {
+            let mut a = a.clone();
+            a.extend(["--gpu-path", path, "--antialias", "1"]);
+            let o = phong(&a);
+            assert!(o.status.success(), "{}", stderr(&o));
+            assert!(stderr(&o).contains(said), "{path}: {}", stderr(&o));
+        }
+        // `bench --backend gpu -v`: the line, the path, and the kernels' times where the
+        // adapter has timestamps.
+        let o = phong(&[
+            "bench",
+            "benches/scenes/fill_4lights.toml",
+            "--backend",
+            "gpu",
+            "--frames",
+            "2",
+            "--width",
+            "64",
+            "--height",
+            "32",
+            "-v",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let line = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            line.starts_with("phong: 64x32 tris=") && line.contains(" frames=2 ms_per_frame="),
+            "{line}"
+        );
+        let e = stderr(&o);
+        assert!(e.contains("compute rasterizer") && e.contains("readback="), "{e}");
+        if !e.contains("no timestamps") {
+            assert!(e.contains("gpu kernels per frame") && e.contains("shade="), "{e}");
+        }
+        let mut a = a.clone();
+        a.extend(["--gpu-path", "compute", "--antialias", "4"]);
+        let o = phong(&a);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("cannot draw this frame: it draws one sample per pixel"),
+            "{}",
+            stderr(&o)
+        );
     } else if std::env::var_os("PHONG_REQUIRE_GPU").is_some() {
         panic!("PHONG_REQUIRE_GPU is set but: {}", stderr(&o));
     } else {
