@@ -438,6 +438,13 @@ impl Gpu {
         self.item_capacity = items.max(1);
     }
 
+    /// The largest storage buffer binding the device allows, in bytes.
+    pub fn max_storage_bytes(&self) -> u64 {
+        self.limits
+            .max_buffer_size
+            .min(self.limits.max_storage_buffer_binding_size)
+    }
+
     /// Whether renders time their pass on the GPU ([`GpuStats::gpu_pass`]): the adapter has
     /// timestamp queries.
     pub fn has_timestamps(&self) -> bool {
@@ -908,6 +915,35 @@ impl Gpu {
                 "it draws one sample per pixel (antialias = {})",
                 scene.image.samples
             ));
+        }
+        // Its storage buffers: the visibility buffer, and per vertex its record, projection and
+        // colours (flat objects' vertices de-indexed, three per triangle).
+        let max = self.max_storage_bytes();
+        let vertices: u64 = scene
+            .objects
+            .iter()
+            .map(|o| match o.shading.interpolation {
+                Interpolation::Flat => 3 * o.mesh.triangles().len() as u64,
+                _ => o.mesh.positions().len() as u64,
+            })
+            .sum();
+        let triangles = scene.triangle_count() as u64;
+        for (what, bytes) in [
+            (
+                "visibility buffer",
+                u64::from(scene.image.width) * u64::from(scene.image.height) * 8,
+            ),
+            ("per-vertex colours", vertices * 64),
+            ("indices", triangles * 12),
+        ] {
+            if bytes > max {
+                return Some(format!(
+                    "its {what} ({bytes} bytes) exceeds the adapter's storage buffer limit ({max} bytes)"
+                ));
+            }
+        }
+        if triangles >= u64::from(u32::MAX) {
+            return Some(format!("it numbers triangles in 32 bits ({triangles} triangles)"));
         }
         let (w, h) = (scene.image.width as f32, scene.image.height as f32);
         for (i, o) in scene.objects.iter().enumerate() {

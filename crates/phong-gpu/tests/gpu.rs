@@ -260,6 +260,35 @@ fn compute_rasterizer_matches_the_cpu() {
     assert!(2 * drawn >= names.len(), "{drawn} of {}", names.len());
 }
 
+/// A frame whose visibility buffer would exceed the adapter's storage buffers is not for the
+/// compute rasterizer (the automatic path then takes the pipeline); the reason says so.
+#[test]
+fn compute_rasterizer_respects_buffer_limits() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("terms.toml");
+    scene.image.samples = 1;
+    let max = gpu.max_storage_bytes();
+    // The smallest square whose 8-byte-per-pixel visibility buffer exceeds the limit.
+    let side = (((max / 8) as f64).sqrt() as u64 + 1) as u32;
+    if side > phong_core::limits::MAX_IMAGE_DIMENSION {
+        eprintln!("skipped: this adapter's storage buffers hold any image ({max} bytes)");
+        return;
+    }
+    let m = scene.camera.clip_from_world(1.0);
+    for (s, over) in [(side - 1, false), (side, true)] {
+        scene.image.width = s;
+        scene.image.height = s;
+        let why = gpu.compute_reason(&scene, &m);
+        assert_eq!(why.is_some(), over, "{s}: {why:?}");
+        if let Some(why) = why {
+            assert!(
+                why.contains("visibility buffer") && why.contains("storage buffer limit"),
+                "{why}"
+            );
+        }
+    }
+}
+
 /// A frame whose large triangles' tiles overflow the compute rasterizer's list is drawn again
 /// by the pipeline (automatic path), or is an error (compute path asked for).
 #[test]
