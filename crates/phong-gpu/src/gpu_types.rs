@@ -166,6 +166,10 @@ pub struct GpuRaster {
     pub size: [u32; 4],
     /// The premultiplied background.
     pub background: [f32; 4],
-    /// x: the tile item capacity.
+    /// x: the tile item capacity; y: samples per pixel.
     pub items: [u32; 4],
+    /// The sample offsets' bounds in 1/256 pixel: min x, max x, min y, max y.
+    pub span: [i32; 4],
+    /// The sample offsets in 1/256 pixel (x, y, unused, unused).
+    pub pattern: [[i32; 4]; 16],
 }

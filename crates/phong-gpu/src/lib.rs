@@ -9,8 +9,9 @@
 //! - the render pipeline: the GPU's rasterizer, a `Depth32Float` depth buffer, MSAA;
 //! - the compute rasterizer (`raster.wgsl`): a visibility buffer filled by 64-bit atomics with
 //!   the CPU renderer's coverage arithmetic, then shaded per pixel by the same fragment
-//!   function. Where it can draw a frame (one sample per pixel, 64-bit atomics, no triangle
-//!   to clip: [`Gpu::compute_reason`]) it is the default: on an H100, whose graphics stages
+//!   function, per pixel and triangle, then resolved as the CPU renderer resolves. Where it
+//!   can draw a frame (64-bit atomics, no triangle to clip, buffers within the adapter's
+//!   limits: [`Gpu::compute_reason`]) it is the default: on an H100, whose graphics stages
 //!   run on 2 of 66 TPCs, it draws a 1M-triangle sphere with 8 lights at 4K in 0.43 ms
 //!   against the pipeline's 13.2 ms, and its images are within 1/255 of the CPU's.
 //!
@@ -683,7 +684,7 @@ impl Gpu {
             max_buf,
         )?;
         if compute {
-            self.check_limit("visibility buffer bytes", u64::from(w) * u64::from(h) * 8, max_buf)?;
+            self.check_limit("visibility buffer bytes", samples_total * 8, max_buf)?;
             self.check_limit(
                 "per-vertex colour bytes",
                 vertices.len() as u64 * size_of::<[[f32; 4]; 4]>() as u64,
@@ -781,10 +782,28 @@ impl Gpu {
 
         let drawing = if compute {
             let kernels = self.kernels()?;
+            // The CPU renderer's sample pattern, as it snaps it (1/256 pixel).
+            let offsets: Vec<[i32; 2]> = phong_core::limits::sample_pattern(samples)
+                .iter()
+                .map(|&(x, y)| [(x * 256.0).round() as i32, (y * 256.0).round() as i32])
+                .collect();
+            let mut pattern = [[0i32; 4]; 16];
+            for (p, o) in pattern.iter_mut().zip(&offsets) {
+                *p = [o[0], o[1], 0, 0];
+            }
+            let xs = offsets.iter().map(|o| o[0]);
+            let ys = offsets.iter().map(|o| o[1]);
             let raster = GpuRaster {
                 size: [w, h, vertices.len() as u32, triangles as u32],
                 background: premultiplied,
-                items: [self.item_capacity, 0, 0, 0],
+                items: [self.item_capacity, samples, 0, 0],
+                span: [
+                    xs.clone().min().unwrap_or(128),
+                    xs.max().unwrap_or(128),
+                    ys.clone().min().unwrap_or(128),
+                    ys.max().unwrap_or(128),
+                ],
+                pattern,
             };
             let rb = buf("raster", bytemuck::bytes_of(&raster), wgpu::BufferUsages::UNIFORM);
             let vb = buf("vertices", &non_empty(&vertices), storage);
@@ -792,7 +811,11 @@ impl Gpu {
             let ib = buf("indices", &non_empty(&indices), storage);
             let projected = empty("projected", vertices.len() as u64 * 16, storage);
             let colors = empty("vertex colours", vertices.len() as u64 * 64, storage);
-            let visibility = empty("visibility", u64::from(w) * u64::from(h) * 8, storage);
+            let visibility = empty(
+                "visibility",
+                u64::from(w) * u64::from(h) * u64::from(samples) * 8,
+                storage,
+            );
             let items = empty("items", u64::from(self.item_capacity) * 8, storage);
             let counter = empty("item count", 16, storage | wgpu::BufferUsages::COPY_SRC);
             let dispatch = empty("dispatches", 32, storage | wgpu::BufferUsages::INDIRECT);
@@ -839,9 +862,8 @@ impl Gpu {
                 };
                 Ok(ComputeStage { pipeline, bind, groups })
             };
-            let pixels = u64::from(w) * u64::from(h);
             let stages = vec![
-                stage(Kernel::Clear, Ok((pixels, 64)))?,
+                stage(Kernel::Clear, Ok((samples_total, 64)))?,
                 stage(Kernel::Vertex, Ok((vertices.len() as u64, 64)))?,
                 stage(Kernel::Raster, Ok((triangles as u64, 64)))?,
                 stage(Kernel::Args, Ok((1, 1)))?,
@@ -910,12 +932,6 @@ impl Gpu {
         if !self.device.features().contains(needed) {
             return Some(format!("the adapter {} has no 64-bit atomics", self.info.name));
         }
-        if scene.image.samples != 1 {
-            return Some(format!(
-                "it draws one sample per pixel (antialias = {})",
-                scene.image.samples
-            ));
-        }
         // Its storage buffers: the visibility buffer, and per vertex its record, projection and
         // colours (flat objects' vertices de-indexed, three per triangle).
         let max = self.max_storage_bytes();
@@ -931,7 +947,7 @@ impl Gpu {
         for (what, bytes) in [
             (
                 "visibility buffer",
-                u64::from(scene.image.width) * u64::from(scene.image.height) * 8,
+                u64::from(scene.image.width) * u64::from(scene.image.height) * u64::from(scene.image.samples) * 8,
             ),
             ("per-vertex colours", vertices * 64),
             ("indices", triangles * 12),

@@ -3,9 +3,10 @@
 // Some GPUs run the graphics pipeline's stages on a few of their cores (an H100 has two
 // graphics-capable TPCs of 66): there this path is many times faster. It is the CPU
 // renderer's arithmetic: vertices snapped to 1/256 pixel, edge functions in 64-bit integers
-// with the top-left rule, one sample per pixel at its centre, the nearest depth (the first
-// triangle on ties, as GL_LESS in draw order), then the same vertex and fragment stages as
-// the pipeline (frame.wgsl), interpolated perspective-correctly.
+// with the top-left rule, its sample patterns (1, 4 or 16 per pixel), the nearest depth per
+// sample (the first triangle on ties, as GL_LESS in draw order), then the same vertex and
+// fragment stages as the pipeline (frame.wgsl), interpolated perspective-correctly at the
+// pixel's centre once per visible triangle, and the CPU's resolve.
 //
 // 1. cs_vertex: per vertex, window position and (Gouraud, flat) colours.
 // 2. cs_raster: per triangle; small ones test their pixels here, large ones reserve one item
@@ -20,8 +21,12 @@ struct Raster {
     size: vec4<u32>,
     // Premultiplied background (what the pipeline clears to).
     background: vec4<f32>,
-    // x: item capacity.
+    // x: item capacity; y: samples per pixel (1, 4 or 16).
     items: vec4<u32>,
+    // The sample offsets' bounds in 1/256 pixel: min x, max x, min y, max y.
+    span: vec4<i32>,
+    // The CPU renderer's sample pattern: offsets within the pixel in 1/256 (x, y).
+    pattern: array<vec4<i32>, 16>,
 }
 
 struct Colors {
@@ -45,7 +50,7 @@ struct Colors {
 // pipeline); [1]: large triangles listed.
 @group(0) @binding(11) var<storage, read_write> counter: array<atomic<u32>>;
 @group(0) @binding(12) var<storage, read_write> dispatch: array<u32>;
-// The visibility buffer's words, for clearing and shading.
+// The visibility buffer's words (samples of a pixel together), for clearing and shading.
 @group(0) @binding(13) var<storage, read_write> visibility_words: array<vec2<u32>>;
 @group(0) @binding(14) var image: texture_storage_2d<rgba16float, write>;
 // Large triangles: triangle, first item, first tile (x | y << 16), tiles across | down << 16.
@@ -81,7 +86,7 @@ fn cs_clear(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         atomicStore(&counter[0], 0u);
         atomicStore(&counter[1], 0u);
     }
-    if (i < raster.size.x * raster.size.y) {
+    if (i < raster.size.x * raster.size.y * raster.items.y) {
         visibility_words[i] = vec2<u32>(0u);
     }
 }
@@ -174,10 +179,12 @@ fn setup(t: u32) -> Setup {
     }
     let lo = min(q0, min(q1, q2));
     let hi = max(q0, max(q1, q2));
-    // The first pixel whose centre is at or right of the minimum, the last at or left of the
-    // maximum (arithmetic shifts round down, negatives included).
-    s.box_min = max((lo - vec2<i32>(128) + vec2<i32>(255)) >> vec2<u32>(8u), vec2<i32>(0));
-    s.box_max = min(((hi - vec2<i32>(128)) >> vec2<u32>(8u)) + vec2<i32>(1), vec2<i32>(raster.size.xy));
+    // The first pixel with a sample at or right of the minimum, the last with one at or left
+    // of the maximum (arithmetic shifts round down, negatives included).
+    let span_min = raster.span.xz;
+    let span_max = raster.span.yw;
+    s.box_min = max((lo - span_max + vec2<i32>(255)) >> vec2<u32>(8u), vec2<i32>(0));
+    s.box_max = min(((hi - span_min) >> vec2<u32>(8u)) + vec2<i32>(1), vec2<i32>(raster.size.xy));
     if (any(s.box_min >= s.box_max)) {
         return s;
     }
@@ -208,7 +215,7 @@ fn setup(t: u32) -> Setup {
     return s;
 }
 
-// The edge functions at pixel `p`'s centre, and whether the pixel is covered.
+// The edge functions at a point of pixel `p` (offset `o` in 1/256), and whether it is covered.
 struct Edges {
     e0: i64,
     e1: i64,
@@ -216,9 +223,9 @@ struct Edges {
     covered: bool,
 }
 
-fn edges_at(s: Setup, p: vec2<i32>) -> Edges {
-    let x = i64(p.x) * SUBPIXEL + HALF;
-    let y = i64(p.y) * SUBPIXEL + HALF;
+fn edges_at(s: Setup, p: vec2<i32>, o: vec2<i32>) -> Edges {
+    let x = i64(p.x) * SUBPIXEL + i64(o.x);
+    let y = i64(p.y) * SUBPIXEL + i64(o.y);
     var e: Edges;
     e.e0 = s.a0 * x + s.b0 * y + s.c0;
     e.e1 = s.a1 * x + s.b1 * y + s.c1;
@@ -227,16 +234,21 @@ fn edges_at(s: Setup, p: vec2<i32>) -> Edges {
     return e;
 }
 
-// Depth test of triangle `t` at pixel `p`: the nearest depth, then the lowest triangle, wins.
+// Depth test of triangle `t` at each sample of pixel `p`: the nearest depth, then the lowest
+// triangle, wins.
 fn test_pixel(s: Setup, t: u32, p: vec2<i32>) {
-    let e = edges_at(s, p);
-    if (!e.covered) {
-        return;
-    }
     let inv = 1.0 / f32(s.area);
-    let z = clamp(f32(e.e0) * inv * s.z.x + f32(e.e1) * inv * s.z.y + f32(e.e2) * inv * s.z.z, 0.0, 1.0);
-    let key = (u64(~bitcast<u32>(z)) << 32u) | u64(~t);
-    atomicMax(&visibility[u32(p.y) * raster.size.x + u32(p.x)], key);
+    let ns = raster.items.y;
+    let base = (u32(p.y) * raster.size.x + u32(p.x)) * ns;
+    for (var k = 0u; k < ns; k++) {
+        let e = edges_at(s, p, raster.pattern[k].xy);
+        if (!e.covered) {
+            continue;
+        }
+        let z = clamp(f32(e.e0) * inv * s.z.x + f32(e.e1) * inv * s.z.y + f32(e.e2) * inv * s.z.z, 0.0, 1.0);
+        let key = (u64(~bitcast<u32>(z)) << 32u) | u64(~t);
+        atomicMax(&visibility[base + k], key);
+    }
 }
 
 @compute @workgroup_size(64)
@@ -316,21 +328,11 @@ fn cs_tiles(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id)
     test_pixel(s, t, p);
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= raster.size.x || gid.y >= raster.size.y) {
-        return;
-    }
-    let p = vec2<i32>(gid.xy);
-    let key = visibility_words[gid.y * raster.size.x + gid.x];
-    if (all(key == vec2<u32>(0u))) {
-        textureStore(image, p, raster.background);
-        return;
-    }
-    // Little-endian words: x holds ~triangle, y ~depth.
-    let t = ~key.x;
+// The colour of visible triangle `t` at pixel `p`'s centre (shading once per pixel, as the
+// CPU renderer, whichever of its samples the triangle covers).
+fn color_of(t: u32, p: vec2<i32>) -> vec3<f32> {
     let s = setup(t);
-    let e = edges_at(s, p);
+    let e = edges_at(s, p, vec2<i32>(128));
     let ids = vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
     let v = vec3<u32>(ids[s.order.x], ids[s.order.y], ids[s.order.z]);
     // Perspective-correct weights: λ_i/w_i normalised (the area cancels).
@@ -358,5 +360,59 @@ fn cs_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
         f.flat_color = colors[ids.x].flat_color.xyz;
         f.flat_back = colors[ids.x].flat_back.xyz;
     }
-    textureStore(image, p, vec4<f32>(fragment(f, !s.front), 1.0));
+    return fragment(f, !s.front);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= raster.size.x || gid.y >= raster.size.y) {
+        return;
+    }
+    let p = vec2<i32>(gid.xy);
+    let ns = raster.items.y;
+    let base = (gid.y * raster.size.x + gid.x) * ns;
+    if (ns == 1u) {
+        let key = visibility_words[base];
+        if (all(key == vec2<u32>(0u))) {
+            textureStore(image, p, raster.background);
+        } else {
+            // Little-endian words: x holds ~triangle, y ~depth.
+            textureStore(image, p, vec4<f32>(color_of(~key.x, p), 1.0));
+        }
+        return;
+    }
+    // Several samples: each distinct triangle shaded once, then the CPU's resolve in sample
+    // order, alpha-weighted (background samples carry the background's alpha).
+    var ids: array<u32, 16>;
+    var cols: array<vec3<f32>, 16>;
+    var distinct = 0u;
+    let bg = raster.background;
+    var acc = vec4<f32>(0.0);
+    for (var k = 0u; k < ns; k++) {
+        let key = visibility_words[base + k];
+        if (all(key == vec2<u32>(0u))) {
+            // Premultiplied: rgb · alpha, as the resolve sums.
+            acc += bg;
+            continue;
+        }
+        let t = ~key.x;
+        var c = vec3<f32>(0.0);
+        var found = false;
+        for (var j = 0u; j < distinct; j++) {
+            if (ids[j] == t) {
+                c = cols[j];
+                found = true;
+                break;
+            }
+        }
+        if (!found) {
+            c = color_of(t, p);
+            ids[distinct] = t;
+            cols[distinct] = c;
+            distinct++;
+        }
+        acc += vec4<f32>(c, 1.0);
+    }
+    // Premultiplied average; the read-back divides by alpha (straight alpha, as the CPU).
+    textureStore(image, p, acc / f32(ns));
 }

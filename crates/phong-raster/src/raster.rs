@@ -116,20 +116,7 @@ fn map3<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
     [f(a[0]), f(a[1]), f(a[2])]
 }
 
-/// Sample positions within a pixel, in [0, 1)², for 1, 4 and 16 samples.
-/// 1: the centre. 4: the D3D/Vulkan standard rotated grid. 16: a 4×4 grid.
-pub fn sample_pattern(samples: u32) -> Vec<(f32, f32)> {
-    match samples {
-        4 => [(-2.0, -6.0), (6.0, -2.0), (-6.0, 2.0), (2.0, 6.0)]
-            .iter()
-            .map(|&(x, y)| (0.5 + x / 16.0, 0.5 + y / 16.0))
-            .collect(),
-        16 => (0..16)
-            .map(|i| ((i % 4) as f32 * 0.25 + 0.125, (i / 4) as f32 * 0.25 + 0.125))
-            .collect(),
-        _ => vec![(0.5, 0.5)],
-    }
-}
+pub use phong_core::limits::sample_pattern;
 
 /// The term of `s` that `output` shows (normal and depth are not terms).
 #[inline]
