@@ -197,6 +197,7 @@ enum Drawing {
 /// One dispatch of the compute rasterizer: workgroups `(x, y)`, or indirect from this offset
 /// of the dispatch buffer (large triangles, tiles).
 struct ComputeStage {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
     bind: wgpu::BindGroup,
     groups: Result<(u32, u32), u64>,
@@ -212,10 +213,11 @@ enum Kernel {
     Expand,
     Tiles,
     Shade,
+    ShadeSamples,
 }
 
 impl Kernel {
-    const ALL: [Kernel; 7] = [
+    const ALL: [Kernel; 8] = [
         Kernel::Clear,
         Kernel::Vertex,
         Kernel::Raster,
@@ -223,7 +225,10 @@ impl Kernel {
         Kernel::Expand,
         Kernel::Tiles,
         Kernel::Shade,
+        Kernel::ShadeSamples,
     ];
+    /// Dispatches per frame (one of the two shading kernels).
+    const STAGES: u32 = 7;
 
     fn name(self) -> &'static str {
         match self {
@@ -234,6 +239,7 @@ impl Kernel {
             Kernel::Expand => "cs_expand",
             Kernel::Tiles => "cs_tiles",
             Kernel::Shade => "cs_shade",
+            Kernel::ShadeSamples => "cs_shade_samples",
         }
     }
 
@@ -246,12 +252,12 @@ impl Kernel {
             Kernel::Args => &[3, 11, 12],
             Kernel::Expand => &[10, 11, 15],
             Kernel::Tiles => &[2, 3, 5, 6, 7, 9, 10, 11],
-            Kernel::Shade => &[0, 1, 2, 3, 4, 5, 6, 7, 8, 13, 14],
+            Kernel::Shade | Kernel::ShadeSamples => &[0, 1, 2, 3, 4, 5, 6, 7, 8, 13, 14],
         }
     }
 }
 
-struct Kernels([wgpu::ComputePipeline; 7]);
+struct Kernels([wgpu::ComputePipeline; 8]);
 
 impl Kernels {
     fn get(&self, k: Kernel) -> &wgpu::ComputePipeline {
@@ -760,7 +766,7 @@ impl Gpu {
                 },
         );
         let resolved_view = resolved.create_view(&Default::default());
-        let passes = if compute { Kernel::ALL.len() as u32 } else { 1 };
+        let passes = if compute { Kernel::STAGES } else { 1 };
         let timing = self.has_timestamps().then(|| {
             let set = d.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("phong pass times"),
@@ -860,7 +866,12 @@ impl Gpu {
                     Ok((n, size)) => Ok(dispatch_groups(n, size, max_groups)
                         .ok_or_else(|| self.fail("preparing the compute rasterizer", format!("{n} threads")))?),
                 };
-                Ok(ComputeStage { pipeline, bind, groups })
+                Ok(ComputeStage {
+                    kernel: k,
+                    pipeline,
+                    bind,
+                    groups,
+                })
             };
             let stages = vec![
                 stage(Kernel::Clear, Ok((samples_total, 64)))?,
@@ -871,7 +882,14 @@ impl Gpu {
                 stage(Kernel::Tiles, Err(16))?,
                 ComputeStage {
                     groups: Ok((w.div_ceil(8), h.div_ceil(8))),
-                    ..stage(Kernel::Shade, Err(0))?
+                    ..stage(
+                        if samples == 1 {
+                            Kernel::Shade
+                        } else {
+                            Kernel::ShadeSamples
+                        },
+                        Err(0),
+                    )?
                 },
             ];
             Drawing::Compute {
@@ -1163,14 +1181,13 @@ impl Gpu {
             None => (None, Vec::new()),
             Some(_) => {
                 let ticks = &ticks[..2 * passes as usize];
-                let stages = if per_kernel {
-                    Kernel::ALL
+                let stages = match &p.drawing {
+                    Drawing::Compute { stages, .. } if per_kernel => stages
                         .iter()
                         .zip(ticks.chunks_exact(2))
-                        .filter_map(|(k, t)| Some((k.name(), span(t[0], t[1])?)))
-                        .collect()
-                } else {
-                    Vec::new()
+                        .filter_map(|(s, t)| Some((s.kernel.name(), span(t[0], t[1])?)))
+                        .collect(),
+                    _ => Vec::new(),
                 };
                 (span(ticks[0], ticks[ticks.len() - 1]), stages)
             }

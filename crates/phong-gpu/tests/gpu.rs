@@ -283,14 +283,10 @@ fn compute_rasterizer_respects_buffer_limits() {
     for (s, over) in [(side - 1, false), (side, true)] {
         scene.image.width = s;
         scene.image.height = s;
-        let why = gpu.compute_reason(&scene, &m);
-        assert_eq!(why.is_some(), over, "{s}: {why:?}");
-        if let Some(why) = why {
-            assert!(
-                why.contains("visibility buffer") && why.contains("storage buffer limit"),
-                "{why}"
-            );
-        }
+        // (At this size some objects may also reach far off screen: a later reason.)
+        let why = gpu.compute_reason(&scene, &m).unwrap_or_default();
+        assert_eq!(why.contains("visibility buffer"), over, "{s}: {why}");
+        assert_eq!(why.contains("storage buffer limit"), over, "{s}: {why}");
     }
 }
 
