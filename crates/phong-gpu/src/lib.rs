@@ -352,7 +352,60 @@ fn non_empty<T: bytemuck::Pod + bytemuck::Zeroable>(v: &[T]) -> Vec<u8> {
     }
 }
 
+/// Error scopes around GPU work: what they catch becomes [`Error::Failed`] ([`Gpu::check`]).
+struct Scopes {
+    out_of_memory: wgpu::ErrorScopeGuard,
+    validation: wgpu::ErrorScopeGuard,
+}
+
 impl Gpu {
+    fn scopes(&self) -> Scopes {
+        Scopes {
+            out_of_memory: self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
+            validation: self.device.push_error_scope(wgpu::ErrorFilter::Validation),
+        }
+    }
+
+    /// Pops `scopes` (the last pushed first): a validation or out-of-memory error while
+    /// `doing` is an error.
+    fn check(&self, scopes: Scopes, doing: &'static str) -> Result<(), Error> {
+        if let Some(e) = pollster::block_on(scopes.validation.pop()) {
+            return Err(self.fail(doing, e.to_string()));
+        }
+        if let Some(e) = pollster::block_on(scopes.out_of_memory.pop()) {
+            return Err(self.fail(doing, format!("out of memory: {e}")));
+        }
+        Ok(())
+    }
+
+    /// Maps `buffer` (a copy into it submitted), waits for the GPU, checks `scopes`, and
+    /// returns its contents, copied out of the mapping in one piece (it may be uncached
+    /// memory, slow to read in small pieces).
+    fn read_buffer<T: bytemuck::Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+        scopes: Scopes,
+        doing: &'static str,
+    ) -> Result<Vec<T>, Error> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait(doing)?;
+        self.check(scopes, doing)?;
+        rx.recv()
+            .map_err(|e| self.fail(doing, e.to_string()))?
+            .map_err(|e| self.fail(doing, e.to_string()))?;
+        let out = {
+            let data = buffer
+                .get_mapped_range(..)
+                .map_err(|e| self.fail(doing, e.to_string()))?;
+            bytemuck::pod_collect_to_vec(&data[..])
+        };
+        buffer.unmap();
+        Ok(out)
+    }
+
     /// Opens the first adapter wgpu finds (high performance preferred); `WGPU_BACKEND` and
     /// `WGPU_ADAPTER_NAME` select another, as wgpu documents.
     pub fn new() -> Result<Gpu, Error> {
@@ -715,8 +768,7 @@ impl Gpu {
         let bg = scene.image.background;
         let premultiplied = [bg[0] * bg[3], bg[1] * bg[3], bg[2] * bg[3], bg[3]];
 
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scopes = self.scopes();
         let d = &self.device;
         let buf = |label, contents: &[u8], usage| {
             d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -919,12 +971,7 @@ impl Gpu {
                 pipelines: [self.pipeline(samples, false), self.pipeline(samples, true)],
             }
         };
-        if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(self.fail("preparing the frame", e.to_string()));
-        }
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(self.fail("preparing the frame (out of memory)", e.to_string()));
-        }
+        self.check(scopes, "preparing the frame")?;
         Ok(Prepared {
             width: w,
             height: h,
@@ -1049,8 +1096,7 @@ impl Gpu {
     fn draw_timed(&self, p: &Prepared, per_kernel: bool) -> Result<Drawn, Error> {
         let per_kernel = per_kernel && matches!(p.drawing, Drawing::Compute { .. });
         let passes = if per_kernel { p.passes } else { 1 };
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scopes = self.scopes();
         let t1 = Instant::now();
         let mut enc = self.device.create_command_encoder(&Default::default());
         match &p.drawing {
@@ -1148,32 +1194,13 @@ impl Gpu {
             enc.copy_buffer_to_buffer(resolved, 0, &p.feedback, 16, 16 * u64::from(passes));
         }
         self.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        p.feedback.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        self.wait("rendering")?;
+        let words: Vec<u32> = self.read_buffer(&p.feedback, scopes, "rendering")?;
         let wall = t1.elapsed();
-        if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(self.fail("rendering", e.to_string()));
-        }
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(self.fail("rendering (out of memory)", e.to_string()));
-        }
-        rx.recv()
-            .map_err(|e| self.fail("rendering", e.to_string()))?
-            .map_err(|e| self.fail("rendering", e.to_string()))?;
-        let (count, ticks): (u32, Vec<u64>) = {
-            let data = p
-                .feedback
-                .get_mapped_range(..)
-                .map_err(|e| self.fail("rendering", e.to_string()))?;
-            (
-                bytemuck::pod_read_unaligned(&data[..4]),
-                bytemuck::pod_collect_to_vec(&data[16..]),
-            )
-        };
-        p.feedback.unmap();
+        let count = words[0];
+        let ticks: Vec<u64> = words[4..]
+            .chunks_exact(2)
+            .map(|w| u64::from(w[0]) | u64::from(w[1]) << 32)
+            .collect();
         // Ticks × period (ns per tick); a counter that went backwards gives none.
         let period = f64::from(self.queue.get_timestamp_period());
         let span = |a: u64, b: u64| Some(Duration::from_secs_f64(b.checked_sub(a)? as f64 * period * 1e-9));
@@ -1205,8 +1232,7 @@ impl Gpu {
     pub fn read(&self, p: &Prepared) -> Result<Image, Error> {
         let (w, h) = (p.width, p.height);
         let d = &self.device;
-        let scope = d.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let validation = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scopes = self.scopes();
         let row = u64::from(w) * 8;
         let align = u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let padded = row.div_ceil(align) * align;
@@ -1244,30 +1270,10 @@ impl Gpu {
             },
         );
         self.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        out.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        self.wait("reading the image back")?;
-        if let Some(e) = pollster::block_on(validation.pop()) {
-            return Err(self.fail("reading the image back", e.to_string()));
-        }
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(self.fail("reading the image back (out of memory)", e.to_string()));
-        }
-        rx.recv()
-            .map_err(|e| self.fail("reading the image back", e.to_string()))?
-            .map_err(|e| self.fail("reading the image back", e.to_string()))?;
-        // The halves out of the mapping in one copy, then converted by `half` (F16C where the
-        // processor has it): a 4K frame's conversion channel by channel in scalar code took
-        // about 300 ms on an H100 machine's Xeon.
-        let halves: Vec<u16> = {
-            let data = out
-                .get_mapped_range(..)
-                .map_err(|e| self.fail("reading the image back", e.to_string()))?;
-            bytemuck::pod_collect_to_vec(&data[..])
-        };
-        out.unmap();
+        // Halves converted by `half` (F16C where the processor has it) in one pass; with a
+        // scalar conversion pixel by pixel from the mapping, a 4K frame's read-back took
+        // 230–480 ms on the H100 machine, 190–260 ms after (BENCHMARKS.md).
+        let halves: Vec<u16> = self.read_buffer(&out, scopes, "reading the image back")?;
         let mut floats = vec![0f32; halves.len()];
         halves.reinterpret_cast::<half::f16>().convert_to_f32_slice(&mut floats);
         let bg = p.background;
@@ -1294,7 +1300,7 @@ impl Gpu {
         cases: &[(SurfacePoint, Material, ShadingSettings, View)],
     ) -> Result<Vec<Shading>, Error> {
         let d = &self.device;
-        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scopes = self.scopes();
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("phong shade cases"),
             source: wgpu::ShaderSource::Wgsl(COMPUTE_WGSL.into()),
@@ -1359,15 +1365,7 @@ impl Gpu {
         }
         enc.copy_buffer_to_buffer(&rb, 0, &out, 0, size);
         self.queue.submit([enc.finish()]);
-        out.map_async(wgpu::MapMode::Read, .., |_| {});
-        self.wait("shading test cases")?;
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(self.fail("shading test cases", e.to_string()));
-        }
-        let data = out
-            .get_mapped_range(..)
-            .map_err(|e| self.fail("reading test results", e.to_string()))?;
-        let floats: &[f32] = bytemuck::cast_slice(&data);
+        let floats: Vec<f32> = self.read_buffer(&out, scopes, "shading test cases")?;
         let c = |i: usize| Color::new(floats[i], floats[i + 1], floats[i + 2]);
         Ok((0..cases.len())
             .map(|k| Shading {
