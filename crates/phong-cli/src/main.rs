@@ -44,7 +44,8 @@ enum Backend {
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum GpuPathArg {
-    /// The compute rasterizer where it can draw the frame, else the pipeline.
+    /// On a GPU the compute rasterizer where it can draw the frame, else the pipeline; on a
+    /// CPU adapter (lavapipe) the pipeline.
     Auto,
     /// The GPU's render pipeline (its own rasterizer).
     Pipeline,

@@ -378,6 +378,8 @@ fn gpu_backend_selection() {
             "benches/scenes/fill_4lights.toml",
             "--backend",
             "gpu",
+            "--gpu-path",
+            "compute",
             "--frames",
             "2",
             "--width",

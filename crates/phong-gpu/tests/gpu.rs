@@ -265,8 +265,26 @@ fn compute_rasterizer_matches_the_cpu() {
     assert!(2 * drawn >= 3 * names.len(), "{drawn} of {}", 3 * names.len());
 }
 
+/// The automatic path: the compute rasterizer on a GPU, the pipeline on a CPU adapter.
+#[test]
+fn automatic_path_follows_the_adapter() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("terms.toml");
+    scene.image.width = 160;
+    scene.image.height = 100;
+    let m = scene.camera.clip_from_world(1.6);
+    let (_, stats) = gpu.render(&scene).unwrap();
+    let on_cpu = gpu.adapter_name().contains(", Cpu)");
+    assert_eq!(
+        stats.compute,
+        !on_cpu && gpu.compute_reason(&scene, &m).is_none(),
+        "{}",
+        gpu.adapter_name()
+    );
+}
+
 /// A frame whose visibility buffer would exceed the adapter's storage buffers is not for the
-/// compute rasterizer (the automatic path then takes the pipeline); the reason says so.
+/// compute rasterizer (the automatic paths then take the pipeline); the reason says so.
 #[test]
 fn compute_rasterizer_respects_buffer_limits() {
     let Some(gpu) = gpu() else { return };
@@ -291,10 +309,11 @@ fn compute_rasterizer_respects_buffer_limits() {
 }
 
 /// A frame whose large triangles' tiles overflow the compute rasterizer's list is drawn again
-/// by the pipeline (automatic path), or is an error (compute path asked for).
+/// by the pipeline (compute preferred), or is an error (compute path asked for).
 #[test]
 fn compute_overflow_falls_back_to_the_pipeline() {
     let Some(mut gpu) = gpu() else { return };
+    gpu.set_path(GpuPath::PreferCompute);
     // A full-screen quad of two triangles, each boxing the whole image: 2 × 20 × 13 tiles of
     // 16×16 at 320×200.
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/scenes/fill_4lights.toml");
@@ -325,7 +344,7 @@ fn compute_overflow_falls_back_to_the_pipeline() {
 /// time lies inside the wall-clock interval from submitting the pass to its completion.
 #[test]
 fn pass_time_lies_within_the_render() {
-    let Some(gpu) = gpu() else { return };
+    let Some(mut gpu) = gpu() else { return };
     let scene = load("terms.toml");
     let (_, stats) = gpu.render(&scene).unwrap();
     if !gpu.has_timestamps() {
@@ -346,6 +365,7 @@ fn pass_time_lies_within_the_render() {
         .camera
         .clip_from_world(scene.image.width as f32 / scene.image.height as f32);
     if gpu.compute_reason(&scene, &m).is_none() {
+        gpu.set_path(GpuPath::Compute);
         let prepared = gpu.prepare(&scene).unwrap();
         assert!(prepared.is_compute());
         assert!(gpu.draw(&prepared).unwrap().stages.is_empty());
