@@ -159,12 +159,12 @@ pub struct Prepared {
     background: [f32; 4],
     premultiplied: [f32; 4],
     triangles: usize,
-    item_capacity: u32,
     resolved: wgpu::Texture,
     resolved_view: wgpu::TextureView,
     /// Timestamps (the start and end of each pass) and the buffer they are resolved into.
     timing: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    /// Mapped after each draw: the compute path's item count (16 bytes), then the timestamps.
+    /// Mapped after each draw: the compute path's counters (item count, large triangles,
+    /// overflow flag; 16 bytes), then the timestamps.
     feedback: wgpu::Buffer,
     /// Timed passes at most: one (the pipeline's) or one per compute kernel.
     passes: u32,
@@ -883,7 +883,7 @@ impl Gpu {
                 storage,
             );
             let items = empty("items", u64::from(self.item_capacity) * 8, storage);
-            let counter = empty("item count", 16, storage | wgpu::BufferUsages::COPY_SRC);
+            let counter = empty("item counters", 16, storage | wgpu::BufferUsages::COPY_SRC);
             let dispatch = empty("dispatches", 32, storage | wgpu::BufferUsages::INDIRECT);
             let large = empty("large triangles", u64::from(self.item_capacity / 2 + 1) * 16, storage);
             let resources: [(u32, wgpu::BindingResource); 16] = [
@@ -986,7 +986,6 @@ impl Gpu {
             background: bg,
             premultiplied,
             triangles,
-            item_capacity: self.item_capacity,
             resolved,
             resolved_view,
             timing,
@@ -1194,7 +1193,7 @@ impl Gpu {
                         }
                     }
                 }
-                enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 0, 4);
+                enc.copy_buffer_to_buffer(counter, 0, &p.feedback, 0, 16);
             }
         }
         if let Some((set, resolved)) = &p.timing {
@@ -1204,7 +1203,7 @@ impl Gpu {
         self.queue.submit([enc.finish()]);
         let words: Vec<u32> = self.read_buffer(&p.feedback, scopes, "rendering")?;
         let wall = t1.elapsed();
-        let count = words[0];
+        let overflow_flag = words[2];
         let ticks: Vec<u64> = words[4..]
             .chunks_exact(2)
             .map(|w| u64::from(w[0]) | u64::from(w[1]) << 32)
@@ -1227,7 +1226,7 @@ impl Gpu {
                 (span(ticks[0], ticks[ticks.len() - 1]), stages)
             }
         };
-        let overflowed = matches!(p.drawing, Drawing::Compute { .. }) && count > p.item_capacity;
+        let overflowed = matches!(p.drawing, Drawing::Compute { .. }) && overflow_flag != 0;
         Ok(Drawn {
             wall,
             gpu,

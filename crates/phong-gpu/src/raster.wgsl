@@ -47,8 +47,9 @@ struct Colors {
 @group(0) @binding(8) var<storage, read_write> colors: array<Colors>;
 @group(0) @binding(9) var<storage, read_write> visibility: array<atomic<u64>>;
 @group(0) @binding(10) var<storage, read_write> items: array<vec2<u32>>;
-// [0]: items reserved (may exceed the capacity: then the frame is drawn again by the
-// pipeline); [1]: large triangles listed.
+// [0]: items reserved (may exceed the capacity); [1]: large triangles listed; [2]: 1 when a
+// triangle's items did not fit (then the frame is drawn again by the pipeline; [0] alone
+// could wrap around).
 @group(0) @binding(11) var<storage, read_write> counter: array<atomic<u32>>;
 @group(0) @binding(12) var<storage, read_write> dispatch: array<u32>;
 // The visibility buffer's words (samples of a pixel together), for clearing and shading.
@@ -86,6 +87,7 @@ fn cs_clear(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     if (i == 0u) {
         atomicStore(&counter[0], 0u);
         atomicStore(&counter[1], 0u);
+        atomicStore(&counter[2], 0u);
     }
     if (i < raster.size.x * raster.size.y * raster.items.y) {
         visibility_words[i] = vec2<u32>(0u);
@@ -275,7 +277,8 @@ fn cs_raster(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let span = vec2<u32>((s.box_max - vec2<i32>(1)) / TILE) - t0 + vec2<u32>(1u);
     let n = span.x * span.y;
     let first = atomicAdd(&counter[0], n);
-    if (first + n > raster.items.x) {
+    if (first > raster.items.x || n > raster.items.x - first) {
+        atomicStore(&counter[2], 1u);
         return;
     }
     // Every large triangle has at least two tiles, so no more than capacity / 2 are listed.
