@@ -686,10 +686,8 @@ impl Gpu {
             GpuPath::Pipeline => false,
             // A driver that cannot build the compute rasterizer leaves the pipeline.
             GpuPath::Auto if self.info.device_type == wgpu::DeviceType::Cpu => false,
-            GpuPath::Auto | GpuPath::PreferCompute => {
-                self.compute_reason(scene, &clip_from_world).is_none() && self.kernels().is_ok()
-            }
-            GpuPath::Compute => match self.compute_reason(scene, &clip_from_world) {
+            GpuPath::Auto | GpuPath::PreferCompute => self.compute_reason(scene).is_none() && self.kernels().is_ok(),
+            GpuPath::Compute => match self.compute_reason(scene) {
                 None => true,
                 Some(why) => return Err(Error::Compute(why)),
             },
@@ -995,11 +993,12 @@ impl Gpu {
         })
     }
 
-    /// Why the compute rasterizer cannot draw `scene` (`None`: it can): it needs one sample
-    /// per pixel, 64-bit atomics, and every object's bounding box in front of the near plane,
-    /// behind the far plane and within ±32768 pixels of the window (so that no triangle needs
-    /// clipping and snapped coordinates fit its integers).
-    pub fn compute_reason(&self, scene: &Scene, clip_from_world: &glam::Mat4) -> Option<String> {
+    /// Why the compute rasterizer cannot draw `scene` (`None`: it can): it needs 64-bit
+    /// atomics, its buffers within the adapter's storage limit, fewer than 2^32 - 1 triangles,
+    /// and every object's bounding box in front of the near plane, behind the far plane and
+    /// less than 32768 pixels from the window's origin (so that no triangle needs clipping and
+    /// snapped coordinates fit its integers).
+    pub fn compute_reason(&self, scene: &Scene) -> Option<String> {
         let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
         if !self.device.features().contains(needed) {
             return Some(format!("the adapter {} has no 64-bit atomics", self.info.name));
@@ -1034,6 +1033,7 @@ impl Gpu {
             return Some(format!("it numbers triangles in 32 bits ({triangles} triangles)"));
         }
         let (w, h) = (scene.image.width as f32, scene.image.height as f32);
+        let clip_from_world = scene.camera.clip_from_world(w / h);
         for (i, o) in scene.objects.iter().enumerate() {
             let Some((lo, hi)) = o.mesh.bounds() else { continue };
             for k in 0..8 {
@@ -1042,11 +1042,11 @@ impl Gpu {
                     if k & 2 == 0 { lo.y } else { hi.y },
                     if k & 4 == 0 { lo.z } else { hi.z },
                 );
-                let c = *clip_from_world * p.extend(1.0);
+                let c = clip_from_world * p.extend(1.0);
                 let sx = (c.x / c.w * 0.5 + 0.5) * w;
                 let sy = (0.5 - c.y / c.w * 0.5) * h;
-                let inside =
-                    c.w > 0.0 && c.z >= -c.w && c.z <= c.w && sx.abs() <= 32768.0 - w && sy.abs() <= 32768.0 - h;
+                // Snapped (× 256), |x| < 2^23: exact in f32 and in the shader's i32.
+                let inside = c.w > 0.0 && c.z >= -c.w && c.z <= c.w && sx.abs() < 32768.0 && sy.abs() < 32768.0;
                 if !inside {
                     return Some(format!(
                         "object {} reaches outside the view volume (near or far plane, or far off screen)",

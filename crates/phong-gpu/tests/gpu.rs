@@ -246,8 +246,7 @@ fn compute_rasterizer_matches_the_cpu() {
             scene.image.width = 320;
             scene.image.height = 200;
             scene.image.samples = samples;
-            let m = scene.camera.clip_from_world(320.0 / 200.0);
-            if let Some(why) = gpu.compute_reason(&scene, &m) {
+            if let Some(why) = gpu.compute_reason(&scene) {
                 if why.contains("64-bit atomics") {
                     eprintln!("skipped: {why}");
                     return;
@@ -272,12 +271,11 @@ fn automatic_path_follows_the_adapter() {
     let mut scene = load("terms.toml");
     scene.image.width = 160;
     scene.image.height = 100;
-    let m = scene.camera.clip_from_world(1.6);
     let (_, stats) = gpu.render(&scene).unwrap();
     let on_cpu = gpu.adapter_name().contains(", Cpu)");
     assert_eq!(
         stats.compute,
-        !on_cpu && gpu.compute_reason(&scene, &m).is_none(),
+        !on_cpu && gpu.compute_reason(&scene).is_none(),
         "{}",
         gpu.adapter_name()
     );
@@ -297,12 +295,11 @@ fn compute_rasterizer_respects_buffer_limits() {
         eprintln!("skipped: this adapter's storage buffers hold any image ({max} bytes)");
         return;
     }
-    let m = scene.camera.clip_from_world(1.0);
     for (s, over) in [(side - 1, false), (side, true)] {
         scene.image.width = s;
         scene.image.height = s;
         // (At this size some objects may also reach far off screen: a later reason.)
-        let why = gpu.compute_reason(&scene, &m).unwrap_or_default();
+        let why = gpu.compute_reason(&scene).unwrap_or_default();
         assert_eq!(why.contains("visibility buffer"), over, "{s}: {why}");
         assert_eq!(why.contains("storage buffer limit"), over, "{s}: {why}");
     }
@@ -321,8 +318,7 @@ fn compute_overflow_falls_back_to_the_pipeline() {
     scene.image.width = 320;
     scene.image.height = 200;
     scene.image.samples = 1;
-    let m = scene.camera.clip_from_world(320.0 / 200.0);
-    if let Some(why) = gpu.compute_reason(&scene, &m) {
+    if let Some(why) = gpu.compute_reason(&scene) {
         eprintln!("skipped: {why}");
         return;
     }
@@ -361,10 +357,7 @@ fn pass_time_lies_within_the_render() {
     // frame's span on the GPU, itself within the wall-clock draw.
     let mut scene = scene;
     scene.image.samples = 1;
-    let m = scene
-        .camera
-        .clip_from_world(scene.image.width as f32 / scene.image.height as f32);
-    if gpu.compute_reason(&scene, &m).is_none() {
+    if gpu.compute_reason(&scene).is_none() {
         gpu.set_path(GpuPath::Compute);
         let prepared = gpu.prepare(&scene).unwrap();
         assert!(prepared.is_compute());
