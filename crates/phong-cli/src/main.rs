@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use phong_core::{Material, named_materials};
-use phong_raster::{RenderOptions, Renderer, render_with_stats};
+use phong_raster::{RenderOptions, RenderStats, Renderer, render_with_stats};
 use phong_scene::{INTERPOLATIONS, MODELS, OUTPUTS, apply_model, parse_choice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -220,6 +220,30 @@ fn open_gpu(backend: Backend, path: GpuPathArg) -> Result<Option<phong_gpu::Gpu>
     Ok(gpu)
 }
 
+/// A rendered image: the GPU's in `f32`, the CPU's in 8 bits where that is exact (see
+/// `Renderer::render_8bit`), else in `f32`.
+enum Rendered {
+    Linear(phong_core::Image),
+    Bits(phong_core::Image8),
+}
+
+impl Rendered {
+    fn draw_labels(&mut self, scene: &phong_core::Scene) {
+        match self {
+            Rendered::Linear(i) => phong_core::text::draw_labels(i, &scene.camera, &scene.labels),
+            Rendered::Bits(i) => phong_core::text::draw_labels(i, &scene.camera, &scene.labels),
+        }
+    }
+
+    fn write_png(&self, path: &std::path::Path, scene: &phong_core::Scene) -> Result<()> {
+        match self {
+            Rendered::Linear(i) => phong_scene::write_png(path, i, scene.image.encoding)?,
+            Rendered::Bits(i) => phong_scene::write_png8(path, i)?,
+        }
+        Ok(())
+    }
+}
+
 /// One render: the image, times (setup or upload, raster or GPU render pass, read-back, then
 /// the CPU's stage times), triangles drawn, pixels shaded, and whether the GPU's compute
 /// rasterizer drew it.
@@ -227,13 +251,13 @@ fn render_once(
     scene: &phong_core::Scene,
     gpu: Option<&phong_gpu::Gpu>,
     options: &RenderOptions,
-) -> Result<(phong_core::Image, [Duration; 6], usize, u64, bool)> {
+) -> Result<(Rendered, [Duration; 6], usize, u64, bool)> {
     Ok(match gpu {
         Some(g) => {
             let (img, st) = g.render(scene)?;
             let z = Duration::ZERO;
             (
-                img,
+                Rendered::Linear(img),
                 [st.upload, st.render, st.readback, z, z, z],
                 st.triangles,
                 0,
@@ -241,8 +265,26 @@ fn render_once(
             )
         }
         None => {
-            let (img, st) = render_with_stats(scene, options)?;
-            (img, cpu_times(&st), st.triangles_drawn, st.pixels_shaded, false)
+            let mut renderer = Renderer::new();
+            match renderer.render_8bit(scene, options)?.map(|(_, st)| st) {
+                Some(st) => (
+                    Rendered::Bits(renderer.into_image8().expect("an 8-bit image after its render")),
+                    cpu_times(&st),
+                    st.triangles_drawn,
+                    st.pixels_shaded,
+                    false,
+                ),
+                None => {
+                    let (img, st) = render_with_stats(scene, options)?;
+                    (
+                        Rendered::Linear(img),
+                        cpu_times(&st),
+                        st.triangles_drawn,
+                        st.pixels_shaded,
+                        false,
+                    )
+                }
+            }
         }
     })
 }
@@ -324,9 +366,9 @@ fn render(a: RenderArgs) -> Result<()> {
     let (mut image, times, triangles, shaded, gpu_compute) =
         render_once(&scene, gpu.as_ref(), &options).with_context(|| format!("rendering {}", a.run.input.display()))?;
     bar.finish_and_clear();
-    phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
+    image.draw_labels(&scene);
     let t_write = Instant::now();
-    phong_scene::write_png(&a.output, &image, scene.image.encoding)?;
+    image.write_png(&a.output, &scene)?;
     let t_write = t_write.elapsed();
     if a.run.verbose {
         let backend = match &gpu {
@@ -446,11 +488,19 @@ fn bench(a: BenchArgs) -> Result<()> {
                 threads: None,
                 ..a.run.options(None)
             };
+            // In 8 bits where `phong render` writes 8 bits (the same bytes), as llvmpipe renders
+            // into an RGBA8 buffer.
             let mut renderer = Renderer::new();
+            let frame = |renderer: &mut Renderer| -> Result<RenderStats> {
+                Ok(match renderer.render_8bit(&scene, &options)?.map(|(_, st)| st) {
+                    Some(st) => st,
+                    None => renderer.render(&scene, &options)?.1,
+                })
+            };
             pool.install(|| -> Result<()> {
-                renderer.render(&scene, &options)?;
+                frame(&mut renderer)?;
                 for _ in 0..a.frames {
-                    let st = renderer.render(&scene, &options)?.1;
+                    let st = frame(&mut renderer)?;
                     for (k, d) in cpu_times(&st).into_iter().enumerate() {
                         sum[k] += d;
                     }

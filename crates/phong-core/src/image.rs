@@ -108,6 +108,98 @@ impl Image {
     }
 }
 
+/// A `width × height` image of 8-bit straight-alpha RGBA pixels, row 0 at the top: an
+/// [`Image`] as [`Image::to_bytes`] encodes it (colour by `encoding`, alpha linearly), made
+/// directly by a renderer that writes its tiles in 8 bits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image8 {
+    width: u32,
+    height: u32,
+    encoding: Encoding,
+    pixels: Vec<[u8; 4]>,
+}
+
+impl Image8 {
+    /// A zeroed image; sizes as for [`Image::new`].
+    pub fn new(width: u32, height: u32, encoding: Encoding) -> Result<Self, Error> {
+        check_size(width, height)?;
+        Ok(Image8 {
+            width,
+            height,
+            encoding,
+            pixels: vec![[0; 4]; width as usize * height as usize],
+        })
+    }
+
+    /// Whether 8-bit pixels tell transparency as [`Image::has_transparency`] does (an alpha
+    /// below 1) for every image whose background alpha is `alpha`: its pixels' alphas are
+    /// `(k + (n − k)·alpha) / n` for `k` of `n ≤ 16` samples covered, which round to 255 while
+    /// below 1 only when `alpha` lies in `(1 − 8/255, 1)`.
+    pub fn exact_for_background(alpha: f32) -> bool {
+        alpha == 1.0 || alpha <= 1.0 - 8.0 / 255.0
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// The encoding of the colour channels.
+    pub fn encoding(&self) -> Encoding {
+        self.encoding
+    }
+    /// Pixels, row-major from the top.
+    pub fn pixels(&self) -> &[[u8; 4]] {
+        &self.pixels
+    }
+    /// Mutable pixels.
+    pub fn pixels_mut(&mut self) -> &mut [[u8; 4]] {
+        &mut self.pixels
+    }
+    /// Whether any pixel is not opaque.
+    pub fn has_transparency(&self) -> bool {
+        self.pixels.iter().any(|p| p[3] < 255)
+    }
+    /// RGB (or RGBA when `alpha`) bytes, row-major.
+    pub fn to_bytes(&self, alpha: bool) -> Vec<u8> {
+        if alpha {
+            return self.pixels.iter().flatten().copied().collect();
+        }
+        self.pixels.iter().flat_map(|p| [p[0], p[1], p[2]]).collect()
+    }
+}
+
+/// What labels are drawn on: an [`Image`], or an [`Image8`] (whose pixels are the encoded
+/// colour, opaque).
+pub trait Canvas {
+    /// Width and height in pixels.
+    fn size(&self) -> (u32, u32);
+    /// Sets pixel `(x, y)` to the opaque colour `c`.
+    fn put(&mut self, x: u32, y: u32, c: crate::Color);
+}
+
+impl Canvas for Image {
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    fn put(&mut self, x: u32, y: u32, c: crate::Color) {
+        self.pixels[y as usize * self.width as usize + x as usize] = [c.r, c.g, c.b, 1.0];
+    }
+}
+
+impl Canvas for Image8 {
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    fn put(&mut self, x: u32, y: u32, c: crate::Color) {
+        let e = self.encoding;
+        self.pixels[y as usize * self.width as usize + x as usize] = [e.encode(c.r), e.encode(c.g), e.encode(c.b), 255];
+    }
+}
+
 fn check_size(width: u32, height: u32) -> Result<(), Error> {
     let max = crate::limits::MAX_IMAGE_DIMENSION;
     for (what, v) in [("image width", width), ("image height", height)] {

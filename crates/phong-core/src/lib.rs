@@ -43,7 +43,7 @@ pub mod text;
 pub use camera::{Camera, Projection, Viewer};
 pub use color::Color;
 pub use error::Error;
-pub use image::{Encoding, Image};
+pub use image::{Canvas, Encoding, Image, Image8};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;

@@ -2,7 +2,7 @@
 //! the teapots of the gallery, the terms of a decomposition). Backend
 //! independent: applied to the [`Image`] after rendering.
 
-use crate::{Camera, Color, Image, Label};
+use crate::{Camera, Canvas, Color, Label};
 use glam::Vec4;
 
 /// Rows of a glyph, top first; bit 4 is the leftmost pixel.
@@ -63,9 +63,10 @@ fn glyph(c: char) -> [u8; 7] {
 
 /// Draws `text` with its top-left corner at pixel `(x, y)`, `size` pixels
 /// per font pixel, 6 font pixels per character; clipped to the image.
-pub fn draw_text(image: &mut Image, x: i64, y: i64, text: &str, color: Color, size: u32) {
+pub fn draw_text(image: &mut impl Canvas, x: i64, y: i64, text: &str, color: Color, size: u32) {
     let size = i64::from(size.max(1));
-    let (w, h) = (i64::from(image.width()), i64::from(image.height()));
+    let (w, h) = image.size();
+    let (w, h) = (i64::from(w), i64::from(h));
     for (i, ch) in text.chars().enumerate() {
         let rows = glyph(ch);
         let gx = x + i as i64 * 6 * size;
@@ -79,7 +80,7 @@ pub fn draw_text(image: &mut Image, x: i64, y: i64, text: &str, color: Color, si
                         let px = gx + col * size + dx;
                         let py = y + r as i64 * size + dy;
                         if (0..w).contains(&px) && (0..h).contains(&py) {
-                            image.pixels_mut()[(py * w + px) as usize] = [color.r, color.g, color.b, 1.0];
+                            image.put(px as u32, py as u32, color);
                         }
                     }
                 }
@@ -96,8 +97,9 @@ pub fn text_size(text: &str, size: u32) -> (u32, u32) {
 
 /// Draws each label centred on the projection of its world position; labels
 /// behind the camera are skipped.
-pub fn draw_labels(image: &mut Image, camera: &Camera, labels: &[Label]) {
-    let (w, h) = (image.width() as f32, image.height() as f32);
+pub fn draw_labels(image: &mut impl Canvas, camera: &Camera, labels: &[Label]) {
+    let (w, h) = image.size();
+    let (w, h) = (w as f32, h as f32);
     let m = camera.clip_from_world(w / h);
     for l in labels {
         let c = m * Vec4::from((l.position, 1.0));
@@ -121,6 +123,7 @@ pub fn draw_labels(image: &mut Image, camera: &Camera, labels: &[Label]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Image;
 
     #[test]
     fn draws_glyph_bits() {

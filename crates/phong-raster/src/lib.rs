@@ -32,7 +32,7 @@ pub mod simd;
 
 pub use raster::{coverage_counts, sample_pattern};
 
-use phong_core::{Image, Scene};
+use phong_core::{Encoding, Image, Image8, Scene};
 use std::time::Duration;
 use thiserror::Error;
 
@@ -133,6 +133,7 @@ pub fn render_with_stats(scene: &Scene, options: &RenderOptions) -> Result<(Imag
 #[derive(Default)]
 pub struct Renderer {
     image: Option<Image>,
+    image8: Option<Image8>,
     scratch: raster::Scratch,
 }
 
@@ -145,22 +146,60 @@ impl Renderer {
     /// Renders `scene`, reusing the memory of previous frames (every pixel is written; a size
     /// change reallocates the image).
     pub fn render(&mut self, scene: &Scene, options: &RenderOptions) -> Result<(&Image, RenderStats), Error> {
-        let stats = render_into(scene, options, &mut self.image, &mut self.scratch)?;
-        Ok((self.image.as_ref().expect("set by render_into"), stats))
+        check(scene, options)?;
+        let (w, h) = (scene.image.width, scene.image.height);
+        if self.image.as_ref().is_none_or(|i| (i.width(), i.height()) != (w, h)) {
+            // Zeroed (the allocator's zero pages, no fill): the tiles write every pixel.
+            self.image = Some(Image::new(w, h, [0.0; 4])?);
+        }
+        let image = self.image.as_mut().expect("set above");
+        let stats = in_pool(options, || {
+            raster::render(scene, options, image.pixels_mut(), Encoding::Linear, &mut self.scratch)
+        })?;
+        Ok((self.image.as_ref().expect("set above"), stats))
     }
 
-    /// The last frame's image, if any.
+    /// [`Renderer::render`] straight into 8 bits, encoded by the scene's encoding: the same
+    /// bytes as the `f32` image's [`Image::to_bytes`], a quarter of the memory written. `None`
+    /// where 8 bits cannot tell transparency as the `f32` image does (a background alpha in
+    /// `(1 − 8/255, 1)`, see [`Image8::exact_for_background`]): render in `f32` then.
+    pub fn render_8bit(
+        &mut self,
+        scene: &Scene,
+        options: &RenderOptions,
+    ) -> Result<Option<(&Image8, RenderStats)>, Error> {
+        check(scene, options)?;
+        if !Image8::exact_for_background(scene.image.background[3]) {
+            return Ok(None);
+        }
+        let (w, h, encoding) = (scene.image.width, scene.image.height, scene.image.encoding);
+        if self
+            .image8
+            .as_ref()
+            .is_none_or(|i| (i.width(), i.height(), i.encoding()) != (w, h, encoding))
+        {
+            self.image8 = Some(Image8::new(w, h, encoding)?);
+        }
+        let image = self.image8.as_mut().expect("set above");
+        let stats = in_pool(options, || {
+            raster::render(scene, options, image.pixels_mut(), encoding, &mut self.scratch)
+        })?;
+        Ok(Some((self.image8.as_ref().expect("set above"), stats)))
+    }
+
+    /// The last `f32` frame's image, if any.
     pub fn into_image(self) -> Option<Image> {
         self.image
     }
+
+    /// The last 8-bit frame's image, if any.
+    pub fn into_image8(self) -> Option<Image8> {
+        self.image8
+    }
 }
 
-fn render_into(
-    scene: &Scene,
-    options: &RenderOptions,
-    image: &mut Option<Image>,
-    scratch: &mut raster::Scratch,
-) -> Result<RenderStats, Error> {
+/// The scene's and options' checks shared by both targets.
+fn check(scene: &Scene, options: &RenderOptions) -> Result<(), Error> {
     let s = scene.image.samples;
     if !phong_core::limits::SAMPLE_COUNTS.contains(&s) {
         return Err(Error::Samples(s));
@@ -183,19 +222,17 @@ fn render_into(
     {
         return Err(Error::ThreadCount(n));
     }
-    if image.as_ref().is_none_or(|i| (i.width(), i.height()) != (w, h)) {
-        // Zeroed (the allocator's zero pages, no fill): the tiles write every pixel.
-        *image = Some(Image::new(w, h, [0.0; 4])?);
-    }
-    let target = image.as_mut().expect("set above");
+    Ok(())
+}
+
+/// Runs `f` on `options.threads` threads (a pool of its own), or on the current pool.
+fn in_pool<T: Send>(options: &RenderOptions, f: impl FnOnce() -> Result<T, Error> + Send) -> Result<T, Error> {
     match options.threads {
-        None => raster::render(scene, options, target, scratch),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|source| Error::Threads { threads: n, source })?;
-            pool.install(|| raster::render(scene, options, target, scratch))
-        }
+        None => f(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|source| Error::Threads { threads: n, source })?
+            .install(f),
     }
 }

@@ -383,3 +383,73 @@ fn renderer_reuse_matches_fresh_renders() {
         );
     }
 }
+
+/// Rendering straight into 8 bits gives the bytes of the `f32` image's encoding, pixel for
+/// pixel: every example and benchmark scene, both encodings, the fast and the reference path,
+/// the AVX2 and the portable build, 1 and 3 threads, one `Renderer` kept across all of them (its
+/// 8-bit and `f32` frames alternate); and transparency is told as the `f32` image tells it, for
+/// backgrounds with alpha 0, 0.5 and 1 and 1, 4 and 16 samples. A background alpha that 8 bits
+/// cannot tell apart from opaque is refused (`None`).
+#[test]
+fn eight_bit_frames_are_the_encoded_f32_frames() {
+    let mut renderer = phong_raster::Renderer::new();
+    for (i, path) in scenes().iter().enumerate() {
+        let mut scene = phong_scene::load(path).unwrap().scene;
+        scene.image.width = [96, 150][i % 2];
+        scene.image.height = [64, 100][i % 2];
+        for encoding in [Encoding::Linear, Encoding::Srgb] {
+            scene.image.encoding = encoding;
+            for (reference, no_avx2, threads) in [(false, false, 1), (false, true, 3), (true, false, 3)] {
+                let options = RenderOptions {
+                    reference,
+                    no_avx2,
+                    threads: Some(threads),
+                    ..Default::default()
+                };
+                let expected = render(&scene, &options).unwrap().to_bytes(encoding, true);
+                let (image, _) = renderer
+                    .render_8bit(&scene, &options)
+                    .unwrap()
+                    .expect("an opaque background");
+                assert_eq!(image.encoding(), encoding);
+                let got = image.to_bytes(true);
+                let differ = expected.iter().zip(&got).filter(|(a, b)| a != b).count();
+                assert_eq!(
+                    differ,
+                    0,
+                    "{} {encoding:?} reference={reference} no_avx2={no_avx2} threads={threads}",
+                    path.display()
+                );
+            }
+        }
+    }
+    let mut scene = phong_scene::load(&scenes()[0]).unwrap().scene;
+    scene.image.width = 80;
+    scene.image.height = 60;
+    for alpha in [0.0, 0.5, 1.0] {
+        for samples in [1, 4, 16] {
+            scene.image.background = [0.2, 0.4, 0.6, alpha];
+            scene.image.samples = samples;
+            let options = RenderOptions::default();
+            let f32_image = render(&scene, &options).unwrap();
+            let (image, _) = renderer.render_8bit(&scene, &options).unwrap().expect("an exact alpha");
+            assert_eq!(
+                image.has_transparency(),
+                f32_image.has_transparency(),
+                "{alpha} {samples}"
+            );
+            let transparent = f32_image.has_transparency();
+            assert_eq!(
+                image.to_bytes(transparent),
+                f32_image.to_bytes(scene.image.encoding, transparent)
+            );
+        }
+    }
+    scene.image.background = [0.0, 0.0, 0.0, 0.98];
+    assert!(
+        renderer
+            .render_8bit(&scene, &RenderOptions::default())
+            .unwrap()
+            .is_none()
+    );
+}

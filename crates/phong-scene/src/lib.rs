@@ -14,7 +14,7 @@ mod toml_scene;
 
 pub use error::Error;
 pub use obj::{ObjPart, load_obj};
-pub use png_out::write_png;
+pub use png_out::{write_png, write_png8};
 pub use toml_scene::{INTERPOLATIONS, MODELS, Model, OUTPUTS, apply_model, parse_choice, parse_scene};
 
 use std::path::Path;

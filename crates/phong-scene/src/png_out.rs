@@ -2,22 +2,41 @@
 //! then renamed over it, so a failed write never leaves a partial image.
 
 use crate::Error;
-use phong_core::{Encoding, Image};
+use phong_core::{Encoding, Image, Image8};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Writes `image` as an 8-bit PNG: RGB, or RGBA when some pixel is not
 /// opaque; colours encoded with `encoding` (sRGB adds the PNG `sRGB` chunk).
 pub fn write_png(path: &Path, image: &Image, encoding: Encoding) -> Result<(), Error> {
+    let alpha = image.has_transparency();
+    let bytes = image.to_bytes(encoding, alpha);
+    write_bytes(path, (image.width(), image.height()), &bytes, alpha, encoding)
+}
+
+/// [`write_png`] for an image already in 8 bits (the same file as for the `f32` image it
+/// encodes).
+pub fn write_png8(path: &Path, image: &Image8) -> Result<(), Error> {
+    let alpha = image.has_transparency();
+    let bytes = image.to_bytes(alpha);
+    write_bytes(path, (image.width(), image.height()), &bytes, alpha, image.encoding())
+}
+
+/// `bytes` (RGB, or RGBA with `alpha`) as a PNG at `path`, atomically.
+fn write_bytes(
+    path: &Path,
+    (width, height): (u32, u32),
+    bytes: &[u8],
+    alpha: bool,
+    encoding: Encoding,
+) -> Result<(), Error> {
     let err = |source: std::io::Error| Error::Write {
         path: path.to_path_buf(),
         source,
     };
-    let alpha = image.has_transparency();
-    let bytes = image.to_bytes(encoding, alpha);
     let mut buf = Vec::with_capacity(bytes.len() / 2);
     {
-        let mut enc = png::Encoder::new(&mut buf, image.width(), image.height());
+        let mut enc = png::Encoder::new(&mut buf, width, height);
         enc.set_color(if alpha {
             png::ColorType::Rgba
         } else {
@@ -29,7 +48,7 @@ pub fn write_png(path: &Path, image: &Image, encoding: Encoding) -> Result<(), E
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         }
         let mut w = enc.write_header().map_err(|e| err(std::io::Error::other(e)))?;
-        w.write_image_data(&bytes).map_err(|e| err(std::io::Error::other(e)))?;
+        w.write_image_data(bytes).map_err(|e| err(std::io::Error::other(e)))?;
         w.finish().map_err(|e| err(std::io::Error::other(e)))?;
     }
     let tmp = temp_path(path);
