@@ -1,6 +1,6 @@
 //! Labels: 5×7 bitmap text stamped over a rendered image (the names under
 //! the teapots of the gallery, the terms of a decomposition). Backend
-//! independent: applied to the [`Image`] after rendering.
+//! independent: applied to the image ([`crate::Image`] or [`crate::Image8`]) after rendering.
 
 use crate::{Camera, Canvas, Color, Label};
 use glam::Vec4;

@@ -29,7 +29,12 @@
 //! - per-light skips of zero ambient colours and unit normalisation factors in the kernel:
 //!   exact, but the fill frame went 50 → 53 ms (register allocation), reverted;
 //! - sorting the pixels of a Gouraud tile for a deferred pass instead of colouring them during
-//!   visibility: the sort cost more than the interpolation (tile CPU time 24 → 18 ms).
+//!   visibility: the sort cost more than the interpolation (tile CPU time 24 → 18 ms);
+//! - 8-bit frames (`Pixel`) encoded by scalar saturating casts: they did not vectorise (22%
+//!   of a 1-thread 100k Gouraud frame); the SSE2 `encode_linear` made it 5.9%. Even so
+//!   `phong bench` gained nothing measurable from writing a quarter of the bytes (every pixel
+//!   is encoded, single-triangle tiles go through the task's buffer); one-shot renders and
+//!   memory did (BENCHMARKS.md).
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
