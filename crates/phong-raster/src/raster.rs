@@ -32,9 +32,9 @@
 //!   visibility: the sort cost more than the interpolation (tile CPU time 24 → 18 ms);
 //! - 8-bit frames (`Pixel`) encoded by scalar saturating casts: they did not vectorise (22%
 //!   of a 1-thread 100k Gouraud frame); the SSE2 `encode_linear` made it 5.9%. Even so
-//!   `phong bench` gained nothing measurable from writing a quarter of the bytes (every pixel
-//!   is encoded, single-triangle tiles go through the task's buffer); one-shot renders and
-//!   memory did (BENCHMARKS.md).
+//!   `phong bench` gained only 2–6% from writing a quarter of the bytes (every pixel is
+//!   encoded, single-triangle tiles go through the task's buffer); one-shot renders (−27%)
+//!   and memory gained more (BENCHMARKS.md).
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
