@@ -383,14 +383,24 @@ impl Gpu {
     }
 
     /// Maps `buffer` (a copy into it submitted), waits for the GPU, checks `scopes`, and
-    /// returns its contents, copied out of the mapping in one piece (it may be uncached
-    /// memory, slow to read in small pieces).
+    /// returns its contents.
     fn read_buffer<T: bytemuck::Pod>(
         &self,
         buffer: &wgpu::Buffer,
         scopes: Scopes,
         doing: &'static str,
     ) -> Result<Vec<T>, Error> {
+        self.read_mapped(buffer, scopes, doing, |data| bytemuck::pod_collect_to_vec(data))
+    }
+
+    /// [`Gpu::read_buffer`], `f` reading the mapped bytes in place.
+    fn read_mapped<R>(
+        &self,
+        buffer: &wgpu::Buffer,
+        scopes: Scopes,
+        doing: &'static str,
+        f: impl FnOnce(&[u8]) -> R,
+    ) -> Result<R, Error> {
         let (tx, rx) = std::sync::mpsc::channel();
         buffer.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
@@ -404,7 +414,7 @@ impl Gpu {
             let data = buffer
                 .get_mapped_range(..)
                 .map_err(|e| self.fail(doing, e.to_string()))?;
-            bytemuck::pod_collect_to_vec(&data[..])
+            f(&data[..])
         };
         buffer.unmap();
         Ok(out)
@@ -1277,24 +1287,31 @@ impl Gpu {
             },
         );
         self.queue.submit([enc.finish()]);
-        // Halves converted by `half` (F16C where the processor has it) in one pass; with a
-        // scalar conversion pixel by pixel from the mapping, a 4K frame's read-back took
-        // 230–480 ms on the H100 machine, 190–260 ms after (BENCHMARKS.md).
-        let halves: Vec<u16> = self.read_buffer(&out, scopes, "reading the image back")?;
-        let mut floats = vec![0f32; halves.len()];
-        halves.reinterpret_cast::<half::f16>().convert_to_f32_slice(&mut floats);
+        // Row by row from the mapping: each row's halves converted by `half` (F16C where the
+        // processor has it) into a small buffer, then made straight alpha into the image. On
+        // the H100 machine (4K frame) the whole-frame copies this replaces (66 MB of halves,
+        // 133 MB of floats, both freshly allocated) took 175–194 ms beside a 44–58 ms copy
+        // out of the mapping.
         let bg = p.background;
-        let stride = padded as usize / 2;
-        let mut pixels = Vec::with_capacity(w as usize * h as usize);
-        for y in 0..h as usize {
-            for c in floats[y * stride..y * stride + 4 * w as usize].chunks_exact(4) {
-                pixels.push(if c[3] > 0.0 {
-                    [c[0] / c[3], c[1] / c[3], c[2] / c[3], c[3]]
-                } else {
-                    [bg[0], bg[1], bg[2], 0.0]
-                });
+        let stride = padded as usize;
+        let pixels = self.read_mapped(&out, scopes, "reading the image back", |data| {
+            let mut pixels = Vec::with_capacity(w as usize * h as usize);
+            let mut floats = vec![0f32; 4 * w as usize];
+            for y in 0..h as usize {
+                let halves: Vec<u16> = bytemuck::pod_collect_to_vec(&data[y * stride..y * stride + row as usize]);
+                halves.reinterpret_cast::<half::f16>().convert_to_f32_slice(&mut floats);
+                pixels.extend(floats.chunks_exact(4).map(|c| {
+                    if c[3] == 1.0 {
+                        [c[0], c[1], c[2], 1.0]
+                    } else if c[3] > 0.0 {
+                        [c[0] / c[3], c[1] / c[3], c[2] / c[3], c[3]]
+                    } else {
+                        [bg[0], bg[1], bg[2], 0.0]
+                    }
+                }));
             }
-        }
+            pixels
+        })?;
         Ok(Image::from_pixels(w, h, pixels)?)
     }
 
