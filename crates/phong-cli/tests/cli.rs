@@ -388,12 +388,7 @@ fn gpu_backend_selection() {
             "32",
             "-v",
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let line = String::from_utf8_lossy(&o.stdout);
-        assert!(
-            line.starts_with("phong: 64x32 tris=") && line.contains(" frames=2 ms_per_frame="),
-            "{line}"
-        );
+        assert_bench_line(&o, "64x32", 2, 2);
         let e = stderr(&o);
         assert!(e.contains("compute rasterizer") && e.contains("readback="), "{e}");
         if !e.contains("no timestamps") {
@@ -431,6 +426,32 @@ fn gpu_backend_selection() {
     }
 }
 
+/// `phong bench`'s output `o`: success and exactly one line in the documented format, of
+/// `size`, at least `min_tris` triangles and `frames` frames, with positive times and rates.
+fn assert_bench_line(o: &std::process::Output, size: &str, min_tris: u64, frames: u32) {
+    assert!(o.status.success(), "{}", stderr(o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = out.trim();
+    assert_eq!(out.lines().count(), 1, "{out}");
+    let fields: Vec<&str> = line.split(' ').collect();
+    assert_eq!(fields.len(), 6, "{line}");
+    assert_eq!(fields[0], "phong:");
+    assert_eq!(fields[1], size);
+    assert!(
+        fields[2].strip_prefix("tris=").unwrap().parse::<u64>().unwrap() >= min_tris,
+        "{line}"
+    );
+    assert_eq!(fields[3], format!("frames={frames}"));
+    assert!(
+        fields[4].strip_prefix("ms_per_frame=").unwrap().parse::<f64>().unwrap() > 0.0,
+        "{line}"
+    );
+    assert!(
+        fields[5].strip_prefix("mpix_per_s=").unwrap().parse::<f64>().unwrap() > 0.0,
+        "{line}"
+    );
+}
+
 /// `phong bench` prints exactly one line in the documented format, and -v the stages.
 #[test]
 fn bench_line_format() {
@@ -445,26 +466,7 @@ fn bench_line_format() {
         "32",
         "-v",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let out = String::from_utf8_lossy(&o.stdout);
-    let line = out.trim();
-    assert_eq!(out.lines().count(), 1, "{out}");
-    let fields: Vec<&str> = line.split(' ').collect();
-    assert_eq!(fields[0], "phong:");
-    assert_eq!(fields[1], "64x32");
-    assert!(
-        fields[2].strip_prefix("tris=").unwrap().parse::<u64>().unwrap() > 1000,
-        "{line}"
-    );
-    assert_eq!(fields[3], "frames=2");
-    assert!(
-        fields[4].strip_prefix("ms_per_frame=").unwrap().parse::<f64>().unwrap() > 0.0,
-        "{line}"
-    );
-    assert!(
-        fields[5].strip_prefix("mpix_per_s=").unwrap().parse::<f64>().unwrap() > 0.0,
-        "{line}"
-    );
+    assert_bench_line(&o, "64x32", 1001, 2);
     let e = stderr(&o);
     assert!(
         e.contains("setup+binning=")

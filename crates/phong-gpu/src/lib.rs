@@ -512,6 +512,12 @@ impl Gpu {
         self.item_capacity = items.max(1);
     }
 
+    /// Whether the adapter runs on the CPU (Mesa's lavapipe): [`GpuPath::Auto`] takes the
+    /// pipeline there.
+    pub fn is_cpu_adapter(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// The largest storage buffer binding the device allows, in bytes.
     pub fn max_storage_bytes(&self) -> u64 {
         self.limits
@@ -695,7 +701,7 @@ impl Gpu {
         let compute = match path {
             GpuPath::Pipeline => false,
             // A driver that cannot build the compute rasterizer leaves the pipeline.
-            GpuPath::Auto if self.info.device_type == wgpu::DeviceType::Cpu => false,
+            GpuPath::Auto if self.is_cpu_adapter() => false,
             GpuPath::Auto | GpuPath::PreferCompute => self.compute_reason(scene).is_none() && self.kernels().is_ok(),
             GpuPath::Compute => match self.compute_reason(scene) {
                 None => true,

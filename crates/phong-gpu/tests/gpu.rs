@@ -272,7 +272,7 @@ fn automatic_path_follows_the_adapter() {
     scene.image.width = 160;
     scene.image.height = 100;
     let (_, stats) = gpu.render(&scene).unwrap();
-    let on_cpu = gpu.adapter_name().contains(", Cpu)");
+    let on_cpu = gpu.is_cpu_adapter();
     assert_eq!(
         stats.compute,
         !on_cpu && gpu.compute_reason(&scene).is_none(),
