@@ -356,17 +356,17 @@ struct Chunk {
     binned: Vec<(u32, u32)>,
 }
 
-/// A Gouraud triangle set up before its vertices were lit: what its plane equations need
-/// besides its edges (in the chunk's triangle `slot`), filled in once the colours exist.
+/// A Gouraud triangle set up before its vertices were lit (in the chunk's triangle `slot`),
+/// its planes made once the colours exist. 16 bytes: the rest of what the planes need (vertex
+/// 0's window position, `1/w`, the area, the facing) is read again from the vertex records
+/// and the triangle's edges. Keeping them here (56 bytes) was within noise at one thread and
+/// slower at two (the 1M-triangle sphere's setup and planes stages, 4 interleaved pairs:
+/// 9.0 / 8.5 / 13.7 / 9.2 → 8.4 / 8.2 / 7.7 / 8.9 ms): a million-triangle frame's setup is
+/// bound by memory traffic there.
 struct Pending {
     slot: u32,
     /// Input vertices, in the set-up order.
     idx: [u32; 3],
-    /// Vertex 0's snapped window position.
-    origin: (i64, i64),
-    inv_w: [f32; 3],
-    area: u64,
-    front: bool,
 }
 
 /// Working memory kept between frames by a [`Renderer`](crate::Renderer): emptied, never
@@ -375,7 +375,10 @@ struct Pending {
 pub(crate) struct Scratch {
     /// The fast setup's per-vertex buffers (one object at a time).
     vertices: Vec<FastVertex>,
-    colors: Vec<[Vec3; 2]>,
+    /// Gouraud: the lit colour of each vertex seen from the front, and (two-sided) the back;
+    /// kept between frames without clearing (only the vertices of drawn triangles are lit
+    /// and read).
+    colors: [Vec<Vec3>; 2],
     /// Gouraud: whether a vertex is used by a drawn triangle (only those are lit).
     used: Vec<AtomicBool>,
     /// Chunks of set-up triangles, emptied, for the next frame's setup tasks.
@@ -551,14 +554,11 @@ impl<'a> Frame<'a> {
             )
         });
         let sides = if two_sided { 2 } else { 1 };
-        let light = |ps: &[Vec3], ns: &[Vec3], out: &mut [[Vec3; 2]]| {
+        // The colours of vertices `ps` with normals `ns` from the front and (two-sided) the back.
+        let light = |ps: &[Vec3], ns: &[Vec3], out: [&mut [Vec3]; 2]| {
             let (prep, term) = vertex_lighting.as_ref().expect("only Gouraud objects light vertices");
-            let mut lit_colors = [Vec3::ZERO; LIGHT_GROUP];
-            for (side, flip) in [(0, false), (1, true)].into_iter().take(sides) {
-                light_vertices(self.avx2, prep, *term, ps, ns, flip, &mut lit_colors[..ps.len()]);
-                for (o, c) in out.iter_mut().zip(&lit_colors) {
-                    o[side] = *c;
-                }
+            for (side, o) in out.into_iter().enumerate().take(sides) {
+                light_vertices(self.avx2, prep, *term, ps, ns, side == 1, o);
             }
         };
         let used = &mut scratch.used;
@@ -603,10 +603,6 @@ impl<'a> Frame<'a> {
                             out.pending.push(Pending {
                                 slot: out.tris.len() as u32,
                                 idx: each3(|k| tri[s.order[k]]),
-                                origin: s.xy[0],
-                                inv_w: s.inv_w,
-                                area: s.area,
-                                front: s.front,
                             });
                         } else {
                             out.planes.push(phong_planes(&s, tri));
@@ -616,11 +612,12 @@ impl<'a> Frame<'a> {
                     continue;
                 }
                 // Rare: clip, with the vertices in full (Gouraud: lit here).
-                let mut lit3 = [[Vec3::ZERO; 2]; 3];
+                let mut lit3 = [[Vec3::ZERO; 3]; 2];
                 if gouraud {
                     let ps = tri.map(|i| positions[i as usize]);
                     let ns = tri.map(|i| normals[i as usize]);
-                    light(&ps, &ns, &mut lit3);
+                    let [front, back] = &mut lit3;
+                    light(&ps, &ns, [front, back]);
                 }
                 let t = each3(|k| {
                     let i = tri[k] as usize;
@@ -628,8 +625,8 @@ impl<'a> Frame<'a> {
                         clip: clip_from_world * Vec4::from((positions[i], 1.0)),
                         world: positions[i],
                         normal: normals[i],
-                        color: lit3[k][0],
-                        color_back: lit3[k][1],
+                        color: lit3[0][k],
+                        color_back: lit3[1][k],
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {
@@ -657,27 +654,43 @@ impl<'a> Frame<'a> {
         };
         let mut chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
         if gouraud {
-            let colors = &mut scratch.colors;
-            colors.clear();
-            colors.resize(positions.len(), [Vec3::ZERO; 2]);
-            colors
-                .par_chunks_mut(SETUP_CHUNK)
-                .zip(positions.par_chunks(SETUP_CHUNK))
-                .zip(normals.par_chunks(SETUP_CHUNK))
-                .zip(used.par_chunks(SETUP_CHUNK))
-                .for_each(|(((out, ps), ns), us)| {
-                    for (((o, p), n), u) in out
-                        .chunks_mut(LIGHT_GROUP)
-                        .zip(ps.chunks(LIGHT_GROUP))
-                        .zip(ns.chunks(LIGHT_GROUP))
-                        .zip(us.chunks(LIGHT_GROUP))
-                    {
-                        if u.iter().any(|u| u.load(Ordering::Relaxed)) {
-                            light(p, n, o);
-                        }
+            // Lit straight into the colour arrays, which keep last frame's values (no 24 bytes a
+            // vertex cleared and copied per frame): only the used vertices' colours are read.
+            let [front, back] = &mut scratch.colors;
+            front.resize(positions.len(), Vec3::ZERO);
+            back.resize(if two_sided { positions.len() } else { 0 }, Vec3::ZERO);
+            let mut backs = back.chunks_mut(SETUP_CHUNK);
+            let jobs: Vec<_> = front
+                .chunks_mut(SETUP_CHUNK)
+                .map(|f| (f, backs.next().unwrap_or_default()))
+                .enumerate()
+                .collect();
+            jobs.into_par_iter().for_each(|(j, (f, b))| {
+                let at = j * SETUP_CHUNK;
+                let range = at..at + f.len();
+                let (ps, ns, us) = (&positions[range.clone()], &normals[range.clone()], &used[range]);
+                // Runs of groups of 16 vertices with a used one, each lit by one kernel call.
+                let group_used = |g: usize| {
+                    us[g * LIGHT_GROUP..((g + 1) * LIGHT_GROUP).min(us.len())]
+                        .iter()
+                        .any(|u| u.load(Ordering::Relaxed))
+                };
+                let (groups, mut g) = (us.len().div_ceil(LIGHT_GROUP), 0);
+                while g < groups {
+                    if !group_used(g) {
+                        g += 1;
+                        continue;
                     }
-                });
-            let colors = &*colors;
+                    let start = g;
+                    while g < groups && group_used(g) {
+                        g += 1;
+                    }
+                    let run = start * LIGHT_GROUP..(g * LIGHT_GROUP).min(us.len());
+                    let b = if b.is_empty() { &mut [][..] } else { &mut b[run.clone()] };
+                    light(&ps[run.clone()], &ns[run.clone()], [&mut f[run], b]);
+                }
+            });
+            let colors = &scratch.colors;
             chunks.par_iter_mut().for_each(|chunk| {
                 let Chunk {
                     tris,
@@ -691,13 +704,17 @@ impl<'a> Frame<'a> {
                 let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
                 planes.extend((0..tris.len() as u32).map(|slot| {
                     if let Some(p) = pending.next_if(|p| p.slot == slot) {
-                        let side = usize::from(!p.front);
-                        let c = each3(|k| colors[p.idx[k] as usize][side]);
+                        let t = &tris[slot as usize];
+                        let v = each3(|k| vertices[p.idx[k] as usize].p);
+                        // Twice the area: the cross product of edges 2 (vertex 0 to 1) and 1
+                        // (vertex 2 to 0), as `setup_edges` computed it up to the sign.
+                        let area = (t.a(1) * t.b(2) - t.a(2) * t.b(1)).unsigned_abs();
+                        let c = each3(|k| colors[usize::from(t.back)][p.idx[k] as usize]);
                         plane_equations(
-                            p.origin,
-                            &tris[slot as usize],
-                            p.area,
-                            p.inv_w,
+                            (i64::from(v[0].0), i64::from(v[0].1)),
+                            t,
+                            area,
+                            [v[0].3, v[1].3, v[2].3],
                             [c, [Vec3::ZERO; 3]],
                             true,
                         )
@@ -1862,7 +1879,7 @@ pub(crate) mod tests {
         assert_eq!(size_of::<FastVertex>(), 20);
         assert_eq!(size_of::<Tri>(), 80);
         assert_eq!(size_of::<Planes>(), 96);
-        assert_eq!(size_of::<Pending>(), 56);
+        assert_eq!(size_of::<Pending>(), 16);
     }
 
     /// A xorshift64 generator: the tests' reproducible random numbers.

@@ -244,16 +244,29 @@ pub fn encode_linear(dst: &mut [[u8; 4]], src: &[[f32; 4]]) {
     {
         use core::arch::x86_64::{
             _mm_add_ps, _mm_cvtsi128_si32, _mm_cvttps_epi32, _mm_loadu_ps, _mm_max_ps, _mm_min_ps, _mm_mul_ps,
-            _mm_packs_epi32, _mm_packus_epi16, _mm_set1_ps, _mm_setzero_ps,
+            _mm_packs_epi32, _mm_packus_epi16, _mm_set1_ps, _mm_setzero_ps, _mm_storeu_si128,
         };
-        for (d, s) in dst.iter_mut().zip(src) {
-            // SAFETY: SSE2 is part of x86-64; `s` is 4 readable f32.
-            let word = unsafe {
-                let v = _mm_min_ps(_mm_max_ps(_mm_loadu_ps(s.as_ptr()), _mm_setzero_ps()), _mm_set1_ps(1.0));
-                let v = _mm_add_ps(_mm_mul_ps(v, _mm_set1_ps(255.0)), _mm_set1_ps(0.5));
-                let i = _mm_cvttps_epi32(v);
-                _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(i, i), _mm_packs_epi32(i, i)))
-            };
+        // One pixel's four channels as 32-bit integers in [0, 255].
+        // SAFETY (of the callers' blocks): SSE2 is part of x86-64; `s` is 4 readable f32.
+        let channels = |s: &[f32; 4]| unsafe {
+            let v = _mm_min_ps(_mm_max_ps(_mm_loadu_ps(s.as_ptr()), _mm_setzero_ps()), _mm_set1_ps(1.0));
+            _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(v, _mm_set1_ps(255.0)), _mm_set1_ps(0.5)))
+        };
+        // Four pixels packed together and stored as 16 bytes (one pixel at a time: 6.7% of a
+        // 1-thread 100k-triangle Gouraud frame).
+        let (mut d4, mut s4) = (dst.chunks_exact_mut(4), src.chunks_exact(4));
+        for (d, s) in (&mut d4).zip(&mut s4) {
+            // SAFETY: SSE2 is part of x86-64; `d` is 16 writable bytes.
+            unsafe {
+                let lo = _mm_packs_epi32(channels(&s[0]), channels(&s[1]));
+                let hi = _mm_packs_epi32(channels(&s[2]), channels(&s[3]));
+                _mm_storeu_si128(d.as_mut_ptr().cast(), _mm_packus_epi16(lo, hi));
+            }
+        }
+        for (d, s) in d4.into_remainder().iter_mut().zip(s4.remainder()) {
+            let i = channels(s);
+            // SAFETY: SSE2 is part of x86-64.
+            let word = unsafe { _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(i, i), _mm_packs_epi32(i, i))) };
             *d = word.to_le_bytes();
         }
     }
