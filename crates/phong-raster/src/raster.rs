@@ -410,6 +410,8 @@ struct Frame<'a> {
     avx2: bool,
     /// Per object: how the fast path shades it (decided once per frame).
     modes: Vec<Mode>,
+    /// Every object is Gouraud-shaded on the fast path (see [`Frame::tile_visible`]).
+    gouraud_only: bool,
     /// Per object: its view vector rule.
     views: Vec<View>,
     w: u32,
@@ -442,7 +444,7 @@ impl<'a> Frame<'a> {
             .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))
             .collect::<Vec<_>>();
         let span = SampleSpan::of(&pattern);
-        let modes = scene
+        let modes: Vec<Mode> = scene
             .objects
             .iter()
             .map(|o| {
@@ -464,9 +466,11 @@ impl<'a> Frame<'a> {
                 }
             })
             .collect();
+        let gouraud_only = !reference && modes.iter().all(|m| matches!(m, Mode::Gouraud));
         let mut frame = Frame {
             scene,
             avx2,
+            gouraud_only,
             modes,
             views,
             w,
@@ -1483,6 +1487,39 @@ impl Frame<'_> {
         }
         depth.clear();
         depth.resize(tw * th * ns, f32::INFINITY);
+        if ns == 1 && self.gouraud_only {
+            // Every visible pixel is coloured during visibility (see `Forward`): the tile
+            // starts as background and needs no ids, no scan and no deferred shading (1
+            // thread, 4 and 3 interleaved pairs: 100k sphere 13.7 → 13.1 ms, 1M 41.2 → 39.6 ms).
+            let background = resolve(std::iter::once(bg), 1, bg);
+            for line in rows.iter_mut() {
+                line.fill(background);
+            }
+            for &ti in bin {
+                let t = self.tri(ti);
+                let (ox, oy) = self.pattern[0];
+                let o = each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
+                let bb = t.bbox();
+                let forward = Forward {
+                    planes: ColorPlanes::new(self.planes(ti)),
+                    rows: &mut *rows,
+                };
+                let tile = (x0, y0, tw, y1);
+                self.visible_single(
+                    t,
+                    0,
+                    o,
+                    tile,
+                    (bb[0].max(x0), bb[2].min(x1)),
+                    depth,
+                    None,
+                    Some(forward),
+                );
+            }
+            let end = Instant::now();
+            clock.add(t_start, end, end, end);
+            return depth.iter().filter(|&&d| d != f32::INFINITY).count() as u64;
+        }
         ids.clear();
         ids.resize(tw * th * ns, u32::MAX);
         let mut offsets = [[0i64; 3]; 16];
@@ -1506,9 +1543,18 @@ impl Frame<'_> {
                         planes: ColorPlanes::new(self.planes(ti)),
                         rows: &mut *rows,
                     };
-                    self.visible_single(t, k as u32, offsets[0], tile, (bx0, bx1), depth, ids, Some(forward));
+                    self.visible_single(
+                        t,
+                        k as u32,
+                        offsets[0],
+                        tile,
+                        (bx0, bx1),
+                        depth,
+                        Some(ids),
+                        Some(forward),
+                    );
                 } else {
-                    self.visible_single(t, k as u32, offsets[0], tile, (bx0, bx1), depth, ids, None);
+                    self.visible_single(t, k as u32, offsets[0], tile, (bx0, bx1), depth, Some(ids), None);
                 }
                 continue;
             }
@@ -1638,7 +1684,7 @@ impl Frame<'_> {
         (x0, y0, tw, y1): (u32, u32, usize, u32),
         (bx0, bx1): (u32, u32),
         depth: &mut [f32],
-        ids: &mut [u32],
+        mut ids: Option<&mut [u32]>,
         mut forward: Option<Forward>,
     ) {
         let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
@@ -1676,9 +1722,11 @@ impl Frame<'_> {
                     if zz < depth[at] {
                         depth[at] = zz;
                         if forward.is_some() {
-                            ids[at] = FORWARD;
+                            if let Some(ids) = ids.as_deref_mut() {
+                                ids[at] = FORWARD;
+                            }
                             passed |= 1 << k;
-                        } else {
+                        } else if let Some(ids) = ids.as_deref_mut() {
                             ids[at] = ti;
                         }
                     }
