@@ -34,7 +34,20 @@
 //!   of a 1-thread 100k Gouraud frame); the SSE2 `encode_linear` made it 5.9%. Even so
 //!   `phong bench` gained only 2–6% from writing a quarter of the bytes (every pixel is
 //!   encoded, single-triangle tiles go through the task's buffer); one-shot renders (−27%)
-//!   and memory gained more (BENCHMARKS.md).
+//!   and memory gained more (BENCHMARKS.md);
+//! - culling a setup chunk's triangles first, branch-free (area, facing, pixel box), then
+//!   setting up only the survivors (a quarter of a 1M sphere's): slower (the setup stage 12.3
+//!   → 16.0 ms, 1 thread; LLVM kept branches for the clamps, and the survivors pay twice);
+//! - software prefetch of the vertex records of the triangle 16 ahead in the setup: within
+//!   noise, slightly slower (12.3 → 13.0 ms): the setup is not bound by load latency;
+//! - the covered pixels of a narrow row found as a mask first, then only those tested for
+//!   depth (to spare the coverage branch's mispredictions): slower, 13.4 → 13.8 ms (100k);
+//! - Gouraud planes computed as four `[r, g, b, 1/w]` lanes that the compiler vectorises
+//!   (the same bits): the planes stage unchanged (3.5 ms at 1M): it is bound by memory;
+//! - 32-pixel tiles instead of 64 (so that a tile's colours, depths and ids fit in L1):
+//!   slower, 100k Gouraud 7.0 → 7.9 ms and 1M 22 → 23.5 ms at 2 threads (more triangles
+//!   binned twice, more per-tile work);
+//! - 8-bit stores streamed past the caches: within noise, single runs slower. Not kept.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
