@@ -51,8 +51,8 @@
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
-    Batch, Planes, Prepared, Term, avx2_available, encode_linear, group_lanes, light_vertices, project_vertices,
-    shade_batch, shade_group, stream_copy, stream_fence, stream_fill,
+    Batch, GouraudTri, Planes, Prepared, Term, avx2_available, covered_span, encode_linear, gouraud_tile, group_lanes,
+    light_vertices, project_vertices, shade_batch, shade_group, stream_copy, stream_fence, stream_fill,
 };
 use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
@@ -1644,18 +1644,31 @@ impl Frame<'_> {
             && !bin.is_empty()
             && !(bin.len() == 1 && self.covers_rect(bin[0], self.tile_rect(tile)))
         {
-            return self.tile_gouraud(tile, bg, clock, rows, depth);
+            return self.tile_gouraud(tile, bg, clock, rows, depth, self.gouraud_kernel(tile));
         }
         self.tile_visible(tile, bg, clock, rows, image, (depth, ids))
     }
 
+    /// Whether [`Frame::tile_gouraud`] draws `tile` with the AVX2 kernel ([`gouraud_tile`]):
+    /// with AVX2, where the tile has at least 8 pixels per triangle of its bin. Its cost per
+    /// triangle is higher than the scalar loop's, its cost per pixel lower (1 thread, 3
+    /// interleaved runs: kernel everywhere, scalar everywhere, this rule: 100k sphere 12.0,
+    /// 13.6, 12.1 ms; 1M 44.1, 40.5, 40.4 ms; a 300k sphere of 548 segments 21.0, 20.8, 20.2
+    /// ms).
+    fn gouraud_kernel(&self, tile: u32) -> bool {
+        let (x0, y0, x1, y1) = self.tile_rect(tile);
+        self.avx2 && ((x1 - x0) * (y1 - y0)) as usize >= 8 * self.bins[tile as usize].len()
+    }
+
     /// [`Frame::tile_visible`] of a frame whose objects are all Gouraud-shaded, with one
-    /// sample, past its empty and trivially accepted tiles: every visible pixel is coloured during visibility (see [`Forward`]), so the tile
-    /// starts as background and needs no ids, no scan and no deferred shading (1 thread, 4 and
-    /// 3 interleaved pairs: 100k sphere 13.7 → 13.1 ms, 1M 41.2 → 39.6 ms). Chosen by the
-    /// caller, not inlined: as a branch of `tile_visible`, even one calling this function, it
-    /// made that function's multi-sample loop slower (teapots' tile rasterisation 25.2 → 28.2
-    /// ms of CPU time, 3 interleaved pairs).
+    /// sample, past its empty and trivially accepted tiles: every visible pixel is coloured
+    /// during visibility (see [`Forward`]), so the tile starts as background and needs no ids,
+    /// no scan and no deferred shading (1 thread, 4 and 3 interleaved pairs: 100k sphere 13.7
+    /// → 13.1 ms, 1M 41.2 → 39.6 ms). With `kernel`, by the AVX2 kernel [`gouraud_tile`] (see
+    /// [`Frame::gouraud_kernel`]), else by the scalar loop, `visible_single`: the same bits.
+    /// Chosen by the caller, not inlined: as a branch of `tile_visible`, even one calling this
+    /// function, it made that function's multi-sample loop slower (teapots' tile
+    /// rasterisation 25.2 → 28.2 ms of CPU time, 3 interleaved pairs).
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
     fn tile_gouraud(
@@ -1665,16 +1678,44 @@ impl Frame<'_> {
         clock: &StageClock,
         rows: &mut [&mut [[f32; 4]]],
         depth: &mut Vec<f32>,
+        kernel: bool,
     ) -> u64 {
         let t_start = Instant::now();
         let (x0, y0, x1, y1) = self.tile_rect(tile);
         let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let bin = &self.bins[tile as usize];
         depth.clear();
-        depth.resize(tw * th, f32::INFINITY);
+        // The AVX2 kernel's rows of depth are a multiple of 4 long: it tests windows of 4
+        // pixels aligned in the tile (the extra pixels stay infinite).
+        let stride = if kernel { tw.next_multiple_of(4) } else { tw };
+        depth.resize(stride * th, f32::INFINITY);
         let background = resolve(std::iter::once(bg), 1, bg);
         for line in rows.iter_mut() {
             line.fill(background);
+        }
+        let (ox, oy) = self.pattern[0];
+        let triangle = |k: usize| {
+            let ti = bin[k];
+            let t = self.tri(ti);
+            let bb = t.bbox();
+            let (bx0, by0) = (bb[0].max(x0), bb[1].max(y0));
+            let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(by0) << SUBPIXEL_BITS);
+            GouraudTri {
+                start: each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + t.a(i) * ox + t.b(i) * oy - t.bias(i)),
+                step_x: each3(|i| t.a(i) << SUBPIXEL_BITS),
+                step_y: each3(|i| t.b(i) << SUBPIXEL_BITS),
+                bias: each3(|i| t.bias(i)),
+                inv_area: t.inv_area,
+                z: t.z,
+                cols: (bx0 - x0, bb[2].min(x1).max(bx0) - x0),
+                rows: (by0 - y0, bb[3].min(y1).max(by0) - y0),
+                planes: self.planes(ti),
+            }
+        };
+        if gouraud_tile(kernel, (x0, y0), stride, bin.len(), triangle, depth, rows) {
+            let end = Instant::now();
+            clock.add(t_start, end, end, end);
+            return depth.iter().filter(|&&d| d != f32::INFINITY).count() as u64;
         }
         for &ti in bin {
             let t = self.tri(ti);
@@ -1744,21 +1785,7 @@ impl Frame<'_> {
             let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
             // e − bias at the row's first pixel.
             let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
-            let (mut lo, mut hi) = (0i64, n);
-            if n >= 8 {
-                for i in 0..3 {
-                    let (e, s) = (row[i], step[i]);
-                    if e < 0 {
-                        if s > 0 {
-                            lo = lo.max((-e + s - 1) / s);
-                        } else {
-                            hi = 0;
-                        }
-                    } else if s < 0 {
-                        hi = hi.min(e / -s + 1);
-                    }
-                }
-            }
+            let (lo, hi) = covered_span(row, step, n);
             let line = (py - y0) as usize * tw + (bx0 - x0) as usize;
             let mut eb = each3(|i| row[i] + step[i] * lo);
             // Forward: the pixels of this row (at most a tile's 64) that passed.
@@ -1978,6 +2005,105 @@ pub(crate) mod tests {
         assert_eq!(size_of::<Tri>(), 80);
         assert_eq!(size_of::<Planes>(), 96);
         assert_eq!(size_of::<Pending>(), 16);
+    }
+
+    /// The AVX2 Gouraud tile kernel draws every tile of a frame bit for bit as the scalar loop
+    /// (`visible_single`): each colour and depth, and the count of covered pixels. Frames of
+    /// 203 × 149 pixels (a last column of tiles 11 pixels wide, not a multiple of the kernel's
+    /// 4) with a sphere, a torus and a two-sided ground plane through the near plane, and a
+    /// soup of random triangles from under a pixel to wider than the frame, interpenetrating,
+    /// drawn twice in two materials (equal depths: the first stays), some of them also with
+    /// their vertices rotated.
+    #[test]
+    fn gouraud_kernel_is_the_scalar_loop() {
+        if !avx2_available() {
+            eprintln!("skipped: this CPU has no AVX2");
+            return;
+        }
+        let src = r#"
+[image]
+width = 203
+height = 149
+[camera]
+position = [0.0, 0.4, 0.5]
+target = [0.0, 0.0, -2.0]
+near = 0.1
+[shading]
+model = "blinn-phong"
+interpolation = "gouraud"
+two_sided = true
+[[light]]
+type = "point"
+position = [0.5, 2.0, -1.0]
+attenuation = [1.0, 0.1, 0.05]
+[[object]]
+shape = "sphere"
+segments = 40
+material = "gold"
+position = [-0.4, 0.0, -2.0]
+scale = 0.7
+[[object]]
+shape = "torus"
+segments = 32
+material = "ruby"
+position = [0.5, 0.0, -1.5]
+[[object]]
+shape = "plane"
+segments = 6
+material = "pewter"
+position = [0.0, -0.5, 0.0]
+scale = 300.0
+"#;
+        let path = std::path::Path::new("gouraud-kernel.toml");
+        let shapes = phong_scene::parse_scene(src, path).unwrap().scene;
+        let mut soup = shapes.clone();
+        soup.objects.truncate(2);
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut unit = move || (next() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..400u32 {
+            let centre = Vec3::new(unit() * 3.0 - 1.5, unit() * 2.0 - 1.0, -1.0 - unit() * 3.0);
+            let size = [0.004, 0.05, 0.3, 2.5][k as usize % 4] * (0.5 + unit());
+            for _ in 0..3 {
+                positions.push(centre + (Vec3::new(unit(), unit(), unit()) - 0.5) * size);
+            }
+            triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+            if k % 10 == 0 {
+                triangles.push([3 * k + 1, 3 * k + 2, 3 * k]);
+            }
+        }
+        // Twice, in two materials: the same depths, other colours.
+        let mesh = phong_core::Mesh::from_triangles(positions, triangles).unwrap();
+        for object in &mut soup.objects {
+            object.mesh = mesh.clone();
+        }
+        for (name, scene) in [("shapes", &shapes), ("soup", &soup)] {
+            let frame = Frame::build(scene, false, true, &mut Scratch::default());
+            let clock = StageClock::default();
+            let bg = [0.1, 0.2, 0.3, 1.0];
+            let (mut drawn, mut wide) = (0, 0);
+            for tile in 0..frame.bins.len() as u32 {
+                let (x0, y0, x1, y1) = frame.tile_rect(tile);
+                let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+                let draw = |kernel: bool| {
+                    let mut pixels = vec![[f32::NAN; 4]; tw * th];
+                    let mut rows: Vec<&mut [[f32; 4]]> = pixels.chunks_mut(tw).collect();
+                    let mut depth = Vec::new();
+                    let n = frame.tile_gouraud(tile, bg, &clock, &mut rows, &mut depth, kernel);
+                    let stride = depth.len() / th;
+                    let depth: Vec<f32> = depth.chunks(stride).flat_map(|r| r[..tw].to_vec()).collect();
+                    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    (n, bits(pixels.as_flattened()), bits(&depth))
+                };
+                let (scalar, vector) = (draw(false), draw(true));
+                assert!(scalar == vector, "{name}: tile {tile} differs");
+                drawn += scalar.0;
+                wide += u64::from(tw % 4 != 0 && scalar.0 > 0);
+            }
+            assert!(drawn > 203 * 149 / 2, "{name}: only {drawn} pixels drawn");
+            assert!(wide > 0, "{name}: nothing drawn in the narrow tiles");
+        }
     }
 
     /// A xorshift64 generator: the tests' reproducible random numbers.

@@ -1,0 +1,266 @@
+//! The Gouraud tile kernel (AVX2): visibility and colour of a tile's triangles, four pixels of
+//! a row at a time, bit for bit the scalar loop's (`raster`'s `visible_single` with its
+//! colour planes), which stays as the twin on CPUs without AVX2 and is tested against it.
+//!
+//! Per four pixels of a row: the three edge functions as exact integers in `f64` lanes (an
+//! edge value inside a triangle's box is below 2^51 in magnitude, so integer steps added in
+//! `f64` are exact, and `E as f64` is the scalar's conversion of the same integer), coverage
+//! as their sign bits, the barycentrics `(E · 1/area) as f32` and the depth `Σ λ_i z_i` in the
+//! scalar's order, the depth test and its blended store, then the colours `q_rgb / q_w` of the
+//! passing pixels, `q = c + g_x·dx + g_y·dy` per channel in the scalar's order (no fused
+//! multiply-adds, an exact division), transposed into `[r, g, b, 1]` pixels and blended into
+//! the row.
+//!
+//! Signs: `E − bias` is never `−0.0` (sums of integers in `f64` give `+0.0` where they cancel,
+//! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
+//! sign bit is exactly `E − bias < 0`.
+//!
+//! Measured (1080p, 1 thread, 3 interleaved runs; `phong bench SCENE --frames 20 --threads 1`):
+//! on the 100k Gouraud sphere the scalar loop takes 13.1–13.3 ms a frame, this kernel
+//! 11.7–11.9. Per frame that sphere's tiles hold 31k triangles, 263k rows of their boxes,
+//! 458k windows of which 354k hold a covered pixel, 830k covered pixels; the 1M sphere's
+//! 249k triangles, 749k rows, 1.1M windows, 568k with a pixel: each triangle is a third of a
+//! window, and the kernel's cost per triangle (its broadcasts) made that frame slower (39.2
+//! → 43.8 ms), hence the caller's choice per tile (`raster`'s `Frame::gouraud_kernel`).
+//! Dead ends, each against the kernel as it is:
+//! - The blend of the depth and of the pixels as a load, `blendv` and store: LLVM makes it
+//!   one masked store (`vmaskmovps`), slow on AMD and not forwarded to later loads: 14.6 ms
+//!   (it also made 4-pixel windows at any column, not aligned ones, 16.5 ms). Loading by
+//!   `lddqu`, which LLVM does not treat as a plain load, keeps the blend.
+//! - Every window of a row's box tested, without the covered span's three divisions: 12.5 ms.
+//!   The windows outside the span cost more than the divisions: a row's exact span makes its
+//!   first and last windows hold covered pixels, so the "any pixel covered" branch is
+//!   predictable.
+//! - The span from `1/step` multiplications in `f64`, rounded outward (one more window at
+//!   either end now and then): 13.3 ms; the same made exact by one integer test per edge:
+//!   12.8 ms. The `i64` divisions stay.
+
+use super::kernel::Planes;
+
+/// The pixels a triangle's row covers, as a range of `k` over `0..n` (pixels from the row's
+/// first column), given per edge `row[i]` = `E_i − bias_i` at the first pixel and its step per
+/// pixel `step[i]`: exact integer bounds of `row + k·step >= 0` for rows of 8 pixels or more,
+/// where the three divisions cost less than testing each pixel; `0..n` for narrower rows.
+#[inline(always)]
+pub(crate) fn covered_span(row: [i64; 3], step: [i64; 3], n: i64) -> (i64, i64) {
+    let (mut lo, mut hi) = (0i64, n);
+    if n >= 8 {
+        for i in 0..3 {
+            let (e, s) = (row[i], step[i]);
+            if e < 0 {
+                if s > 0 {
+                    lo = lo.max((-e + s - 1) / s);
+                } else {
+                    hi = 0;
+                }
+            } else if s < 0 {
+                hi = hi.min(e / -s + 1);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+/// A triangle as [`gouraud_tile`] draws it into a tile, in the tile's pixels.
+#[derive(Clone, Copy)]
+pub struct GouraudTri<'p> {
+    /// Per edge `i`: `E_i − bias_i` at the sample of the first pixel (column `cols.0`, row
+    /// `rows.0`), in 1/256² pixel².
+    pub start: [i64; 3],
+    /// Per edge: the change of `E_i` per pixel to the right.
+    pub step_x: [i64; 3],
+    /// Per edge: the change of `E_i` per row down.
+    pub step_y: [i64; 3],
+    /// Per edge: 1 where the edge is not top-left (`E_i = start + … + bias_i`), else 0.
+    pub bias: [i64; 3],
+    /// `1 / (twice the signed area)`: barycentrics are `E_i · inv_area`.
+    pub inv_area: f64,
+    /// Window depth per vertex.
+    pub z: [f32; 3],
+    /// Columns of the tile to draw, `cols.0..cols.1`.
+    pub cols: (u32, u32),
+    /// Rows of the tile to draw, `rows.0..rows.1`.
+    pub rows: (u32, u32),
+    /// The colour planes: `attr[0..3]` red, green and blue over `w`, `inv_w` the `1/w` plane,
+    /// each `[c, g_x, g_y]` about `origin`.
+    pub planes: &'p Planes,
+}
+
+/// Draws `n` triangles, `tri(0)` first, into a tile at `(x0, y0)` of the frame: `depth`
+/// (row-major, `stride` a row; a multiple of 4 at least the tile's width is fastest) keeps the nearest depth, and each pixel that passes
+/// its depth test (`z < depth`) gets its triangle's colour in `rows`. The AVX2 kernel, only
+/// with `avx2` (the caller checked [`super::avx2_available`]); returns false and draws nothing
+/// without it (the caller then draws with the scalar loop).
+pub fn gouraud_tile<'p>(
+    avx2: bool,
+    (x0, y0): (u32, u32),
+    stride: usize,
+    n: usize,
+    tri: impl Fn(usize) -> GouraudTri<'p>,
+    depth: &mut [f32],
+    rows: &mut [&mut [[f32; 4]]],
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        super::require_avx2();
+        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+        unsafe { gouraud_tile_avx2((x0, y0), stride, n, tri, depth, rows) };
+        return true;
+    }
+    let _ = (avx2, x0, y0, stride, n, tri, depth, rows);
+    false
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn gouraud_tile_avx2<'p>(
+    (x0, y0): (u32, u32),
+    stride: usize,
+    n: usize,
+    tri: impl Fn(usize) -> GouraudTri<'p>,
+    depth: &mut [f32],
+    rows: &mut [&mut [[f32; 4]]],
+) {
+    use core::arch::x86_64::*;
+    let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+    let lanes_epi = _mm_setr_epi32(0, 1, 2, 3);
+    // Blend masks from a window's pass bits, by shifting bit j into the sign of lane j (of a
+    // 4-pixel mask), or of lanes 4·j..4·j + 4 (of the masks of pixels 0, 1 and of 2, 3).
+    let shift4 = _mm_setr_epi32(31, 30, 29, 28);
+    let shift01 = _mm256_setr_epi32(31, 31, 31, 31, 30, 30, 30, 30);
+    let shift23 = _mm256_setr_epi32(29, 29, 29, 29, 28, 28, 28, 28);
+    let (one, half) = (_mm_set1_ps(1.0), _mm_set1_ps(0.5));
+    for k in 0..n {
+        let t = tri(k);
+        let ((c0, c1), (r0, r1)) = (t.cols, t.rows);
+        if c1 <= c0 || r1 <= r0 {
+            continue;
+        }
+        let width = i64::from(c1 - c0);
+        let p = t.planes;
+        let inv = _mm256_set1_pd(t.inv_area);
+        let z = t.z.map(|v| _mm_set1_ps(v));
+        let bias = t.bias.map(|b| _mm256_set1_pd(b as f64));
+        let lane_step = t.step_x.map(|s| _mm256_mul_pd(lanes_pd, _mm256_set1_pd(s as f64)));
+        let step4 = t.step_x.map(|s| _mm256_set1_pd((4 * s) as f64));
+        // Per channel (r, g, b, w): the plane's [c, g_x, g_y].
+        let plane = |ch: usize| if ch < 3 { p.attr[ch] } else { p.inv_w };
+        let cc: [__m128; 4] = std::array::from_fn(|ch| _mm_set1_ps(plane(ch)[0]));
+        let gx: [__m128; 4] = std::array::from_fn(|ch| _mm_set1_ps(plane(ch)[1]));
+        let ox = _mm_set1_ps(p.origin[0]);
+        let mut row_e = t.start;
+        for r in r0..r1 {
+            let (lo, hi) = covered_span(row_e, t.step_x, width);
+            if lo < hi {
+                let dy = _mm_set1_ps((y0 + r) as f32 + 0.5 - p.origin[1]);
+                let gyy: [__m128; 4] = std::array::from_fn(|ch| _mm_mul_ps(_mm_set1_ps(plane(ch)[2]), dy));
+                // Windows of 4 pixels aligned in the tile: a window's loads and stores are at
+                // the same addresses as its neighbours' of the triangles before it, so that
+                // they forward from the store buffer. Lanes outside the triangle's box (in the
+                // tile) are tested too: no sample there is inside the three edges.
+                let end = i64::from(c0) + hi;
+                let mut col = (i64::from(c0) + lo) & !3;
+                let mut e: [__m256d; 3] = std::array::from_fn(|i| {
+                    _mm256_add_pd(
+                        _mm256_set1_pd((row_e[i] + t.step_x[i] * (col - i64::from(c0))) as f64),
+                        lane_step[i],
+                    )
+                });
+                let line = r as usize * stride;
+                let row = &mut *rows[r as usize];
+                while col < end {
+                    let outside = _mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(e[0], e[1]), e[2])) as u32;
+                    // Lanes past the tile's right edge (a frame's last column of tiles).
+                    let valid = 15u32 >> (col + 4 - row.len() as i64).max(0);
+                    let inside = !outside & valid;
+                    if inside != 0 {
+                        let l: [__m128; 3] =
+                            std::array::from_fn(|i| _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e[i], bias[i]), inv)));
+                        let zz = _mm_add_ps(
+                            _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
+                            _mm_mul_ps(l[2], z[2]),
+                        );
+                        let at = line + col as usize;
+                        let pass = if let Some(d4) = depth.get_mut(at..at + 4) {
+                            // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend
+                            // and a store of the same address are otherwise turned into a masked
+                            // store (`vmaskmovps`), slow on AMD and not forwarded to later loads
+                            // (100k sphere, 1 thread: 13.0 → 14.6 ms with it).
+                            // SAFETY: `d4` is 4 readable f32.
+                            let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
+                            let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
+                            let m = _mm_castsi128_ps(_mm_sllv_epi32(_mm_set1_epi32(pass as i32), shift4));
+                            // SAFETY: `d4` is 4 writable f32.
+                            unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, m)) };
+                            pass
+                        } else {
+                            // A caller's depth without room for whole windows: one at a time.
+                            let mut zs = [0f32; 4];
+                            // SAFETY: `zs` is 4 writable f32.
+                            unsafe { _mm_storeu_ps(zs.as_mut_ptr(), zz) };
+                            let mut pass = 0;
+                            for (j, &zj) in zs.iter().enumerate() {
+                                if inside & (1 << j) != 0 && zj < depth[at + j] {
+                                    depth[at + j] = zj;
+                                    pass |= 1 << j;
+                                }
+                            }
+                            pass
+                        };
+                        if pass != 0 {
+                            let c = col as usize;
+                            let px =
+                                _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32((x0 as usize + c) as i32), lanes_epi));
+                            let dx = _mm_sub_ps(_mm_add_ps(px, half), ox);
+                            let q: [__m128; 4] = std::array::from_fn(|ch| {
+                                _mm_add_ps(_mm_add_ps(cc[ch], _mm_mul_ps(gx[ch], dx)), gyy[ch])
+                            });
+                            let w = _mm_div_ps(one, q[3]);
+                            let (cr, cg, cb) = (_mm_mul_ps(q[0], w), _mm_mul_ps(q[1], w), _mm_mul_ps(q[2], w));
+                            // Transposed: pixel j is [r_j, g_j, b_j, 1].
+                            let (rg_lo, rg_hi) = (_mm_unpacklo_ps(cr, cg), _mm_unpackhi_ps(cr, cg));
+                            let (b1_lo, b1_hi) = (_mm_unpacklo_ps(cb, one), _mm_unpackhi_ps(cb, one));
+                            let pixels = [
+                                _mm_movelh_ps(rg_lo, b1_lo),
+                                _mm_movehl_ps(b1_lo, rg_lo),
+                                _mm_movelh_ps(rg_hi, b1_hi),
+                                _mm_movehl_ps(b1_hi, rg_hi),
+                            ];
+                            if let Some(win) = row.get_mut(c..c + 4) {
+                                let pb = _mm256_set1_epi32(pass as i32);
+                                let m01 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift01));
+                                let m23 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift23));
+                                let ptr = win.as_mut_ptr().cast::<f32>();
+                                // SAFETY: `win` is 4 pixels, 16 readable and writable f32 from `ptr`.
+                                unsafe {
+                                    // By `lddqu`, as the depth above.
+                                    let old01 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.cast()));
+                                    let old23 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.add(8).cast()));
+                                    let new01 = _mm256_set_m128(pixels[1], pixels[0]);
+                                    let new23 = _mm256_set_m128(pixels[3], pixels[2]);
+                                    _mm256_storeu_ps(ptr, _mm256_blendv_ps(old01, new01, m01));
+                                    _mm256_storeu_ps(ptr.add(8), _mm256_blendv_ps(old23, new23, m23));
+                                }
+                            } else {
+                                let mut m = pass;
+                                while m != 0 {
+                                    let j = m.trailing_zeros() as usize;
+                                    // SAFETY: `row[c + j]` is 4 writable f32 (bounds-checked).
+                                    unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
+                                    m &= m - 1;
+                                }
+                            }
+                        }
+                    }
+                    for i in 0..3 {
+                        e[i] = _mm256_add_pd(e[i], step4[i]);
+                    }
+                    col += 4;
+                }
+            }
+            for (e, s) in row_e.iter_mut().zip(t.step_y) {
+                *e += s;
+            }
+        }
+    }
+}
