@@ -1712,10 +1712,10 @@ impl Frame<'_> {
                 planes: self.planes(ti),
             }
         };
-        if gouraud_tile(kernel, (x0, y0), stride, bin.len(), triangle, depth, rows) {
+        if let Some(covered) = gouraud_tile(kernel, (x0, y0), stride, bin.len(), triangle, depth, rows) {
             let end = Instant::now();
             clock.add(t_start, end, end, end);
-            return depth.iter().filter(|&&d| d != f32::INFINITY).count() as u64;
+            return covered;
         }
         for &ti in bin {
             let t = self.tri(ti);

@@ -31,6 +31,12 @@
 //!   The windows outside the span cost more than the divisions: a row's exact span makes its
 //!   first and last windows hold covered pixels, so the "any pixel covered" branch is
 //!   predictable.
+//! - Windows of 8 pixels (two `f64` vectors per edge, `f32` vectors of 8) from columns that are
+//!   multiples of 4, so that a row's span of up to 5 pixels is one window (fewer loop exits
+//!   mispredicted): 11.0 → 11.7 ms (100k), 38.9 → 39.8 ms (1M); most windows' second half is
+//!   empty, and the division and transposes of 8 lanes cost more than the loop saves.
+//! - The covered pixels counted by a scan of the tile's depths after the kernel: 3% of the
+//!   frame (the `+∞ → finite` transitions of the windows are counted instead: 10.9 → 10.8).
 //! - The span from `1/step` multiplications in `f64`, rounded outward (one more window at
 //!   either end now and then): 13.3 ms; the same made exact by one integer test per edge:
 //!   12.8 ms. The `i64` divisions stay.
@@ -88,9 +94,10 @@ pub struct GouraudTri<'p> {
 
 /// Draws `n` triangles, `tri(0)` first, into a tile at `(x0, y0)` of the frame: `depth`
 /// (row-major, `stride` a row; a multiple of 4 at least the tile's width is fastest) keeps the nearest depth, and each pixel that passes
-/// its depth test (`z < depth`) gets its triangle's colour in `rows`. The AVX2 kernel, only
-/// with `avx2` (the caller checked [`super::avx2_available`]); returns false and draws nothing
-/// without it (the caller then draws with the scalar loop).
+/// its depth test (`z < depth`) gets its triangle's colour in `rows`; returns how many pixels
+/// of `depth` were `+∞` before and are not after. The AVX2 kernel, only with `avx2` (the
+/// caller checked [`super::avx2_available`]); returns `None` and draws nothing without it (the
+/// caller then draws with the scalar loop).
 pub fn gouraud_tile<'p>(
     avx2: bool,
     (x0, y0): (u32, u32),
@@ -99,16 +106,15 @@ pub fn gouraud_tile<'p>(
     tri: impl Fn(usize) -> GouraudTri<'p>,
     depth: &mut [f32],
     rows: &mut [&mut [[f32; 4]]],
-) -> bool {
+) -> Option<u64> {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
         super::require_avx2();
         // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
-        unsafe { gouraud_tile_avx2((x0, y0), stride, n, tri, depth, rows) };
-        return true;
+        return Some(unsafe { gouraud_tile_avx2((x0, y0), stride, n, tri, depth, rows) });
     }
     let _ = (avx2, x0, y0, stride, n, tri, depth, rows);
-    false
+    None
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -120,8 +126,11 @@ fn gouraud_tile_avx2<'p>(
     tri: impl Fn(usize) -> GouraudTri<'p>,
     depth: &mut [f32],
     rows: &mut [&mut [[f32; 4]]],
-) {
+) -> u64 {
     use core::arch::x86_64::*;
+    // Pixels whose depth left +∞ (no depth returns to it: `z < d` fails at `z = +∞`).
+    let mut covered = 0u64;
+    let inf = _mm_set1_ps(f32::INFINITY);
     let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
     let lanes_epi = _mm_setr_epi32(0, 1, 2, 3);
     // Blend masks from a window's pass bits, by shifting bit j into the sign of lane j (of a
@@ -189,6 +198,7 @@ fn gouraud_tile_avx2<'p>(
                             // SAFETY: `d4` is 4 readable f32.
                             let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
                             let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
+                            covered += u64::from((pass & _mm_movemask_ps(_mm_cmpeq_ps(d, inf)) as u32).count_ones());
                             let m = _mm_castsi128_ps(_mm_sllv_epi32(_mm_set1_epi32(pass as i32), shift4));
                             // SAFETY: `d4` is 4 writable f32.
                             unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, m)) };
@@ -201,6 +211,7 @@ fn gouraud_tile_avx2<'p>(
                             let mut pass = 0;
                             for (j, &zj) in zs.iter().enumerate() {
                                 if inside & (1 << j) != 0 && zj < depth[at + j] {
+                                    covered += u64::from(depth[at + j] == f32::INFINITY);
                                     depth[at + j] = zj;
                                     pass |= 1 << j;
                                 }
@@ -263,4 +274,5 @@ fn gouraud_tile_avx2<'p>(
             }
         }
     }
+    covered
 }
