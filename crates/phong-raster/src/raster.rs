@@ -896,8 +896,10 @@ pub(crate) trait Pixel: Copy + Send + Sync {
     fn as_linear(row: &mut [Self]) -> Option<&mut [[f32; 4]]>;
     /// `dst` from the tile buffer's `src`.
     fn store(dst: &mut [Self], src: &[[f32; 4]], encoding: Encoding);
+    /// `value` as a pixel of the frame.
+    fn from_linear(value: [f32; 4], encoding: Encoding) -> Self;
     /// `dst` all `value`.
-    fn fill(dst: &mut [Self], value: [f32; 4], encoding: Encoding);
+    fn fill(dst: &mut [Self], value: Self);
 }
 
 impl Pixel for [f32; 4] {
@@ -907,7 +909,10 @@ impl Pixel for [f32; 4] {
     fn store(dst: &mut [Self], src: &[[f32; 4]], _: Encoding) {
         stream_copy(dst, src);
     }
-    fn fill(dst: &mut [Self], value: [f32; 4], _: Encoding) {
+    fn from_linear(value: [f32; 4], _: Encoding) -> Self {
+        value
+    }
+    fn fill(dst: &mut [Self], value: Self) {
         stream_fill(dst, value);
     }
 }
@@ -939,8 +944,11 @@ impl Pixel for [u8; 4] {
             }
         }
     }
-    fn fill(dst: &mut [Self], value: [f32; 4], encoding: Encoding) {
-        dst.fill(encode(value, encoding));
+    fn from_linear(value: [f32; 4], encoding: Encoding) -> Self {
+        encode(value, encoding)
+    }
+    fn fill(dst: &mut [Self], value: Self) {
+        dst.fill(value);
     }
 }
 
@@ -1007,9 +1015,9 @@ pub(crate) fn render<P: Pixel>(
                     } else if bin == 0 && !options.reference {
                         // An 8-bit frame's empty tile: its background encoded once.
                         let t = Instant::now();
-                        let background = resolve(std::iter::repeat_n(bg, ns), ns, bg);
+                        let background = P::from_linear(resolve(std::iter::repeat_n(bg, ns), ns, bg), encoding);
                         for row in rows.iter_mut() {
-                            P::fill(row, background, encoding);
+                            P::fill(row, background);
                         }
                         let end = Instant::now();
                         clock.add(t, end, end, end);
