@@ -896,6 +896,9 @@ pub(crate) trait Pixel: Copy + Send + Sync {
     fn as_linear(row: &mut [Self]) -> Option<&mut [[f32; 4]]>;
     /// `dst` from the tile buffer's `src`.
     fn store(dst: &mut [Self], src: &[[f32; 4]], encoding: Encoding);
+    /// The frame's row as 8-bit pixels that `Encoding::Linear` encodes (8-bit frames in that
+    /// encoding only), for Gouraud tiles drawn straight into it ([`Frame::tile_gouraud8`]).
+    fn as_linear8(row: &mut [Self], encoding: Encoding) -> Option<&mut [[u8; 4]]>;
     /// `value` as a pixel of the frame.
     fn from_linear(value: [f32; 4], encoding: Encoding) -> Self;
     /// `dst` all `value`.
@@ -908,6 +911,9 @@ impl Pixel for [f32; 4] {
     }
     fn store(dst: &mut [Self], src: &[[f32; 4]], _: Encoding) {
         stream_copy(dst, src);
+    }
+    fn as_linear8(_: &mut [Self], _: Encoding) -> Option<&mut [[u8; 4]]> {
+        None
     }
     fn from_linear(value: [f32; 4], _: Encoding) -> Self {
         value
@@ -943,6 +949,9 @@ impl Pixel for [u8; 4] {
                 }
             }
         }
+    }
+    fn as_linear8(row: &mut [Self], encoding: Encoding) -> Option<&mut [[u8; 4]]> {
+        (encoding == Encoding::Linear).then_some(row)
     }
     fn from_linear(value: [f32; 4], encoding: Encoding) -> Self {
         encode(value, encoding)
@@ -1022,6 +1031,15 @@ pub(crate) fn render<P: Pixel>(
                         let end = Instant::now();
                         clock.add(t, end, end, end);
                         0
+                    } else if !options.reference
+                        && frame.gouraud_applies(tile)
+                        && frame.gouraud_kernel(tile)
+                        && let Some(mut rows8) = rows
+                            .iter_mut()
+                            .map(|r| P::as_linear8(r, encoding))
+                            .collect::<Option<Vec<_>>>()
+                    {
+                        frame.tile_gouraud8(tile, bg, &clock, &mut rows8, depth)
                     } else {
                         let tw = rows[0].len();
                         local.resize((TILE_SIZE * TILE_SIZE) as usize, [0.0; 4]);
@@ -1644,17 +1662,21 @@ impl Frame<'_> {
         image: bool,
         (depth, ids): (&mut Vec<f32>, &mut Vec<u32>),
     ) -> u64 {
-        let bin = &self.bins[tile as usize];
-        // Where `tile_visible` would reach its visibility loop (not an empty tile, not a trivial
-        // accept): the same images.
-        if self.gouraud_only
-            && self.pattern.len() == 1
-            && !bin.is_empty()
-            && !(bin.len() == 1 && self.covers_rect(bin[0], self.tile_rect(tile)))
-        {
+        if self.gouraud_applies(tile) {
             return self.tile_gouraud(tile, bg, clock, rows, depth, self.gouraud_kernel(tile));
         }
         self.tile_visible(tile, bg, clock, rows, image, (depth, ids))
+    }
+
+    /// Whether [`Frame::tile_gouraud`] draws `tile`: an all-Gouraud frame with one sample,
+    /// where `tile_visible` would reach its visibility loop (not an empty tile, not a trivial
+    /// accept): the same images.
+    fn gouraud_applies(&self, tile: u32) -> bool {
+        let bin = &self.bins[tile as usize];
+        self.gouraud_only
+            && self.pattern.len() == 1
+            && !bin.is_empty()
+            && !(bin.len() == 1 && self.covers_rect(bin[0], self.tile_rect(tile)))
     }
 
     /// Whether [`Frame::tile_gouraud`] draws `tile` with the AVX2 kernel ([`gouraud_tile`]):
@@ -1701,25 +1723,7 @@ impl Frame<'_> {
         for line in rows.iter_mut() {
             line.fill(background);
         }
-        let (ox, oy) = self.pattern[0];
-        let triangle = |k: usize| {
-            let ti = bin[k];
-            let t = self.tri(ti);
-            let bb = t.bbox();
-            let (bx0, by0) = (bb[0].max(x0), bb[1].max(y0));
-            let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(by0) << SUBPIXEL_BITS);
-            GouraudTri {
-                start: each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + t.a(i) * ox + t.b(i) * oy - t.bias(i)),
-                step_x: each3(|i| t.a(i) << SUBPIXEL_BITS),
-                step_y: each3(|i| t.b(i) << SUBPIXEL_BITS),
-                bias: each3(|i| t.bias(i)),
-                inv_area: t.inv_area,
-                z: t.z,
-                cols: (bx0 - x0, bb[2].min(x1).max(bx0) - x0),
-                rows: (by0 - y0, bb[3].min(y1).max(by0) - y0),
-                planes: self.planes(ti),
-            }
-        };
+        let triangle = |k: usize| self.gouraud_tri(bin[k], (x0, y0, x1, y1));
         if let Some(covered) = gouraud_tile(kernel, (x0, y0), stride, bin.len(), triangle, depth, rows) {
             let end = Instant::now();
             clock.add(t_start, end, end, end);
@@ -1749,6 +1753,59 @@ impl Frame<'_> {
         let end = Instant::now();
         clock.add(t_start, end, end, end);
         depth.iter().filter(|&&d| d != f32::INFINITY).count() as u64
+    }
+
+    /// [`Frame::tile_gouraud`] by the AVX2 kernel straight into the rows of an 8-bit frame that
+    /// `Encoding::Linear` encodes: its pixels are encoded as they are coloured, so the tile
+    /// needs no `f32` buffer (64 KB, twice L1) and no encoding pass (100k sphere, 3 and 5
+    /// interleaved runs: 1 thread 11.6 → 11.2 ms, 2 threads 6.0 → 5.8 ms). The caller checked [`Frame::gouraud_applies`] and [`Frame::gouraud_kernel`].
+    #[inline(never)]
+    fn tile_gouraud8(
+        &self,
+        tile: u32,
+        bg: [f32; 4],
+        clock: &StageClock,
+        rows: &mut [&mut [[u8; 4]]],
+        depth: &mut Vec<f32>,
+    ) -> u64 {
+        let t_start = Instant::now();
+        let (x0, y0, x1, y1) = self.tile_rect(tile);
+        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let bin = &self.bins[tile as usize];
+        depth.clear();
+        let stride = tw.next_multiple_of(4);
+        depth.resize(stride * th, f32::INFINITY);
+        let background = encode(resolve(std::iter::once(bg), 1, bg), Encoding::Linear);
+        for line in rows.iter_mut() {
+            line.fill(background);
+        }
+        let triangle = |k: usize| self.gouraud_tri(bin[k], (x0, y0, x1, y1));
+        let covered = gouraud_tile(self.avx2, (x0, y0), stride, bin.len(), triangle, depth, rows)
+            .expect("tile_gouraud8 without AVX2");
+        let end = Instant::now();
+        clock.add(t_start, end, end, end);
+        covered
+    }
+
+    /// Triangle `ti` as the Gouraud kernel draws it into the tile `(x0, y0, x1, y1)`.
+    #[inline(always)]
+    fn gouraud_tri(&self, ti: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> GouraudTri<'_> {
+        let (ox, oy) = self.pattern[0];
+        let t = self.tri(ti);
+        let bb = t.bbox();
+        let (bx0, by0) = (bb[0].max(x0), bb[1].max(y0));
+        let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(by0) << SUBPIXEL_BITS);
+        GouraudTri {
+            start: each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + t.a(i) * ox + t.b(i) * oy - t.bias(i)),
+            step_x: each3(|i| t.a(i) << SUBPIXEL_BITS),
+            step_y: each3(|i| t.b(i) << SUBPIXEL_BITS),
+            bias: each3(|i| t.bias(i)),
+            inv_area: t.inv_area,
+            z: t.z,
+            cols: (bx0 - x0, bb[2].min(x1).max(bx0) - x0),
+            rows: (by0 - y0, bb[3].min(y1).max(by0) - y0),
+            planes: self.planes(ti),
+        }
     }
 
     /// Whether triangle `id` covers the centre of every pixel of the rectangle `(x0, y0, x1, y1)`
@@ -2016,7 +2073,8 @@ pub(crate) mod tests {
     }
 
     /// The AVX2 Gouraud tile kernel draws every tile of a frame bit for bit as the scalar loop
-    /// (`visible_single`): each colour and depth, and the count of covered pixels. Frames of
+    /// (`visible_single`): each colour and depth, and the count of covered pixels; and into an
+    /// 8-bit frame, the scalar loop's colours as `Encoding::Linear` encodes them. Frames of
     /// 203 × 149 pixels (a last column of tiles 11 pixels wide, not a multiple of the kernel's
     /// 4) with a sphere, a torus and a two-sided ground plane through the near plane, and a
     /// soup of random triangles from under a pixel to wider than the frame, interpenetrating,
@@ -2106,6 +2164,17 @@ scale = 300.0
                 };
                 let (scalar, vector) = (draw(false), draw(true));
                 assert!(scalar == vector, "{name}: tile {tile} differs");
+                // Straight into 8 bits: the scalar loop's pixels encoded.
+                let mut bytes = vec![[7u8; 4]; tw * th];
+                let mut rows: Vec<&mut [[u8; 4]]> = bytes.chunks_mut(tw).collect();
+                let n8 = frame.tile_gouraud8(tile, bg, &clock, &mut rows, &mut Vec::new());
+                let encoded: Vec<[u8; 4]> = scalar
+                    .1
+                    .chunks(4)
+                    .map(|p| encode([0, 1, 2, 3].map(|i| f32::from_bits(p[i])), Encoding::Linear))
+                    .collect();
+                assert_eq!(n8, scalar.0, "{name}: tile {tile}");
+                assert!(bytes == encoded, "{name}: tile {tile} differs in 8 bits");
                 drawn += scalar.0;
                 wide += u64::from(tw % 4 != 0 && scalar.0 > 0);
             }

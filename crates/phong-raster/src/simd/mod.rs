@@ -19,7 +19,7 @@ use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
 pub use project::WindowVertex;
 pub(crate) use tile::covered_span;
-pub use tile::{GouraudTri, gouraud_tile};
+pub use tile::{GouraudTri, TilePixel, gouraud_tile};
 
 /// Whether the AVX2 build may be used: the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {

@@ -67,6 +67,21 @@ pub(crate) fn covered_span(row: [i64; 3], step: [i64; 3], n: i64) -> (i64, i64) 
     (lo, hi)
 }
 
+/// A pixel [`gouraud_tile`] writes: linear `f32` RGBA, or 8-bit RGBA as
+/// `Encoding::Linear` encodes it (see `encode_linear`), alpha 255.
+pub trait TilePixel: bytemuck::Pod {
+    /// 8 bits a channel (else `f32`).
+    const EIGHT: bool;
+}
+
+impl TilePixel for [f32; 4] {
+    const EIGHT: bool = false;
+}
+
+impl TilePixel for [u8; 4] {
+    const EIGHT: bool = true;
+}
+
 /// A triangle as [`gouraud_tile`] draws it into a tile, in the tile's pixels.
 #[derive(Clone, Copy)]
 pub struct GouraudTri<'p> {
@@ -93,19 +108,20 @@ pub struct GouraudTri<'p> {
 }
 
 /// Draws `n` triangles, `tri(0)` first, into a tile at `(x0, y0)` of the frame: `depth`
-/// (row-major, `stride` a row; a multiple of 4 at least the tile's width is fastest) keeps the nearest depth, and each pixel that passes
-/// its depth test (`z < depth`) gets its triangle's colour in `rows`; returns how many pixels
+/// (row-major, `stride` a row; a multiple of 4 at least the tile's width is fastest) keeps
+/// the nearest depth, and each pixel that passes its depth test (`z < depth`) gets its
+/// triangle's colour in `rows` (see [`TilePixel`]); returns how many pixels
 /// of `depth` were `+∞` before and are not after. The AVX2 kernel, only with `avx2` (the
 /// caller checked [`super::avx2_available`]); returns `None` and draws nothing without it (the
 /// caller then draws with the scalar loop).
-pub fn gouraud_tile<'p>(
+pub fn gouraud_tile<'p, P: TilePixel>(
     avx2: bool,
     (x0, y0): (u32, u32),
     stride: usize,
     n: usize,
     tri: impl Fn(usize) -> GouraudTri<'p>,
     depth: &mut [f32],
-    rows: &mut [&mut [[f32; 4]]],
+    rows: &mut [&mut [P]],
 ) -> Option<u64> {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
@@ -119,13 +135,13 @@ pub fn gouraud_tile<'p>(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn gouraud_tile_avx2<'p>(
+fn gouraud_tile_avx2<'p, P: TilePixel>(
     (x0, y0): (u32, u32),
     stride: usize,
     n: usize,
     tri: impl Fn(usize) -> GouraudTri<'p>,
     depth: &mut [f32],
-    rows: &mut [&mut [[f32; 4]]],
+    rows: &mut [&mut [P]],
 ) -> u64 {
     use core::arch::x86_64::*;
     // Pixels whose depth left +∞ (no depth returns to it: `z < d` fails at `z = +∞`).
@@ -138,7 +154,10 @@ fn gouraud_tile_avx2<'p>(
     let shift4 = _mm_setr_epi32(31, 30, 29, 28);
     let shift01 = _mm256_setr_epi32(31, 31, 31, 31, 30, 30, 30, 30);
     let shift23 = _mm256_setr_epi32(29, 29, 29, 29, 28, 28, 28, 28);
-    let (one, half) = (_mm_set1_ps(1.0), _mm_set1_ps(0.5));
+    let (zero, one, half, c255) = (_mm_setzero_ps(), _mm_set1_ps(1.0), _mm_set1_ps(0.5), _mm_set1_ps(255.0));
+    // 8-bit pixels: alpha 1 encodes as 255; the byte order from channel planes to pixels.
+    let opaque = _mm_set1_epi32(255);
+    let interleave = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
     for k in 0..n {
         let t = tri(k);
         let ((c0, c1), (r0, r1)) = (t.cols, t.rows);
@@ -228,37 +247,76 @@ fn gouraud_tile_avx2<'p>(
                             });
                             let w = _mm_div_ps(one, q[3]);
                             let (cr, cg, cb) = (_mm_mul_ps(q[0], w), _mm_mul_ps(q[1], w), _mm_mul_ps(q[2], w));
-                            // Transposed: pixel j is [r_j, g_j, b_j, 1].
-                            let (rg_lo, rg_hi) = (_mm_unpacklo_ps(cr, cg), _mm_unpackhi_ps(cr, cg));
-                            let (b1_lo, b1_hi) = (_mm_unpacklo_ps(cb, one), _mm_unpackhi_ps(cb, one));
-                            let pixels = [
-                                _mm_movelh_ps(rg_lo, b1_lo),
-                                _mm_movehl_ps(b1_lo, rg_lo),
-                                _mm_movelh_ps(rg_hi, b1_hi),
-                                _mm_movehl_ps(b1_hi, rg_hi),
-                            ];
-                            if let Some(win) = row.get_mut(c..c + 4) {
-                                let pb = _mm256_set1_epi32(pass as i32);
-                                let m01 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift01));
-                                let m23 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift23));
-                                let ptr = win.as_mut_ptr().cast::<f32>();
-                                // SAFETY: `win` is 4 pixels, 16 readable and writable f32 from `ptr`.
-                                unsafe {
-                                    // By `lddqu`, as the depth above.
-                                    let old01 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.cast()));
-                                    let old23 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.add(8).cast()));
-                                    let new01 = _mm256_set_m128(pixels[1], pixels[0]);
-                                    let new23 = _mm256_set_m128(pixels[3], pixels[2]);
-                                    _mm256_storeu_ps(ptr, _mm256_blendv_ps(old01, new01, m01));
-                                    _mm256_storeu_ps(ptr.add(8), _mm256_blendv_ps(old23, new23, m23));
+                            if P::EIGHT {
+                                let row: &mut [[u8; 4]] = bytemuck::cast_slice_mut(row);
+                                // `Encoding::Linear` as `encode_linear` computes it, per channel:
+                                // `(clamp(c, 0, 1)·255 + 0.5)` truncated, NaN as 0.
+                                let enc = |v: __m128| {
+                                    _mm_cvttps_epi32(_mm_add_ps(
+                                        _mm_mul_ps(_mm_min_ps(_mm_max_ps(v, zero), one), c255),
+                                        half,
+                                    ))
+                                };
+                                // [r0..r3 g0..g3 b0..b3 a a a a] bytes, then pixel by pixel.
+                                let planar = _mm_packus_epi16(
+                                    _mm_packs_epi32(enc(cr), enc(cg)),
+                                    _mm_packs_epi32(enc(cb), opaque),
+                                );
+                                let packed = _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave));
+                                if let Some(win) = row.get_mut(c..c + 4) {
+                                    let m = _mm_castsi128_ps(_mm_sllv_epi32(_mm_set1_epi32(pass as i32), shift4));
+                                    let ptr = win.as_mut_ptr().cast::<f32>();
+                                    // SAFETY: `win` is 4 pixels, 16 readable and writable bytes
+                                    // from `ptr`. By `lddqu`, as the depth above.
+                                    unsafe {
+                                        let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
+                                        _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, m));
+                                    }
+                                } else {
+                                    let mut bytes = [[0u8; 4]; 4];
+                                    // SAFETY: `bytes` is 16 writable bytes.
+                                    unsafe { _mm_storeu_ps(bytes.as_mut_ptr().cast(), packed) };
+                                    let mut m = pass;
+                                    while m != 0 {
+                                        let j = m.trailing_zeros() as usize;
+                                        row[c + j] = bytes[j];
+                                        m &= m - 1;
+                                    }
                                 }
                             } else {
-                                let mut m = pass;
-                                while m != 0 {
-                                    let j = m.trailing_zeros() as usize;
-                                    // SAFETY: `row[c + j]` is 4 writable f32 (bounds-checked).
-                                    unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
-                                    m &= m - 1;
+                                let row: &mut [[f32; 4]] = bytemuck::cast_slice_mut(row);
+                                // Transposed: pixel j is [r_j, g_j, b_j, 1].
+                                let (rg_lo, rg_hi) = (_mm_unpacklo_ps(cr, cg), _mm_unpackhi_ps(cr, cg));
+                                let (b1_lo, b1_hi) = (_mm_unpacklo_ps(cb, one), _mm_unpackhi_ps(cb, one));
+                                let pixels = [
+                                    _mm_movelh_ps(rg_lo, b1_lo),
+                                    _mm_movehl_ps(b1_lo, rg_lo),
+                                    _mm_movelh_ps(rg_hi, b1_hi),
+                                    _mm_movehl_ps(b1_hi, rg_hi),
+                                ];
+                                if let Some(win) = row.get_mut(c..c + 4) {
+                                    let pb = _mm256_set1_epi32(pass as i32);
+                                    let m01 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift01));
+                                    let m23 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift23));
+                                    let ptr = win.as_mut_ptr().cast::<f32>();
+                                    // SAFETY: `win` is 4 pixels, 16 readable and writable f32 from `ptr`.
+                                    unsafe {
+                                        // By `lddqu`, as the depth above.
+                                        let old01 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.cast()));
+                                        let old23 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.add(8).cast()));
+                                        let new01 = _mm256_set_m128(pixels[1], pixels[0]);
+                                        let new23 = _mm256_set_m128(pixels[3], pixels[2]);
+                                        _mm256_storeu_ps(ptr, _mm256_blendv_ps(old01, new01, m01));
+                                        _mm256_storeu_ps(ptr.add(8), _mm256_blendv_ps(old23, new23, m23));
+                                    }
+                                } else {
+                                    let mut m = pass;
+                                    while m != 0 {
+                                        let j = m.trailing_zeros() as usize;
+                                        // SAFETY: `row[c + j]` is 4 writable f32 (bounds-checked).
+                                        unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
+                                        m &= m - 1;
+                                    }
                                 }
                             }
                         }
