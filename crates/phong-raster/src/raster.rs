@@ -48,6 +48,9 @@
 //!   slower, 100k Gouraud 7.0 → 7.9 ms and 1M 22 → 23.5 ms at 2 threads (more triangles
 //!   binned twice, more per-tile work);
 //! - 8-bit stores streamed past the caches: within noise, single runs slower. Not kept.
+//!
+//! The AVX2 Gouraud tile kernel's own dead ends (8-pixel windows, spans without divisions,
+//! masked stores, prefetching, a background filled afterwards) are in `simd/tile.rs`.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{
