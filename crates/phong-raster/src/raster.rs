@@ -2077,12 +2077,13 @@ pub(crate) mod tests {
 
     /// The AVX2 Gouraud tile kernel draws every tile of a frame bit for bit as the scalar loop
     /// (`visible_single`): each colour and depth, and the count of covered pixels; and into an
-    /// 8-bit frame, the scalar loop's colours as `Encoding::Linear` encodes them. Frames of
-    /// 203 × 149 pixels (a last column of tiles 11 pixels wide, not a multiple of the kernel's
-    /// 4) with a sphere, a torus and a two-sided ground plane through the near plane, and a
-    /// soup of random triangles from under a pixel to wider than the frame, interpenetrating,
-    /// drawn twice in two materials (equal depths: the first stays), some of them also with
-    /// their vertices rotated.
+    /// 8-bit frame, the scalar loop's colours as `Encoding::Linear` encodes them. Whole frames
+    /// too: `render` chooses the kernel for some tiles, and its 8-bit frames are the `f32`
+    /// frames' bytes. Frames of 203 × 149 pixels (a last column of tiles 11 pixels wide, not a
+    /// multiple of the kernel's 4) with a sphere, a torus and a two-sided ground plane through
+    /// the near plane, and a soup of random triangles from under a pixel to wider than the
+    /// frame, interpenetrating, drawn twice in two materials (equal depths: the first stays),
+    /// some of them also with their vertices rotated.
     #[test]
     fn gouraud_kernel_is_the_scalar_loop() {
         if !avx2_available() {
@@ -2183,6 +2184,25 @@ scale = 300.0
             }
             assert!(drawn > 203 * 149 / 2, "{name}: only {drawn} pixels drawn");
             assert!(wide > 0, "{name}: nothing drawn in the narrow tiles");
+            // Whole frames: `render` chooses the kernel for some tiles (straight into 8 bits
+            // for the 8-bit frame), and the frames are the `f32` image's bytes, with 1 and 3
+            // threads.
+            let chosen = (0..frame.bins.len() as u32)
+                .filter(|&t| frame.gouraud_applies(t) && frame.gouraud_kernel(t))
+                .count();
+            assert!(chosen > 0, "{name}: no tile for the kernel");
+            for threads in [1, 3] {
+                let options = RenderOptions {
+                    threads: Some(threads),
+                    ..Default::default()
+                };
+                let f32_bytes = crate::render(scene, &options)
+                    .unwrap()
+                    .to_bytes(Encoding::Linear, false);
+                let mut renderer = crate::Renderer::new();
+                let (image8, _) = renderer.render_8bit(scene, &options).unwrap().unwrap();
+                assert!(image8.to_bytes(false) == f32_bytes, "{name}: 8-bit frame differs");
+            }
         }
     }
 
