@@ -441,6 +441,7 @@ mod tests {
             load_obj(&d.join("missing.obj"), &mut Vec::new()),
             Err(Error::Read { .. })
         ));
+        let _ = std::fs::remove_dir_all(d);
     }
 
     #[test]
