@@ -19,21 +19,22 @@
 //! on the 100k Gouraud sphere the scalar loop takes 13.1–13.3 ms a frame, this kernel
 //! 11.7–11.9. Per frame that sphere's tiles hold 31k triangles, 263k rows of their boxes,
 //! 458k windows of which 354k hold a covered pixel, 830k covered pixels; the 1M sphere's
-//! 249k triangles, 749k rows, 1.1M windows, 568k with a pixel: each triangle is a third of a
-//! window, and the kernel's cost per triangle (its broadcasts) made that frame slower (39.2
+//! 249k triangles, 749k rows, 1.1M windows, 568k with a pixel (1.5 pixels of their 4, 3.3
+//! pixels a triangle), and the kernel's cost per triangle (its broadcasts) made that frame slower (39.2
 //! → 43.8 ms), hence the caller's choice per tile (`raster`'s `Frame::gouraud_kernel`).
 //! Dead ends, each against the kernel as it is:
 //! - The blend of the depth and of the pixels as a load, `blendv` and store: LLVM makes it
 //!   one masked store (`vmaskmovps`), slow on AMD and not forwarded to later loads: 14.6 ms
-//!   (it also made 4-pixel windows at any column, not aligned ones, 16.5 ms). Loading by
-//!   `lddqu`, which LLVM does not treat as a plain load, keeps the blend.
+//!   against the scalar loop's 13.0 with windows at any column, 16.5 ms with aligned windows
+//!   and blend masks made from the pass bits (LLVM fused those too). Loading by `lddqu`,
+//!   which LLVM does not treat as a plain load, keeps the blend (then 12.0 ms).
 //! - Every window of a row's box tested, without the covered span's three divisions: 12.5 ms.
 //!   The windows outside the span cost more than the divisions: a row's exact span makes its
 //!   first and last windows hold covered pixels, so the "any pixel covered" branch is
 //!   predictable.
 //! - Windows of 8 pixels (two `f64` vectors per edge, `f32` vectors of 8) from columns that are
 //!   multiples of 4, so that a row's span of up to 5 pixels is one window (fewer loop exits
-//!   mispredicted): 11.0 → 11.7 ms (100k), 38.9 → 39.8 ms (1M); most windows' second half is
+//!   mispredicted): 11.0 → 11.7 ms (100k), 38.8 → 39.5 ms (1M); most windows' second half is
 //!   empty, and the division and transposes of 8 lanes cost more than the loop saves.
 //! - The covered pixels counted by a scan of the tile's depths after the kernel: 3% of the
 //!   frame (the `+∞ → finite` transitions of the windows are counted instead: 10.9 → 10.8).
