@@ -1012,6 +1012,7 @@ pub(crate) fn render<P: Pixel>(
                     let tile = ty as u32 * frame.tiles_x + tx as u32;
                     let TileBuffers { local, depth, ids } = buffers;
                     let bin = frame.bins[tile as usize].len();
+                    let gouraud = !options.reference && frame.gouraud_applies(tile);
                     // f32 rows for tiles drawn straight into the frame (f32 frames only).
                     let linear: Option<Vec<&mut [[f32; 4]]>> = if options.reference || bin <= 1 {
                         rows.iter_mut().map(|r| P::as_linear(r)).collect()
@@ -1022,7 +1023,7 @@ pub(crate) fn render<P: Pixel>(
                         if options.reference {
                             frame.tile(tile, bg, &clock, &mut linear)
                         } else {
-                            frame.draw_tile(tile, bg, &clock, &mut linear, true, (depth, ids))
+                            frame.draw_tile(tile, bg, &clock, &mut linear, true, (depth, ids), gouraud)
                         }
                     } else if bin == 0 && !options.reference {
                         // An 8-bit frame's empty tile: its background encoded once.
@@ -1034,8 +1035,7 @@ pub(crate) fn render<P: Pixel>(
                         let end = Instant::now();
                         clock.add(t, end, end, end);
                         0
-                    } else if !options.reference
-                        && frame.gouraud_applies(tile)
+                    } else if gouraud
                         && frame.gouraud_kernel(tile)
                         && let Some(mut rows8) = rows
                             .iter_mut()
@@ -1050,7 +1050,7 @@ pub(crate) fn render<P: Pixel>(
                         let n = if options.reference {
                             frame.tile(tile, bg, &clock, &mut buffer)
                         } else {
-                            frame.draw_tile(tile, bg, &clock, &mut buffer, false, (depth, ids))
+                            frame.draw_tile(tile, bg, &clock, &mut buffer, false, (depth, ids), gouraud)
                         };
                         for (dst, src) in rows.iter_mut().zip(&buffer) {
                             P::store(dst, src, encoding);
@@ -1653,9 +1653,10 @@ impl Frame<'_> {
         jobs.len() as u64
     }
 
-    /// A tile of the fast path: [`Frame::tile_gouraud`] where it applies, else
-    /// [`Frame::tile_visible`].
+    /// A tile of the fast path: [`Frame::tile_gouraud`] where it applies (`gouraud`, the
+    /// caller's [`Frame::gouraud_applies`], decided once per tile), else [`Frame::tile_visible`].
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn draw_tile(
         &self,
         tile: u32,
@@ -1664,8 +1665,9 @@ impl Frame<'_> {
         rows: &mut [&mut [[f32; 4]]],
         image: bool,
         (depth, ids): (&mut Vec<f32>, &mut Vec<u32>),
+        gouraud: bool,
     ) -> u64 {
-        if self.gouraud_applies(tile) {
+        if gouraud {
             return self.tile_gouraud(tile, bg, clock, rows, depth, self.gouraud_kernel(tile));
         }
         self.tile_visible(tile, bg, clock, rows, image, (depth, ids))
@@ -1684,8 +1686,8 @@ impl Frame<'_> {
 
     /// Whether [`Frame::tile_gouraud`] draws `tile` with the AVX2 kernel ([`gouraud_tile`]):
     /// with AVX2, where the tile has at least 8 pixels per triangle of its bin. Its cost per
-    /// triangle is higher than the scalar loop's, its cost per pixel lower (1 thread, 3
-    /// interleaved runs: kernel everywhere, scalar everywhere, this rule: 100k sphere 12.0,
+    /// triangle is higher than the scalar loop's, its cost per pixel lower (1 thread, means of
+    /// 2 interleaved runs: kernel everywhere, scalar everywhere, this rule: 100k sphere 12.0,
     /// 13.6, 12.1 ms; 1M 44.1, 40.5, 40.4 ms; a 300k sphere of 548 segments 21.0, 20.8, 20.2
     /// ms).
     fn gouraud_kernel(&self, tile: u32) -> bool {
@@ -1714,14 +1716,8 @@ impl Frame<'_> {
         kernel: bool,
     ) -> u64 {
         let t_start = Instant::now();
-        let (x0, y0, x1, y1) = self.tile_rect(tile);
-        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let ((x0, y0, x1, y1), stride) = self.gouraud_depth(tile, depth, kernel);
         let bin = &self.bins[tile as usize];
-        depth.clear();
-        // The AVX2 kernel's rows of depth are a multiple of 4 long: it tests windows of 4
-        // pixels aligned in the tile (the extra pixels stay infinite).
-        let stride = if kernel { tw.next_multiple_of(4) } else { tw };
-        depth.resize(stride * th, f32::INFINITY);
         let background = resolve(std::iter::once(bg), 1, bg);
         for line in rows.iter_mut() {
             line.fill(background);
@@ -1741,7 +1737,7 @@ impl Frame<'_> {
                 planes: ColorPlanes::new(self.planes(ti)),
                 rows: &mut *rows,
             };
-            let tile = (x0, y0, tw, y1);
+            let tile = (x0, y0, (x1 - x0) as usize, y1);
             self.visible_single::<false>(
                 t,
                 0,
@@ -1772,12 +1768,8 @@ impl Frame<'_> {
         depth: &mut Vec<f32>,
     ) -> u64 {
         let t_start = Instant::now();
-        let (x0, y0, x1, y1) = self.tile_rect(tile);
-        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let ((x0, y0, x1, y1), stride) = self.gouraud_depth(tile, depth, true);
         let bin = &self.bins[tile as usize];
-        depth.clear();
-        let stride = tw.next_multiple_of(4);
-        depth.resize(stride * th, f32::INFINITY);
         let background = encode(resolve(std::iter::once(bg), 1, bg), Encoding::Linear);
         for line in rows.iter_mut() {
             line.fill(background);
@@ -1788,6 +1780,18 @@ impl Frame<'_> {
         let end = Instant::now();
         clock.add(t_start, end, end, end);
         covered
+    }
+
+    /// The rectangle of `tile` and its depths, all `+∞`, `stride` a row (returned): with the
+    /// AVX2 kernel (`kernel`) a multiple of 4, as it tests windows of 4 pixels aligned in the
+    /// tile (the extra pixels stay infinite), else the tile's width.
+    fn gouraud_depth(&self, tile: u32, depth: &mut Vec<f32>, kernel: bool) -> ((u32, u32, u32, u32), usize) {
+        let rect @ (x0, y0, x1, y1) = self.tile_rect(tile);
+        let (tw, th) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let stride = if kernel { tw.next_multiple_of(4) } else { tw };
+        depth.clear();
+        depth.resize(stride * th, f32::INFINITY);
+        (rect, stride)
     }
 
     /// Triangle `ti` as the Gouraud kernel draws it into the tile `(x0, y0, x1, y1)`.
