@@ -25,6 +25,8 @@ enum Command {
     Render(RenderArgs),
     /// Render a scene repeatedly and print the time per frame.
     Bench(BenchArgs),
+    /// Serve the live explorer in the browser (until Ctrl-C).
+    Serve(ServeArgs),
     /// List the built-in materials, or show one.
     Materials {
         /// A material name (case, spaces, '-' and '_' ignored).
@@ -147,6 +149,27 @@ struct RenderArgs {
 }
 
 #[derive(clap::Args)]
+struct ServeArgs {
+    /// Scene file (.toml) or model (.obj) to open; the default scene without one.
+    input: Option<PathBuf>,
+    /// Port to listen on.
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// Address to listen on (loopback unless you say otherwise).
+    #[arg(long, default_value = "127.0.0.1")]
+    host: std::net::IpAddr,
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    backend: Backend,
+    /// Rendering threads for the CPU backend (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Open the page in the default browser.
+    #[arg(long)]
+    open: bool,
+}
+
+#[derive(clap::Args)]
 struct BenchArgs {
     #[command(flatten)]
     run: RunArgs,
@@ -174,6 +197,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench(args),
+        Command::Serve(args) => serve(args),
         Command::Materials { name } => materials(name.as_deref()),
     };
     match result {
@@ -184,6 +208,10 @@ fn main() -> ExitCode {
                 c.downcast_ref::<InputError>().is_some()
                     || c.downcast_ref::<phong_scene::Error>().is_some_and(|e| e.is_input())
                     || c.downcast_ref::<phong_core::Error>().is_some()
+                    || matches!(
+                        c.downcast_ref::<phong_serve::StartError>(),
+                        Some(phong_serve::StartError::Input(_) | phong_serve::StartError::Usage(_))
+                    )
                     || matches!(
                         c.downcast_ref::<phong_gpu::Error>(),
                         Some(
@@ -557,6 +585,64 @@ fn bench(a: BenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `phong serve`: the explorer until Ctrl-C.
+fn serve(a: ServeArgs) -> Result<()> {
+    if let Some(t) = a.threads
+        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
+    {
+        bail!(InputError(format!(
+            "--threads must be from 1 to {}, got {t}",
+            phong_core::limits::MAX_THREADS
+        )));
+    }
+    let (scene, library) = phong_serve::initial_scene(a.input.as_deref())?;
+    let gpu = open_gpu(a.backend, GpuPathArg::Auto)?;
+    let backend = match gpu {
+        Some(g) => phong_serve::Backend::Gpu(Box::new(std::sync::Mutex::new(g))),
+        None => phong_serve::Backend::cpu(a.threads).map_err(|e| anyhow::anyhow!(e))?,
+    };
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the server's runtime")?;
+    runtime.block_on(async move {
+        let addr = std::net::SocketAddr::new(a.host, a.port);
+        let listener = phong_serve::bind(addr).await?;
+        let local = listener.local_addr().context("the listening address")?;
+        let shown = if a.host.is_unspecified() {
+            std::net::SocketAddr::new(std::net::Ipv4Addr::LOCALHOST.into(), local.port())
+        } else {
+            local
+        };
+        let url = format!("http://{shown}/");
+        eprintln!(
+            "phong: serving the explorer at {url} (backend {}); Ctrl-C stops",
+            backend.describe()
+        );
+        if !a.host.is_loopback() {
+            eprintln!(
+                "phong: warning: listening on {}: anyone who can reach this port can use the server and its CPU",
+                a.host
+            );
+        }
+        println!("{url}");
+        if a.open
+            && let Err(e) = std::process::Command::new("xdg-open").arg(&url).spawn()
+        {
+            eprintln!("phong: could not open a browser ({e}); open {url} yourself");
+        }
+        let state = std::sync::Arc::new(phong_serve::AppState::new(backend, scene, library));
+        let shutdown = async {
+            let _ = tokio::signal::ctrl_c().await;
+            eprintln!("phong: stopping (renders in flight finish first)");
+        };
+        phong_serve::serve(listener, state, shutdown).await.context("serving")?;
+        eprintln!("phong: stopped");
+        Ok::<(), anyhow::Error>(())
+    })
 }
 
 fn fmt3(c: phong_core::Color) -> String {

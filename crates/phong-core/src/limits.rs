@@ -59,3 +59,49 @@ pub fn sample_pattern(samples: u32) -> Vec<(f32, f32)> {
         _ => vec![(0.5, 0.5)],
     }
 }
+
+/// `phong serve`: largest request body of a scene or probe (JSON), in bytes. The page's
+/// scenes are a few kilobytes; 1 MiB leaves room for scripted scenes with many objects and
+/// inline materials, while a client cannot make the server buffer more.
+pub const SERVE_MAX_BODY: usize = 1 << 20;
+
+/// `phong serve`: most pixels of one rendered image. 3840 × 2160 (a 4K screen) is more than
+/// any browser viewport; frames stay within about 40 ms of CPU time a few at a time.
+pub const SERVE_MAX_PIXELS: u64 = 3840 * 2160;
+
+/// `phong serve`: most samples (pixels times antialias samples) of one image: 4K at 4
+/// samples, so that one request's sample buffers (about 20 bytes each) stay under 1 GiB.
+pub const SERVE_MAX_SAMPLES: u64 = 3840 * 2160 * 4;
+
+/// `phong serve`: most triangles of one scene (uploads included): 4M triangles render in
+/// well under a second on two cores, and its meshes take about 400 MB.
+pub const SERVE_MAX_TRIANGLES: u64 = 1 << 22;
+
+/// `phong serve`: most lights of one scene. The page lists each light's controls; 16 is
+/// OpenGL 2.1's usual implementation count doubled.
+pub const SERVE_MAX_LIGHTS: usize = 16;
+
+/// `phong serve`: largest uploaded file (an OBJ or MTL), in bytes: a 1M-triangle OBJ is about
+/// 60 MB of text.
+pub const SERVE_MAX_UPLOAD: usize = 64 << 20;
+
+/// `phong serve`: most files one client keeps uploaded (an OBJ with its MTL libraries).
+pub const SERVE_MAX_UPLOADS: usize = 16;
+
+/// `phong serve`: most bytes of uploads per client, summed: bounds the memory a client holds.
+pub const SERVE_MAX_UPLOAD_TOTAL: usize = 128 << 20;
+
+/// `phong serve`: most clients holding uploads at once (each up to [`SERVE_MAX_UPLOAD_TOTAL`]);
+/// with the idle timeout, bounds the server's upload memory to 2 GiB.
+pub const SERVE_MAX_CLIENTS: usize = 16;
+
+/// `phong serve`: seconds after which an idle client's uploads are dropped.
+pub const SERVE_IDLE_SECONDS: u64 = 30 * 60;
+
+/// `phong serve`: renders (and probes) in flight for one client. The page keeps at most one
+/// frame and one probe in flight, or the Terms view's four images; 6 leaves room for both.
+pub const SERVE_RENDERS_PER_CLIENT: usize = 6;
+
+/// `phong serve`: renders in flight in all; more wait for none: they answer 503 at once,
+/// because a queued frame is a stale frame for an interactive client.
+pub const SERVE_RENDERS_TOTAL: usize = 32;

@@ -8,14 +8,19 @@
 //! column and key (`scene.toml:12:13: \`shininess\`: must be >= 0, got -1`).
 
 mod error;
+mod json_scene;
 mod obj;
 mod png_out;
 mod toml_scene;
 
 pub use error::Error;
-pub use obj::{ObjPart, load_obj};
-pub use png_out::{write_png, write_png8};
-pub use toml_scene::{INTERPOLATIONS, MODELS, Model, OUTPUTS, apply_model, parse_choice, parse_scene};
+pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
+pub use obj::{ObjPart, load_obj, load_obj_text};
+pub use png_out::{encode_png, encode_png8, write_png, write_png8};
+pub use toml_scene::{
+    INTERPOLATIONS, MODEL_BACKGROUND, MODEL_LIGHTS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model,
+    model_view, parse_choice, parse_scene, parse_scene_with,
+};
 
 use std::path::Path;
 

@@ -254,7 +254,19 @@ fn to_material(m: &tobj::Material) -> Material {
 /// Loads an OBJ file and its MTL materials: one part per group and material.
 pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
     let src = read(path)?;
-    check_obj(path, &src)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    load_obj_text(path, &src, &|mtl| std::fs::read_to_string(dir.join(mtl)), warnings)
+}
+
+/// [`load_obj`] of an OBJ's text `src` (named `path` in messages), its MTL libraries read by
+/// `read_mtl` (given the name the `mtllib` line gives).
+pub fn load_obj_text(
+    path: &Path,
+    src: &str,
+    read_mtl: &dyn Fn(&Path) -> std::io::Result<String>,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<ObjPart>, Error> {
+    check_obj(path, src)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
     let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
@@ -266,14 +278,14 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
     };
     let loaded = tobj::load_obj_buf(&mut BufReader::new(src.as_bytes()), &opts, |mtl: &Path| {
         let p: PathBuf = dir.join(mtl);
-        let text = match std::fs::read_to_string(&p) {
+        let text = match read_mtl(mtl) {
             Ok(t) => t,
             Err(e) => {
                 // Locate the mtllib line for the message.
                 let name = mtl.to_string_lossy();
                 let at = src.find(&*name).unwrap_or(0);
                 let msg = format!("material library {} cannot be read: {e}", p.display());
-                *mtl_error.borrow_mut() = Some(Error::at(path, &src, at, Some("mtllib"), msg));
+                *mtl_error.borrow_mut() = Some(Error::at(path, src, at, Some("mtllib"), msg));
                 return Err(tobj::LoadError::OpenFileFailed);
             }
         };
@@ -287,7 +299,7 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
         return Err(e);
     }
     warnings.extend(mtl_warnings.into_inner());
-    let (models, materials) = loaded.map_err(|e| Error::at(path, &src, 0, None, format!("malformed OBJ: {e}")))?;
+    let (models, materials) = loaded.map_err(|e| Error::at(path, src, 0, None, format!("malformed OBJ: {e}")))?;
     let materials: Vec<tobj::Material> = materials.unwrap_or_default();
     let materials: Vec<Material> = materials.iter().map(to_material).collect();
     let file = path
@@ -316,7 +328,7 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
         };
         let tris = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
         let mesh = Mesh::new(positions, normals, tris)
-            .map_err(|e| Error::at(path, &src, 0, None, format!("group {}: {e}", model.name)))?;
+            .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
         parts.push(ObjPart {
             name: format!("{file}:{}", model.name),
             mesh,
@@ -327,7 +339,7 @@ pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>,
     if parts.is_empty() {
         return Err(Error::at(
             path,
-            &src,
+            src,
             0,
             None,
             "no faces (`f` records): nothing to render".into(),

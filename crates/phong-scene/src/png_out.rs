@@ -22,18 +22,49 @@ pub fn write_png8(path: &Path, image: &Image8) -> Result<(), Error> {
     write_bytes(path, (image.width(), image.height()), &bytes, alpha, image.encoding())
 }
 
+/// The PNG file that [`write_png8`] writes, in memory (the server sends these bytes).
+pub fn encode_png8(image: &Image8) -> Result<Vec<u8>, std::io::Error> {
+    let alpha = image.has_transparency();
+    let bytes = image.to_bytes(alpha);
+    encode((image.width(), image.height()), &bytes, alpha, image.encoding())
+}
+
+/// The PNG file that [`write_png`] writes, in memory.
+pub fn encode_png(image: &Image, encoding: Encoding) -> Result<Vec<u8>, std::io::Error> {
+    let alpha = image.has_transparency();
+    let bytes = image.to_bytes(encoding, alpha);
+    encode((image.width(), image.height()), &bytes, alpha, encoding)
+}
+
 /// `bytes` (RGB, or RGBA with `alpha`) as a PNG at `path`, atomically.
-fn write_bytes(
-    path: &Path,
-    (width, height): (u32, u32),
-    bytes: &[u8],
-    alpha: bool,
-    encoding: Encoding,
-) -> Result<(), Error> {
+fn write_bytes(path: &Path, size: (u32, u32), bytes: &[u8], alpha: bool, encoding: Encoding) -> Result<(), Error> {
     let err = |source: std::io::Error| Error::Write {
         path: path.to_path_buf(),
         source,
     };
+    let buf = encode(size, bytes, alpha, encoding).map_err(err)?;
+    let tmp = temp_path(path);
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(&buf)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(err(e));
+    }
+    Ok(())
+}
+
+/// The PNG file of `bytes`: fast compression (encoding time dominated the write).
+fn encode(
+    (width, height): (u32, u32),
+    bytes: &[u8],
+    alpha: bool,
+    encoding: Encoding,
+) -> Result<Vec<u8>, std::io::Error> {
+    let err = std::io::Error::other;
     let mut buf = Vec::with_capacity(bytes.len() / 2);
     {
         let mut enc = png::Encoder::new(&mut buf, width, height);
@@ -47,22 +78,11 @@ fn write_bytes(
         if encoding == Encoding::Srgb {
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         }
-        let mut w = enc.write_header().map_err(|e| err(std::io::Error::other(e)))?;
-        w.write_image_data(bytes).map_err(|e| err(std::io::Error::other(e)))?;
-        w.finish().map_err(|e| err(std::io::Error::other(e)))?;
+        let mut w = enc.write_header().map_err(err)?;
+        w.write_image_data(bytes).map_err(err)?;
+        w.finish().map_err(err)?;
     }
-    let tmp = temp_path(path);
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&buf)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(e));
-    }
-    Ok(())
+    Ok(buf)
 }
 
 fn temp_path(path: &Path) -> PathBuf {

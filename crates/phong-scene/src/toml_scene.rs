@@ -4,7 +4,7 @@
 //! with the span toml gives; values that need checking are read as
 //! `Spanned` so that a bad one is reported at its own line and column.
 
-use crate::{Error, Loaded, load_obj};
+use crate::{Error, Loaded, ObjPart, load_obj};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS, SAMPLE_COUNTS};
 use phong_core::{
@@ -252,7 +252,14 @@ struct Ctx<'a> {
     path: &'a Path,
     src: &'a str,
     warnings: Vec<String>,
+    /// Where `mesh = "..."` names come from: `None` reads files beside the scene; `Some`
+    /// looks them up in memory (the server's uploads) and never opens a file.
+    meshes: Option<&'a MeshLookup<'a>>,
 }
+
+/// Resolves a `mesh` name to its parts without touching the file system (the error is the
+/// message shown for the `mesh` key).
+pub type MeshLookup<'a> = dyn Fn(&str) -> Result<Vec<ObjPart>, String> + 'a;
 
 impl Ctx<'_> {
     fn err<T>(&self, span: &std::ops::Range<usize>, key: &str, msg: impl Into<String>) -> Result<T, Error> {
@@ -315,6 +322,11 @@ impl Ctx<'_> {
 
 /// Parses a scene file's text; `path` names it in errors and anchors relative mesh paths.
 pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
+    parse_scene_with(src, path, None)
+}
+
+/// [`parse_scene`] with meshes from `meshes` instead of the file system (when given).
+pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, Error> {
     let raw: RawScene = toml::from_str(src).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
         let line_text = src[..offset.min(src.len())].rsplit('\n').next().unwrap_or("");
@@ -334,6 +346,7 @@ pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
         path,
         src,
         warnings: Vec::new(),
+        meshes,
     };
     let scene = build(&mut ctx, raw)?;
     Ok(Loaded {
@@ -811,16 +824,24 @@ fn object(
             if let Some(s) = &o.segments {
                 return ctx.err(&s.span(), "segments", "a mesh has no `segments`");
             }
-            let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
-            if !file.is_file() {
-                return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
-            }
-            let ext_ok = file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-            if !ext_ok {
-                return ctx.err(&m.span(), "mesh", "only Wavefront .obj meshes are supported");
-            }
             let mut warnings = Vec::new();
-            let parts = load_obj(&file, &mut warnings)?;
+            let parts = match ctx.meshes {
+                Some(lookup) => match lookup(m.get_ref()) {
+                    Ok(parts) => parts,
+                    Err(msg) => return ctx.err(&m.span(), "mesh", msg),
+                },
+                None => {
+                    let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
+                    if !file.is_file() {
+                        return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
+                    }
+                    let ext_ok = file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+                    if !ext_ok {
+                        return ctx.err(&m.span(), "mesh", "only Wavefront .obj meshes are supported");
+                    }
+                    load_obj(&file, &mut warnings)?
+                }
+            };
             let mut out = Vec::new();
             for p in parts {
                 let default = if p.has_normals { "file" } else { "angle" };
@@ -901,34 +922,23 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
         .iter()
         .filter_map(|o| o.mesh.bounds())
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-    let (lo, hi) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
-    let centre = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1e-3);
-    let fov = 45.0f32;
-    let dist = radius / (fov.to_radians() * 0.5).sin() * 1.05;
-    let dir = Vec3::new(0.35, 0.45, 1.0).normalize();
+    let view = model_view(bounds);
     let camera = Camera::new(
-        centre + dir * dist,
-        centre,
+        view.position,
+        view.target,
         Vec3::Y,
-        Projection::Perspective { fov_y_deg: fov },
-        (dist - radius * 1.5).max(dist * 0.01),
-        dist + radius * 1.5,
+        Projection::Perspective { fov_y_deg: view.fov },
+        view.near,
+        view.far,
     )
     .expect("framed camera");
-    let light = |d: Vec3, c: f32| Light::directional(d, LightColor::uniform(Color::splat(c)).unwrap()).unwrap();
-    let lighting = Lighting::new(
-        Color::splat(0.2),
-        vec![
-            light(Vec3::new(1.0, -1.0, -1.0), 0.8),
-            light(Vec3::new(-1.0, -0.3, -0.5), 0.35),
-            light(Vec3::new(0.0, -0.5, 1.0), 0.3),
-        ],
-    )
-    .expect("valid");
+    let light = |(d, c): ([f32; 3], f32)| {
+        Light::directional(Vec3::from(d), LightColor::uniform(Color::splat(c)).unwrap()).unwrap()
+    };
+    let lighting = Lighting::new(Color::splat(0.2), MODEL_LIGHTS.map(light).to_vec()).expect("valid");
     let scene = Scene {
         image: ImageSettings {
-            background: [0.08, 0.08, 0.1, 1.0],
+            background: MODEL_BACKGROUND,
             samples: 4,
             ..ImageSettings::default()
         },
@@ -939,4 +949,48 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
         labels: Vec::new(),
     };
     Ok(Loaded { scene, warnings })
+}
+
+/// The view of a model alone: a perspective camera, its vertical field of view 45°, looking
+/// at the centre of the bounding box `(lo, hi)` from above right, far enough that the box's
+/// bounding sphere fits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelView {
+    /// Camera position.
+    pub position: Vec3,
+    /// Camera target.
+    pub target: Vec3,
+    /// Near plane.
+    pub near: f32,
+    /// Far plane.
+    pub far: f32,
+    /// Vertical field of view, degrees.
+    pub fov: f32,
+}
+
+/// The lights of a model alone, `(direction, grey level)`: key, fill and back.
+pub const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
+    ([1.0, -1.0, -1.0], 0.8),
+    ([-1.0, -0.3, -0.5], 0.35),
+    ([0.0, -0.5, 1.0], 0.3),
+];
+
+/// The background of a model alone.
+pub const MODEL_BACKGROUND: [f32; 4] = [0.08, 0.08, 0.1, 1.0];
+
+/// [`ModelView`] for a model with bounds `bounds` (the unit cube's when `None`).
+pub fn model_view(bounds: Option<(Vec3, Vec3)>) -> ModelView {
+    let (lo, hi) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov = 45.0f32;
+    let dist = radius / (fov.to_radians() * 0.5).sin() * 1.05;
+    let dir = Vec3::new(0.35, 0.45, 1.0).normalize();
+    ModelView {
+        position: centre + dir * dist,
+        target: centre,
+        near: (dist - radius * 1.5).max(dist * 0.01),
+        far: dist + radius * 1.5,
+        fov,
+    }
 }

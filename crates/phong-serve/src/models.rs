@@ -1,0 +1,153 @@
+//! Models: those the operator's command loaded from disk (shared, read-only) and those
+//! clients upload (OBJ and MTL files kept in memory per client, capped, dropped when idle).
+//! A scene's `mesh = "NAME"` is looked up here, never on disk.
+
+use crate::api::AppState;
+use phong_core::limits::{SERVE_IDLE_SECONDS, SERVE_MAX_UPLOAD_TOTAL, SERVE_MAX_UPLOADS};
+use phong_scene::ObjPart;
+use serde_json::json;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Models loaded at startup, by the name the scene gives.
+#[derive(Default)]
+pub struct Library {
+    models: HashMap<String, Arc<Vec<ObjPart>>>,
+}
+
+impl Library {
+    /// Adds a model.
+    pub fn insert(&mut self, name: String, parts: Vec<ObjPart>) {
+        self.models.insert(name, Arc::new(parts));
+    }
+
+    /// A model's parts.
+    pub fn get(&self, name: &str) -> Option<Arc<Vec<ObjPart>>> {
+        self.models.get(name).cloned()
+    }
+
+    /// The names.
+    pub fn names(&self) -> Vec<String> {
+        let mut n: Vec<String> = self.models.keys().cloned().collect();
+        n.sort();
+        n
+    }
+}
+
+/// One client's uploaded files and the OBJ files parsed from them.
+#[derive(Default)]
+pub struct Uploads {
+    files: HashMap<String, Arc<Vec<u8>>>,
+    parsed: HashMap<String, Arc<Vec<ObjPart>>>,
+    bytes: usize,
+    /// When the client last used the server.
+    pub last_used: Option<Instant>,
+}
+
+impl Uploads {
+    /// Stores `data` as `name`, replacing a file of that name; `Err` names the limit passed.
+    pub fn put(&mut self, name: &str, data: Vec<u8>) -> Result<(), String> {
+        let old = self.files.get(name).map_or(0, |f| f.len());
+        if old == 0 && self.files.len() >= SERVE_MAX_UPLOADS {
+            return Err(format!(
+                "upload limit: at most {SERVE_MAX_UPLOADS} files per client (SERVE_MAX_UPLOADS); delete one first"
+            ));
+        }
+        if self.bytes - old + data.len() > SERVE_MAX_UPLOAD_TOTAL {
+            return Err(format!(
+                "upload limit: at most {} MiB of files per client (SERVE_MAX_UPLOAD_TOTAL)",
+                SERVE_MAX_UPLOAD_TOTAL >> 20
+            ));
+        }
+        self.bytes = self.bytes - old + data.len();
+        self.files.insert(name.to_string(), Arc::new(data));
+        // An MTL may change any OBJ's materials: parse again on next use.
+        self.parsed.clear();
+        Ok(())
+    }
+
+    /// Removes a file; false when there was none.
+    pub fn remove(&mut self, name: &str) -> bool {
+        match self.files.remove(name) {
+            Some(f) => {
+                self.bytes -= f.len();
+                self.parsed.clear();
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The file names.
+    pub fn names(&self) -> Vec<String> {
+        let mut n: Vec<String> = self.files.keys().cloned().collect();
+        n.sort();
+        n
+    }
+
+    /// The parts of uploaded OBJ `name`, its MTL libraries from the other uploads (parsed once
+    /// per set of uploads); `Err` is the message for the scene's `mesh` key.
+    pub fn parts(&mut self, name: &str) -> Option<Result<Arc<Vec<ObjPart>>, String>> {
+        if let Some(p) = self.parsed.get(name) {
+            return Some(Ok(p.clone()));
+        }
+        let data = self.files.get(name)?.clone();
+        let Ok(src) = std::str::from_utf8(&data) else {
+            return Some(Err(format!("uploaded {name} is not UTF-8 text")));
+        };
+        let files = &self.files;
+        let read = |mtl: &Path| -> std::io::Result<String> {
+            let key = mtl.to_string_lossy();
+            let key = key.rsplit(['/', '\\']).next().unwrap_or(&key);
+            let f = files.get(key).ok_or_else(|| {
+                std::io::Error::new(std::io::ErrorKind::NotFound, "not uploaded (upload it with the OBJ)")
+            })?;
+            String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
+        };
+        let mut warnings = Vec::new();
+        let out = phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings)
+            .map(Arc::new)
+            .map_err(|e| e.to_string());
+        if let Ok(p) = &out {
+            self.parsed.insert(name.to_string(), p.clone());
+        }
+        Some(out)
+    }
+}
+
+/// Drops the uploads of clients idle for [`SERVE_IDLE_SECONDS`], every minute.
+pub async fn sweep_idle(state: Arc<AppState>) {
+    let mut tick = tokio::time::interval(Duration::from_secs(60));
+    loop {
+        tick.tick().await;
+        let idle = Duration::from_secs(SERVE_IDLE_SECONDS);
+        if let Ok(mut clients) = state.uploads.lock() {
+            clients.retain(|_, u| u.last_used.is_some_and(|t| t.elapsed() < idle));
+        }
+    }
+}
+
+/// The page's scene for a model alone: `phong render MODEL.obj`'s camera, lights and
+/// background, the model as its only object.
+pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
+    let bounds = parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+    let v = phong_scene::model_view(bounds);
+    let bg = phong_scene::MODEL_BACKGROUND;
+    let lights: Vec<_> = phong_scene::MODEL_LIGHTS
+        .iter()
+        .map(|(d, c)| json!({"type": "directional", "direction": d, "color": [c, c, c]}))
+        .collect();
+    json!({
+        "image": {"width": 960, "height": 540, "background": [bg[0], bg[1], bg[2]], "antialias": 4},
+        "camera": {"position": v.position.to_array(), "target": v.target.to_array(), "fov": v.fov,
+                   "near": v.near, "far": v.far},
+        "shading": {"viewer": "local"},
+        "light": lights,
+        "object": [{"mesh": name}],
+    })
+}

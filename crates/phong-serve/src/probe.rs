@@ -1,0 +1,446 @@
+//! The probe: what the renderer computes at one pixel, term by term, from phong-core's
+//! [`shade`].
+//!
+//! The pixel's visible triangle is found by a ray through the pixel's centre (the ray's hit
+//! barycentrics are the perspective-correct ones the rasteriser interpolates with). Back faces
+//! are culled unless the object is two-sided; a two-sided back face is lit with its normals
+//! flipped, as the renderers do. The lighting is then [`shade`] itself: once for the pixel's
+//! value, and once per light alone (unclamped, without emission or global ambient) for the
+//! per-light terms.
+
+use glam::{DVec3, Vec3};
+use phong_core::mesh::facet_normal;
+use phong_core::{
+    Color, Interpolation, Light, Lighting, Material, Object, Output, Scene, Shading, ShadingOptions, SpecularModel,
+    SurfacePoint, View, shade, specular_factor,
+};
+use serde::Serialize;
+
+/// Everything the probe reports for a pixel.
+#[derive(Debug, Serialize)]
+pub struct Probe {
+    /// The pixel, from the top-left corner.
+    pub x: u32,
+    /// The pixel's row.
+    pub y: u32,
+    /// The surface seen there; `None`: the background.
+    pub hit: Option<Hit>,
+    /// The pixel's value as the renderer writes it (linear colour, 0..1 where clamped).
+    pub value: [f32; 3],
+    /// `value` in the image's 8-bit encoding (the PNG's bytes).
+    pub value8: [u8; 3],
+    /// Notes on how the value relates to the image (antialiasing, Gouraud).
+    pub notes: Vec<String>,
+}
+
+/// The surface point under a pixel.
+#[derive(Debug, Serialize)]
+pub struct Hit {
+    /// Index in the scene's objects.
+    pub object: usize,
+    /// The object's name.
+    pub name: String,
+    /// Index of the triangle in the object's mesh.
+    pub triangle: usize,
+    /// Perspective-correct barycentric weights of the triangle's vertices.
+    pub barycentric: [f32; 3],
+    /// Whether the triangle is seen from its back (two-sided lighting flips its normals).
+    pub back_face: bool,
+    /// "flat", "gouraud" or "phong".
+    pub interpolation: &'static str,
+    /// "color", "ambient", ... as the object's `output`.
+    pub output: &'static str,
+    /// The shaded point `P` (for flat shading, the triangle's centroid).
+    pub position: [f32; 3],
+    /// The unit normal `N` used (after interpolation, and flipped on a back face).
+    pub normal: [f32; 3],
+    /// The unit view vector `V`.
+    pub view: [f32; 3],
+    /// The material.
+    pub material: MaterialNumbers,
+    /// Energy normalisation factors `(k_d, k_s)` (1, 1 without normalisation).
+    pub normalization: [f32; 2],
+    /// Whether the specular term is gated by `N·L > 0`.
+    pub gate_specular: bool,
+    /// Whether the sum is clamped to `[0, 1]`.
+    pub clamp: bool,
+    /// The specular model: "none", "phong", "blinn-phong" or "lyon".
+    pub specular_model: &'static str,
+    /// `e_m + a_m⊗a_g`: emission and the global ambient term.
+    pub global_ambient: [f32; 3],
+    /// The global ambient light `a_g`.
+    pub ambient_light: [f32; 3],
+    /// One entry per light.
+    pub lights: Vec<LightTerms>,
+    /// The terms summed over lights, from [`shade`] at this point.
+    pub ambient: [f32; 3],
+    /// Diffuse term.
+    pub diffuse: [f32; 3],
+    /// Specular term.
+    pub specular: [f32; 3],
+    /// `ambient + diffuse + specular`, before clamping.
+    pub sum: [f32; 3],
+    /// The colour: `sum`, clamped when the option is on.
+    pub color: [f32; 3],
+    /// Gouraud: the three vertices' lit values, which the pixel interpolates.
+    pub vertices: Vec<VertexValue>,
+}
+
+/// The material's numbers.
+#[derive(Debug, Serialize)]
+pub struct MaterialNumbers {
+    /// `a_m`.
+    pub ambient: [f32; 3],
+    /// `d_m`.
+    pub diffuse: [f32; 3],
+    /// `s_m`.
+    pub specular: [f32; 3],
+    /// `e_m`.
+    pub emission: [f32; 3],
+    /// `s`.
+    pub shininess: f32,
+}
+
+/// One light's part at the point.
+#[derive(Debug, Serialize)]
+pub struct LightTerms {
+    /// "directional", "point" or "spot".
+    pub kind: &'static str,
+    /// Unit vector towards the light, `L`.
+    pub l: [f32; 3],
+    /// The reflection of `L`, `R = 2(L·N)N − L`.
+    pub r: [f32; 3],
+    /// The half vector `H = normalize(L + V)`.
+    pub h: [f32; 3],
+    /// `N·L`.
+    pub n_dot_l: f32,
+    /// `R·V`.
+    pub r_dot_v: f32,
+    /// `N·H`.
+    pub n_dot_h: f32,
+    /// Distance to a point or spot light.
+    pub distance: Option<f32>,
+    /// `1/(k0 + k1·d + k2·d²)` (1 for a directional light).
+    pub attenuation: f32,
+    /// The spot factor (1 for other lights, 0 outside the cone).
+    pub spot: f32,
+    /// The specular factor of the model (`(R·V)^s`, `(N·H)^s`, Lyon's), before gating.
+    pub spec: f32,
+    /// Whether the specular term counts (`N·L > 0`, or gating off).
+    pub lit: bool,
+    /// `att·spot·a_m⊗a_l`.
+    pub ambient: [f32; 3],
+    /// `att·spot·k_d·(N·L)⁺·d_m⊗d_l`.
+    pub diffuse: [f32; 3],
+    /// `att·spot·k_s·f·spec·s_m⊗s_l`.
+    pub specular: [f32; 3],
+    /// The light's colours `(a_l, d_l, s_l)`.
+    pub colors: [[f32; 3]; 3],
+}
+
+/// Gouraud: one vertex's lit value.
+#[derive(Debug, Serialize)]
+pub struct VertexValue {
+    /// Position.
+    pub position: [f32; 3],
+    /// Normal (flipped on a back face).
+    pub normal: [f32; 3],
+    /// The vertex's value of the object's output.
+    pub value: [f32; 3],
+}
+
+fn c3(c: Color) -> [f32; 3] {
+    [c.r, c.g, c.b]
+}
+
+fn v3(v: Vec3) -> [f32; 3] {
+    v.to_array()
+}
+
+/// The term an output shows.
+fn term(output: Output, s: &Shading) -> Color {
+    match output {
+        Output::Ambient => s.ambient,
+        Output::Diffuse => s.diffuse,
+        Output::Specular => s.specular,
+        _ => s.color,
+    }
+}
+
+fn output_name(o: Output) -> &'static str {
+    match o {
+        Output::Color => "color",
+        Output::Ambient => "ambient",
+        Output::Diffuse => "diffuse",
+        Output::Specular => "specular",
+        Output::Normal => "normal",
+        Output::Depth => "depth",
+    }
+}
+
+/// The nearest front-facing (or two-sided) triangle along the ray through pixel `(x, y)`'s
+/// centre: object, triangle, barycentrics, back face.
+fn trace(scene: &Scene, x: u32, y: u32) -> Option<(usize, usize, [f64; 3], bool)> {
+    let (w, h) = (scene.image.width, scene.image.height);
+    let m = scene.camera.clip_from_world(w as f32 / h as f32).as_dmat4().inverse();
+    let ndc_x = 2.0 * (f64::from(x) + 0.5) / f64::from(w) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(h);
+    let near = m.project_point3(DVec3::new(ndc_x, ndc_y, -1.0));
+    let far = m.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));
+    let dir = far - near;
+    let mut best: Option<(f64, usize, usize, [f64; 3], bool)> = None;
+    for (oi, obj) in scene.objects.iter().enumerate() {
+        let two_sided = obj.shading.options.two_sided;
+        let p = obj.mesh.positions();
+        for (ti, t) in obj.mesh.triangles().iter().enumerate() {
+            let [a, b, c] = t.map(|i| p[i as usize].as_dvec3());
+            let (e1, e2) = (b - a, c - a);
+            let pv = dir.cross(e2);
+            let det = e1.dot(pv);
+            if det == 0.0 || !det.is_finite() {
+                continue;
+            }
+            // det = −dir·(e1 × e2): positive where the ray runs against the counter-clockwise
+            // normal, a front face (OpenGL's rule).
+            let back = det < 0.0;
+            if back && !two_sided {
+                continue;
+            }
+            let inv = 1.0 / det;
+            let s = near - a;
+            let u = s.dot(pv) * inv;
+            let q = s.cross(e1);
+            let v = dir.dot(q) * inv;
+            let t_hit = e2.dot(q) * inv;
+            if u < 0.0 || v < 0.0 || u + v > 1.0 || !(0.0..=1.0).contains(&t_hit) {
+                continue;
+            }
+            if best.as_ref().is_none_or(|b| t_hit < b.0) {
+                best = Some((t_hit, oi, ti, [1.0 - u - v, u, v], back));
+            }
+        }
+    }
+    best.map(|(_, o, t, b, back)| (o, t, b, back))
+}
+
+/// Shades a point of `obj` as the renderers do: two-sided lighting is decided by facing, so
+/// the core's per-point flip is off.
+fn shade_obj(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3) -> Shading {
+    let options = ShadingOptions {
+        two_sided: false,
+        ..obj.shading.options
+    };
+    shade(
+        &SurfacePoint { position, normal },
+        view,
+        &obj.material,
+        &scene.lighting,
+        &options,
+    )
+}
+
+/// Probes pixel `(x, y)` of `scene` (inside the image: checked by the caller).
+pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
+    let encoding = scene.image.encoding;
+    let bg = scene.image.background;
+    let mut notes = Vec::new();
+    if scene.image.samples > 1 {
+        notes.push(format!(
+            "antialias {}: the pixel averages {} samples; the probe is the surface at the pixel's centre",
+            scene.image.samples, scene.image.samples
+        ));
+    }
+    let Some((oi, ti, bary, back)) = trace(scene, x, y) else {
+        let value = [bg[0], bg[1], bg[2]];
+        return Probe {
+            x,
+            y,
+            hit: None,
+            value,
+            value8: value.map(|c| encoding.encode(c)),
+            notes,
+        };
+    };
+    let obj = &scene.objects[oi];
+    let mesh = &obj.mesh;
+    let tri = mesh.triangles()[ti];
+    let ps = tri.map(|i| mesh.positions()[i as usize]);
+    let ns = tri.map(|i| mesh.normals()[i as usize]);
+    let b = bary.map(|w| w as f32);
+    let lerp = |v: [Vec3; 3]| v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+    let flip = if back { -1.0 } else { 1.0 };
+    let view = scene.camera.view(obj.shading.viewer);
+    let interpolation = obj.shading.interpolation;
+    let output = obj.shading.output;
+    // The point and normal the lighting is computed at.
+    let (position, normal) = match interpolation {
+        Interpolation::Flat => ((ps[0] + ps[1] + ps[2]) / 3.0, facet_normal(ps[0], ps[1], ps[2]) * flip),
+        _ => (lerp(ps), lerp(ns) * flip),
+    };
+    let at = shade_obj(scene, obj, &view, position, normal);
+    let mut vertices = Vec::new();
+    let value = match output {
+        Output::Normal => {
+            let n = normal.normalize_or_zero();
+            if n == Vec3::ZERO {
+                Color::BLACK
+            } else {
+                Color::new(n.x * 0.5 + 0.5, n.y * 0.5 + 0.5, n.z * 0.5 + 0.5)
+            }
+        }
+        Output::Depth => {
+            let cam = &scene.camera;
+            let d = cam.depth_of(lerp(ps));
+            Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
+        }
+        _ if interpolation == Interpolation::Gouraud => {
+            let mut c = Color::BLACK;
+            for k in 0..3 {
+                let s = shade_obj(scene, obj, &view, ps[k], ns[k] * flip);
+                let v = term(output, &s);
+                vertices.push(VertexValue {
+                    position: v3(ps[k]),
+                    normal: v3(ns[k] * flip),
+                    value: c3(v),
+                });
+                c += v * b[k];
+            }
+            notes.push(
+                "Gouraud: the pixel interpolates the vertices' values; the terms below are the lighting at the \
+                 pixel's own point, for comparison"
+                    .into(),
+            );
+            c
+        }
+        _ => term(output, &at),
+    };
+    let value = c3(value);
+    let hit = hit_terms(scene, obj, &view, position, normal, &at);
+    Probe {
+        x,
+        y,
+        hit: Some(Hit {
+            object: oi,
+            name: obj.name.clone(),
+            triangle: ti,
+            barycentric: b,
+            back_face: back,
+            interpolation: match interpolation {
+                Interpolation::Flat => "flat",
+                Interpolation::Gouraud => "gouraud",
+                Interpolation::Phong => "phong",
+            },
+            output: output_name(output),
+            vertices,
+            ..hit
+        }),
+        value,
+        value8: value.map(|c| encoding.encode(c)),
+        notes,
+    }
+}
+
+/// The per-light numbers at `position` with `normal`, and `at`'s totals.
+fn hit_terms(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3, at: &Shading) -> Hit {
+    let m = &obj.material;
+    let opts = obj.shading.options;
+    let s = m.shininess();
+    let n = normal.normalize_or_zero();
+    let v = view.at(position);
+    let (kd, ks) = opts.normalization.factors(s);
+    // The material without emission, for per-light terms; lights alone, no global ambient.
+    let bare = Material::new(m.ambient(), m.diffuse(), m.specular(), Color::BLACK, s).unwrap_or(*m);
+    let alone = ShadingOptions {
+        clamp: false,
+        two_sided: false,
+        ..opts
+    };
+    let lights = scene
+        .lighting
+        .lights()
+        .iter()
+        .map(|light| {
+            let inc = light.incidence(position);
+            let l = inc.to_light;
+            let r = 2.0 * l.dot(n) * n - l;
+            let h = (l + v).normalize_or_zero();
+            let distance = light.position().map(|p| (p - position).length());
+            let attenuation = match (light.attenuation(), distance) {
+                (Some(a), Some(d)) => a.factor(d),
+                _ => 1.0,
+            };
+            let spot = if attenuation > 0.0 {
+                inc.factor / attenuation
+            } else {
+                0.0
+            };
+            let lighting = Lighting::new(Color::BLACK, vec![*light]).expect("a valid light");
+            let one = shade(&SurfacePoint { position, normal: n }, view, &bare, &lighting, &alone);
+            let lc = light.color();
+            LightTerms {
+                kind: match light {
+                    Light::Directional(_) => "directional",
+                    Light::Point(_) => "point",
+                    Light::Spot(_) => "spot",
+                },
+                l: v3(l),
+                r: v3(r),
+                h: v3(h),
+                n_dot_l: n.dot(l),
+                r_dot_v: r.dot(v),
+                n_dot_h: n.dot(h),
+                distance,
+                attenuation,
+                spot,
+                spec: if l == Vec3::ZERO || n == Vec3::ZERO || v == Vec3::ZERO {
+                    0.0
+                } else {
+                    specular_factor(opts.specular, n, l, v, s)
+                },
+                lit: n.dot(l) > 0.0 || !opts.gate_specular,
+                ambient: c3(one.ambient),
+                diffuse: c3(one.diffuse),
+                specular: c3(one.specular),
+                colors: [c3(lc.ambient()), c3(lc.diffuse()), c3(lc.specular())],
+            }
+        })
+        .collect();
+    let sum = at.ambient + at.diffuse + at.specular;
+    Hit {
+        object: 0,
+        name: String::new(),
+        triangle: 0,
+        barycentric: [0.0; 3],
+        back_face: false,
+        interpolation: "phong",
+        output: "color",
+        position: v3(position),
+        normal: v3(n),
+        view: v3(v),
+        material: MaterialNumbers {
+            ambient: c3(m.ambient()),
+            diffuse: c3(m.diffuse()),
+            specular: c3(m.specular()),
+            emission: c3(m.emission()),
+            shininess: s,
+        },
+        normalization: [kd, ks],
+        gate_specular: opts.gate_specular,
+        clamp: opts.clamp,
+        specular_model: match opts.specular {
+            SpecularModel::None => "none",
+            SpecularModel::Phong => "phong",
+            SpecularModel::BlinnPhong => "blinn-phong",
+            SpecularModel::Lyon { .. } => "lyon",
+        },
+        global_ambient: c3(m.emission() + m.ambient() * scene.lighting.ambient()),
+        ambient_light: c3(scene.lighting.ambient()),
+        lights,
+        ambient: c3(at.ambient),
+        diffuse: c3(at.diffuse),
+        specular: c3(at.specular),
+        sum: c3(sum),
+        color: c3(at.color),
+        vertices: Vec::new(),
+    }
+}

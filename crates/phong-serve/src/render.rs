@@ -1,0 +1,85 @@
+//! Frames for the server: a scene to the PNG file `phong render` writes for it, on the CPU
+//! renderer's own thread pool or on the GPU, never on the async threads.
+
+use phong_core::Scene;
+use phong_raster::{RenderOptions, Renderer};
+use std::sync::Mutex;
+
+/// Which renderer draws the frames.
+pub enum Backend {
+    /// The CPU renderer on a pool of its own, with renderers (their working memory) reused
+    /// between frames.
+    Cpu {
+        /// The rendering threads.
+        pool: rayon::ThreadPool,
+        /// Idle renderers, one taken per frame.
+        renderers: Mutex<Vec<Renderer>>,
+    },
+    /// The wgpu renderer (one frame at a time).
+    Gpu(Box<Mutex<phong_gpu::Gpu>>),
+}
+
+impl Backend {
+    /// The CPU renderer on `threads` threads (all cores when `None`).
+    pub fn cpu(threads: Option<usize>) -> Result<Backend, String> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.unwrap_or(0))
+            .thread_name(|i| format!("phong-render-{i}"))
+            .build()
+            .map_err(|e| format!("could not start the rendering threads: {e}"))?;
+        Ok(Backend::Cpu {
+            pool,
+            renderers: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// Words for the startup line: "cpu, 2 threads" or the GPU adapter.
+    pub fn describe(&self) -> String {
+        match self {
+            Backend::Cpu { pool, .. } => format!("cpu, {} threads", pool.current_num_threads()),
+            Backend::Gpu(g) => format!("gpu, {}", g.lock().map(|g| g.adapter_name()).unwrap_or_default()),
+        }
+    }
+
+    /// `scene` as the PNG file `phong render` writes for it (labels drawn, the same encoder),
+    /// byte for byte.
+    pub fn png(&self, scene: &Scene) -> Result<Vec<u8>, String> {
+        let fail = |e: &dyn std::fmt::Display| format!("rendering failed: {e}");
+        match self {
+            Backend::Cpu { pool, renderers } => {
+                let mut renderer = renderers.lock().ok().and_then(|mut r| r.pop()).unwrap_or_default();
+                let options = RenderOptions::default();
+                let out = pool.install(|| -> Result<Vec<u8>, String> {
+                    // 8 bits where that is exact, as `phong render` does; else f32.
+                    let eight = renderer.render_8bit(scene, &options).map_err(|e| fail(&e))?;
+                    match eight {
+                        Some((image, _)) if scene.labels.is_empty() => {
+                            phong_scene::encode_png8(image).map_err(|e| fail(&e))
+                        }
+                        Some((image, _)) => {
+                            let mut image = image.clone();
+                            phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
+                            phong_scene::encode_png8(&image).map_err(|e| fail(&e))
+                        }
+                        None => {
+                            let (image, _) = renderer.render(scene, &options).map_err(|e| fail(&e))?;
+                            let mut image = image.clone();
+                            phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
+                            phong_scene::encode_png(&image, scene.image.encoding).map_err(|e| fail(&e))
+                        }
+                    }
+                });
+                if let Ok(mut r) = renderers.lock() {
+                    r.push(renderer);
+                }
+                out
+            }
+            Backend::Gpu(gpu) => {
+                let gpu = gpu.lock().map_err(|_| "the GPU renderer failed earlier".to_string())?;
+                let (mut image, _) = gpu.render(scene).map_err(|e| fail(&e))?;
+                phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
+                phong_scene::encode_png(&image, scene.image.encoding).map_err(|e| fail(&e))
+            }
+        }
+    }
+}
