@@ -23,7 +23,8 @@ const S = {
 };
 
 // Test and benchmark hooks: frame latencies, the last frame's PNG, whether work is pending.
-const hooks = { frames: [], lastPng: null, keepPng: false, active: 0, state: S };
+const hooks = { frames: [], lastPng: null, keepPng: false, active: 0, timer: false, state: S };
+hooks.idle = () => hooks.ready === true && hooks.active === 0 && !hooks.timer;
 window.phong = hooks;
 
 // ---------- small helpers ----------
@@ -170,10 +171,12 @@ function changed(preview) {
   saveUrl();
   const t0 = performance.now();
   clearTimeout(fullTimer);
+  hooks.timer = false;
   if (S.view === 'render') {
     if (preview) {
       requestFrame(true, t0);
-      fullTimer = setTimeout(() => requestFrame(false, performance.now()), 250);
+      hooks.timer = true;
+      fullTimer = setTimeout(() => { hooks.timer = false; requestFrame(false, performance.now()); }, 250);
     } else {
       requestFrame(false, t0);
     }
@@ -239,6 +242,7 @@ async function renderTerms() {
     await Promise.all(Object.entries(terms).map(async ([term, id]) => {
       const s = sceneFor(false, (s) => {
         s.image.width = half[0]; s.image.height = half[1];
+        s.image.background = [0, 0, 0];
         s.shading = s.shading || {};
         s.shading.output = term;
         s.object.forEach((o) => delete o.output);
@@ -551,6 +555,7 @@ async function probe(x, y) {
   }
 }
 hooks.probeAt = probe;
+hooks.rerender = () => changed(false);
 
 function showProbe(p) {
   const body = $('probe-body');
@@ -627,12 +632,13 @@ function syncControls() {
   $('segments-value').textContent = o.shape && o.shape !== 'cube' ? segs : '—';
   const mats = [];
   const orig = S.original.object[S.sel];
-  if (orig && orig.material !== undefined) mats.push(['scene', "the scene's own"]);
+  if (orig) mats.push(['scene', orig.material === undefined ? "the model's own" : "the scene's own"]);
   for (const m of S.materials) mats.push([m.name, m.name]);
   mats.push(['custom', 'custom']);
   let current = 'custom';
   if (typeof o.material === 'string' && namedMaterial(o.material) && !(S.scene.materials || {})[o.material]) current = S.materials.find((m) => norm(m.name) === norm(o.material)).name;
   else if (orig && JSON.stringify(o.material) === JSON.stringify(orig.material)) current = 'scene';
+  else if (!orig && o.material === undefined) current = 'custom';
   setOptions($('material'), mats, current);
   const e = effective(o.material);
   $('shininess').value = sliderFromShininess(e.shininess);
@@ -682,7 +688,10 @@ function bindControls() {
   on('material', 'change', (e) => {
     const v = e.target.value;
     const o = obj();
-    if (v === 'scene') o.material = clone(S.original.object[S.sel].material);
+    if (v === 'scene') {
+      const m = S.original.object[S.sel] && S.original.object[S.sel].material;
+      if (m === undefined) delete o.material; else o.material = clone(m);
+    }
     else if (v === 'custom') customMaterial(() => {});
     else o.material = v;
     syncControls();
@@ -740,7 +749,7 @@ function buildLights() {
     const row = (k, label, input) => `<div class="row"><label for="${id(k)}">Light ${n} ${label}</label>${input}<span class="err" data-for="${id(k)}"></span></div>`;
     const perTerm = l.ambient !== undefined || l.diffuse !== undefined || l.specular !== undefined;
     let html = `<h3>Light ${n}</h3>`;
-    html += row('type', 'type', `<select id="${id('type')}">${['directional', 'point', 'spot'].map((t) => `<option${t === l.type ? ' selected' : ''}>${t}</option>`).join('')}</select>`);
+    html += row('type', 'type', `<select id="${id('type')}">${['directional', 'point', 'spot'].map((t) => `<option value="${t}"${t === l.type ? ' selected' : ''}>${t}</option>`).join('')}</select>`);
     html += row('per-term', 'per-term colours', `<input type="checkbox" id="${id('per-term')}"${perTerm ? ' checked' : ''}>`);
     if (perTerm) {
       for (const k of ['ambient', 'diffuse', 'specular']) {
@@ -873,6 +882,7 @@ async function loadFiles(files) {
   S.sel = 0;
   syncControls();
   $('status').textContent = `loaded ${objInfo.name}: ${objInfo.triangles} triangles in ${objInfo.parts} parts`;
+  hooks.loaded = { name: objInfo.name, triangles: objInfo.triangles, parts: objInfo.parts };
   changed(false);
 }
 

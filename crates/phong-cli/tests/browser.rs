@@ -1,0 +1,1035 @@
+//! `phong serve` in a real browser: Debian's chromium driven through chromedriver (WebDriver),
+//! headless, against the `phong` binary as a user starts it. Skipped with a printed reason
+//! where chromium or chromedriver is missing; a failure under `PHONG_REQUIRE_BROWSER=1`.
+//! A failing step saves a screenshot under the target directory's `tmp/browser-failures/`.
+
+use anyhow::{Context, Result, anyhow, bail, ensure};
+use base64::Engine;
+use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};
+use fantoccini::{Client, ClientBuilder, Locator};
+use glam::{Vec3, Vec4Swizzles};
+use serde_json::{Value, json};
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+const CHROMIUM: &str = "/usr/bin/chromium";
+const CHROMEDRIVER: &str = "/usr/bin/chromedriver";
+
+/// One browser at a time: CI has two cores.
+static BROWSER: Mutex<()> = Mutex::new(());
+
+fn browser_available() -> bool {
+    let ok = Path::new(CHROMIUM).exists() && Path::new(CHROMEDRIVER).exists();
+    if !ok {
+        if std::env::var("PHONG_REQUIRE_BROWSER").is_ok_and(|v| v == "1") {
+            panic!("PHONG_REQUIRE_BROWSER=1 but {CHROMIUM} or {CHROMEDRIVER} is not installed");
+        }
+        eprintln!("skipped: {CHROMIUM} and {CHROMEDRIVER} are needed (apt-get install chromium chromium-driver)");
+    }
+    ok
+}
+
+/// A child process killed when dropped.
+struct Proc(Child);
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `phong serve` (extra arguments `args`) and its URL.
+fn start_server(args: &[&str]) -> (Proc, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_phong"))
+        .args(["serve", "--port", "0", "--threads", "2"])
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("phong serve starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut line)
+        .expect("the URL line");
+    (Proc(child), line.trim().to_string())
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free port")
+}
+
+/// The browser session, its server and driver.
+struct Session {
+    client: Client,
+    url: String,
+    name: &'static str,
+    _server: Proc,
+    _driver: Proc,
+    _profile: tempfile::TempDir,
+}
+
+async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<Session> {
+    let (server, url) = start_server(server_args);
+    let port = free_port();
+    let driver = Proc(
+        Command::new(CHROMEDRIVER)
+            .arg(format!("--port={port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .context("chromedriver starts")?,
+    );
+    let t0 = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        ensure!(t0.elapsed() < Duration::from_secs(20), "chromedriver did not listen");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let profile = tempfile::tempdir()?;
+    let mut caps = serde_json::Map::new();
+    caps.insert(
+        "goog:chromeOptions".into(),
+        json!({"binary": CHROMIUM, "args": [
+            "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+            "--disable-component-update", "--no-first-run", "--disable-quic", "--disable-sync",
+            format!("--user-data-dir={}", profile.path().display()), "--window-size=1400,1000"]}),
+    );
+    let client = ClientBuilder::new(hyper_util::client::legacy::connect::HttpConnector::new())
+        .capabilities(caps)
+        .connect(&format!("http://127.0.0.1:{port}"))
+        .await
+        .map_err(|e| anyhow!("WebDriver session: {e}"))?;
+    client.goto(&format!("{url}{query}")).await?;
+    let s = Session {
+        client,
+        url,
+        name,
+        _server: server,
+        _driver: driver,
+        _profile: profile,
+    };
+    s.idle().await?;
+    s.js("window.phong.keepPng = true; window.phong.rerender(); return true;")
+        .await?;
+    s.idle().await?;
+    Ok(s)
+}
+
+impl Session {
+    async fn js(&self, script: &str) -> Result<Value> {
+        Ok(self.client.execute(script, vec![]).await?)
+    }
+
+    /// Waits until the page has no frame in flight or due.
+    async fn idle(&self) -> Result<()> {
+        let t0 = Instant::now();
+        loop {
+            if self
+                .js("return !!(window.phong && window.phong.idle && window.phong.idle());")
+                .await?
+                == json!(true)
+            {
+                return Ok(());
+            }
+            ensure!(t0.elapsed() < Duration::from_secs(30), "the page did not settle");
+            tokio::time::sleep(Duration::from_millis(40)).await;
+        }
+    }
+
+    /// The control whose visible label is `label` (its accessible name).
+    async fn control(&self, label: &str) -> Result<fantoccini::elements::Element> {
+        let l = self
+            .client
+            .find(Locator::XPath(&format!("//label[normalize-space(.)='{label}']")))
+            .await
+            .with_context(|| format!("a label \"{label}\""))?;
+        let id = l
+            .attr("for")
+            .await?
+            .with_context(|| format!("label \"{label}\" names its control"))?;
+        Ok(self.client.find(Locator::Id(&id)).await?)
+    }
+
+    /// The last frame the page showed, as PNG bytes.
+    async fn png(&self) -> Result<Vec<u8>> {
+        let b64 = self.js("return window.phong.lastPng;").await?;
+        let b64 = b64.as_str().context("a frame was shown")?;
+        Ok(base64::engine::general_purpose::STANDARD.decode(b64)?)
+    }
+
+    /// Sets a range or colour input as dragging or picking does (`input` events).
+    async fn set_input(&self, label: &str, value: &str) -> Result<()> {
+        let el = self.control(label).await?;
+        let id = el.attr("id").await?.context("an id")?;
+        self.js(&format!(
+            "const e = document.getElementById('{id}'); e.value = '{value}'; e.dispatchEvent(new Event('input', {{bubbles: true}})); return true;"
+        ))
+        .await?;
+        Ok(())
+    }
+
+    async fn type_into(&self, label: &str, text: &str) -> Result<()> {
+        let el = self.control(label).await?;
+        el.clear().await?;
+        el.send_keys(&format!("{text}\u{E004}")).await?; // Tab: `change` fires
+        Ok(())
+    }
+
+    async fn shot(&self, file: &Path) {
+        if let Ok(png) = self.client.screenshot().await {
+            let _ = std::fs::create_dir_all(file.parent().unwrap_or(Path::new(".")));
+            let _ = std::fs::write(file, png);
+        }
+    }
+
+    /// Runs a step; on failure saves a screenshot and fails the test with the step's name.
+    async fn step<T>(&self, what: &str, f: impl std::future::Future<Output = Result<T>>) -> T {
+        match f.await {
+            Ok(v) => v,
+            Err(e) => {
+                let file = failures_dir().join(format!("{}-{}.png", self.name, what.replace(' ', "_")));
+                self.shot(&file).await;
+                panic!("{}: {what}: {e:#} (screenshot: {})", self.name, file.display());
+            }
+        }
+    }
+}
+
+fn failures_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("browser-failures")
+}
+
+fn decode(png_bytes: &[u8]) -> Result<(u32, u32, Vec<u8>, usize)> {
+    let dec = png::Decoder::new(std::io::Cursor::new(png_bytes));
+    let mut r = dec.read_info()?;
+    let mut buf = vec![0; r.output_buffer_size().context("size")?];
+    let info = r.next_frame(&mut buf)?;
+    buf.truncate(info.buffer_size());
+    Ok((info.width, info.height, buf, info.color_type.samples()))
+}
+
+fn run<F: std::future::Future<Output = ()>>(f: F) {
+    let _one = BROWSER.lock().unwrap_or_else(|e| e.into_inner());
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .expect("runtime")
+        .block_on(f);
+}
+
+#[test]
+fn every_control_changes_the_image() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("controls", "?size=320x180", &[]).await.expect("the page opens");
+        s.step("the page shows an image", async {
+            let (w, h, ..) = decode(&s.png().await?)?;
+            ensure!((w, h) == (320, 180), "frame {w}x{h}");
+            let natural = s.js("return document.getElementById('frame').naturalWidth;").await?;
+            ensure!(natural == json!(320), "the img shows the frame: naturalWidth {natural}");
+            Ok(())
+        })
+        .await;
+        // (label, how to change it): each must change the picture.
+        enum How {
+            Select(&'static str),
+            Input(&'static str),
+            Click,
+        }
+        let changes = [
+            ("Model", How::Select("blinn-phong")),
+            ("Interpolation", How::Select("gouraud")),
+            ("Interpolation", How::Select("flat")),
+            ("Interpolation", How::Select("phong")),
+            ("Shininess", How::Input("300")),
+            ("Ambient", How::Input("#ff0000")),
+            ("Diffuse", How::Input("#00ff00")),
+            ("Specular", How::Input("#0000ff")),
+            ("Emission", How::Input("#202000")),
+            ("Material", How::Select("ruby")),
+            ("Normalization", How::Select("phong")),
+            ("Viewer", How::Select("infinite")),
+            ("Output", How::Select("normal")),
+            ("Output", How::Select("color")),
+            ("Segments", How::Input("4")),
+            ("Shape", How::Select("torus")),
+            ("Antialias", How::Select("1")),
+            ("Encoding", How::Select("srgb")),
+            ("Light 1 type", How::Select("spot")),
+            ("Light 1 per-term colours", How::Click),
+            ("Light 1 diffuse", How::Input("#ff8000")),
+            ("Add light", How::Click),
+            ("Remove light", How::Click),
+            ("Remove light", How::Click),
+            ("Two-sided", How::Click),
+        ];
+        for (label, how) in changes {
+            if label == "Two-sided" {
+                // Two-sided shows where back faces are seen: a plane from below.
+                s.step("a plane seen from below", async {
+                    s.control("Shape").await?.select_by_value("plane").await?;
+                    s.idle().await?;
+                    s.js("const sc = window.phong.state.scene; sc.light = [{type: 'directional', direction: [0, 1, 0]}]; \
+                          sc.camera.position = [0.5, -3, 3]; window.phong.rerender(); return true;")
+                        .await?;
+                    s.idle().await
+                })
+                .await;
+            }
+            if label == "Light 1 per-term colours" {
+                // The same light in per-term form: the picture stays, the terms' inputs appear.
+                s.step("per-term colours", async {
+                    let before = s.png().await?;
+                    s.control(label).await?.click().await?;
+                    s.idle().await?;
+                    for k in ["ambient", "diffuse", "specular"] {
+                        s.control(&format!("Light 1 {k}")).await?;
+                    }
+                    ensure!(s.png().await? == before, "the same light changed the picture");
+                    Ok(())
+                })
+                .await;
+                continue;
+            }
+            let before = s.step("a frame before", s.png()).await;
+            s.step(&format!("change {label}"), async {
+                match how {
+                    How::Select(v) => s.control(label).await?.select_by_value(v).await?,
+                    How::Input(v) => s.set_input(label, v).await?,
+                    How::Click => {
+                        let el = match s.control(label).await {
+                            Ok(e) => e,
+                            Err(_) => {
+                                s.client
+                                    .find(Locator::XPath(&format!("//button[normalize-space(.)='{label}']")))
+                                    .await?
+                            }
+                        };
+                        el.click().await?
+                    }
+                }
+                s.idle().await?;
+                let after = s.png().await?;
+                ensure!(after != before, "the image did not change");
+                let err = s.js("return document.getElementById('error').textContent;").await?;
+                ensure!(err == json!(""), "an error is shown: {err}");
+                Ok(())
+            })
+            .await;
+        }
+    });
+}
+
+/// The highlight: the centroid of the pixels within 5% of the brightest.
+fn brightest(png: &[u8]) -> Result<(f64, f64)> {
+    let (w, _, px, n) = decode(png)?;
+    let lum = |p: &[u8]| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
+    let max = px.chunks(n).map(lum).max().unwrap_or(0);
+    let (mut sx, mut sy, mut count) = (0.0, 0.0, 0.0);
+    for (i, p) in px.chunks(n).enumerate() {
+        if lum(p) * 100 >= max * 95 {
+            sx += f64::from(i as u32 % w);
+            sy += f64::from(i as u32 / w);
+            count += 1.0;
+        }
+    }
+    Ok((sx / count, sy / count))
+}
+
+#[test]
+fn dragging_a_light_moves_the_highlight() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("drag", "?size=480x270", &[]).await.expect("the page opens");
+        s.step("a sphere under one point light", async {
+            s.control("Shape").await?.select_by_value("sphere").await?;
+            s.idle().await?;
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Remove light']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await?;
+            s.type_into("Light 1 position", "1.2, 1.6, 1.6").await?;
+            s.idle().await
+        })
+        .await;
+        let before = s.step("the highlight", async { brightest(&s.png().await?) }).await;
+        s.step("drag the light's marker", async {
+            let marker = s.client.find(Locator::Css("#markers [data-light='0'] circle")).await?;
+            let mut drag = MouseActions::new("mouse".into())
+                .then(PointerAction::MoveToElement {
+                    element: marker,
+                    duration: None,
+                    x: 0.0,
+                    y: 0.0,
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            for _ in 0..12 {
+                drag = drag.then(PointerAction::MoveBy {
+                    duration: Some(Duration::from_millis(20)),
+                    x: -12.0,
+                    y: 6.0,
+                });
+            }
+            drag = drag.then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            });
+            s.client.perform_actions(drag).await?;
+            s.idle().await
+        })
+        .await;
+        s.step("the highlight moved with the light", async {
+            let after = brightest(&s.png().await?)?;
+            let moved = (after.0 - before.0).hypot(after.1 - before.1);
+            ensure!(moved > 10.0, "highlight at {before:?} then {after:?}");
+            ensure!(
+                after.0 < before.0,
+                "the light moved left, the highlight did not: {before:?} {after:?}"
+            );
+            let pos = s.js("return window.phong.state.scene.light[0].position;").await?;
+            ensure!(pos[0].as_f64().unwrap_or(9.0) < 1.2, "light position {pos}");
+            Ok(())
+        })
+        .await;
+        s.step("orbit by dragging the image", async {
+            let before = s.js("return window.phong.state.scene.camera.position;").await?;
+            let png0 = s.png().await?;
+            let frame = s.client.find(Locator::Id("frame")).await?;
+            let drag = MouseActions::new("mouse".into())
+                .then(PointerAction::MoveToElement {
+                    element: frame,
+                    duration: None,
+                    x: -150.0,
+                    y: -80.0,
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                })
+                .then(PointerAction::MoveBy {
+                    duration: Some(Duration::from_millis(100)),
+                    x: 60.0,
+                    y: 0.0,
+                })
+                .then(PointerAction::Up {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            s.client.perform_actions(drag).await?;
+            s.idle().await?;
+            let after = s.js("return window.phong.state.scene.camera.position;").await?;
+            ensure!(after != before, "camera did not move");
+            ensure!(s.png().await? != png0, "image did not change");
+            Ok(())
+        })
+        .await;
+    });
+}
+
+/// The page's Terms images, as RGBA bytes read back by a canvas.
+async fn term_pixels(s: &Session) -> Result<Vec<Vec<u8>>> {
+    let v = s
+        .js(r#"
+        return ['term-ambient', 'term-diffuse', 'term-specular', 'term-total'].map((id) => {
+          const img = document.getElementById(id);
+          const c = document.createElement('canvas');
+          c.width = img.naturalWidth; c.height = img.naturalHeight;
+          const ctx = c.getContext('2d');
+          ctx.drawImage(img, 0, 0);
+          return Array.from(ctx.getImageData(0, 0, c.width, c.height).data);
+        });"#)
+        .await?;
+    let arr = v.as_array().context("four images")?;
+    Ok(arr
+        .iter()
+        .map(|a| {
+            a.as_array()
+                .map(|a| a.iter().map(|x| x.as_u64().unwrap_or(0) as u8).collect())
+                .unwrap_or_default()
+        })
+        .collect())
+}
+
+#[test]
+fn terms_add_up_to_the_total() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("terms", "?size=320x180", &[]).await.expect("the page opens");
+        s.step("open Terms", async {
+            // One sample: an edge pixel averaging a clamped colour would not add up.
+            s.control("Antialias").await?.select_by_value("1").await?;
+            s.idle().await?;
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Terms']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await
+        })
+        .await;
+        s.step("ambient + diffuse + specular = total where nothing clamps", async {
+            let px = term_pixels(&s).await?;
+            ensure!(
+                px.len() == 4 && px.iter().all(|p| p.len() == px[0].len() && !p.is_empty()),
+                "four images"
+            );
+            let (mut checked, mut worst) = (0, 0i32);
+            for i in (0..px[0].len()).step_by(4) {
+                for k in 0..3 {
+                    let (a, d, sp, t) = (px[0][i + k], px[1][i + k], px[2][i + k], px[3][i + k]);
+                    // The terms and total are each rounded to 8 bits: the sum is within 2.
+                    if t < 250 && a < 255 && d < 255 && sp < 255 {
+                        let e = (i32::from(a) + i32::from(d) + i32::from(sp) - i32::from(t)).abs();
+                        worst = worst.max(e);
+                        checked += 1;
+                    }
+                }
+            }
+            ensure!(checked > 10_000, "only {checked} channels checked");
+            ensure!(worst <= 2, "a channel's terms differ from its total by {worst}/255");
+            // The terms are not trivially zero: diffuse and specular carry light.
+            let sum = |p: &Vec<u8>| p.iter().map(|&x| u64::from(x)).sum::<u64>();
+            ensure!(
+                sum(&px[1]) > sum(&px[0]) && sum(&px[2]) > 0,
+                "diffuse and specular are lit"
+            );
+            Ok(())
+        })
+        .await;
+        s.step("the terms follow the controls", async {
+            let before = term_pixels(&s).await?;
+            s.control("Specular").await?;
+            s.set_input("Specular", "#000000").await?;
+            s.idle().await?;
+            let after = term_pixels(&s).await?;
+            ensure!(after[2].chunks(4).all(|p| p[..3] == [0, 0, 0]), "no specular left");
+            ensure!(after[3] != before[3], "total changed");
+            Ok(())
+        })
+        .await;
+        s.step("Compare and Lobe views draw", async {
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Compare']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await?;
+            let legend = s
+                .js("return document.getElementById('compare-legend').textContent;")
+                .await?;
+            ensure!(
+                legend.as_str().unwrap_or("").contains("Blinn-Phong at 4s"),
+                "legend {legend}"
+            );
+            s.control("Difference").await?.click().await?;
+            s.idle().await?;
+            let legend = s
+                .js("return document.getElementById('compare-legend').textContent;")
+                .await?;
+            ensure!(
+                legend.as_str().unwrap_or("").contains("largest difference"),
+                "legend {legend}"
+            );
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Lobe']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await?;
+            let lobe = s.js("return window.phong.lobe;").await?;
+            // Phong's lobe in the plane of incidence is cos(θ)^s (here s = 51.2, gold).
+            let s_ = lobe["shininess"].as_f64().context("shininess")?;
+            for (a, v) in lobe["angles"]
+                .as_array()
+                .context("angles")?
+                .iter()
+                .zip(lobe["phong"].as_array().context("phong")?)
+            {
+                let (a, v) = (a.as_f64().unwrap_or(0.0), v.as_f64().unwrap_or(0.0));
+                let want = a.to_radians().cos().max(0.0).powf(s_);
+                ensure!((v - want).abs() < 1e-4, "phong lobe at {a}°: {v} vs cos^s {want}");
+            }
+            Ok(())
+        })
+        .await;
+    });
+}
+
+#[test]
+fn probe_agrees_with_phong_core_and_the_pixel() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("probe", "?size=320x180", &[]).await.expect("the page opens");
+        s.step("one sample per pixel", async {
+            s.control("Antialias").await?.select_by_value("1").await?;
+            s.idle().await
+        })
+        .await;
+        let p = s
+            .step("click a pixel of the teapot", async {
+                let frame = s.client.find(Locator::Id("frame")).await?;
+                let (_, _, w, h) = frame.rectangle().await?;
+                // 10 pixels right of the image's centre, in CSS pixels of the shown image.
+                let click = MouseActions::new("mouse".into())
+                    .then(PointerAction::MoveToElement {
+                        element: frame,
+                        duration: None,
+                        x: 10.0 * w / 320.0,
+                        y: 0.0,
+                    })
+                    .then(PointerAction::Down {
+                        button: MOUSE_BUTTON_LEFT,
+                    })
+                    .then(PointerAction::Up {
+                        button: MOUSE_BUTTON_LEFT,
+                    });
+                s.client.perform_actions(click).await?;
+                let t0 = Instant::now();
+                loop {
+                    let p = s.js("return window.phong.probe || null;").await?;
+                    if !p.is_null() {
+                        let eq = s
+                            .js("return document.getElementById('probe-equation').textContent;")
+                            .await?;
+                        ensure!(
+                            eq.as_str().unwrap_or("").contains("c = e_m + a_m·a_g"),
+                            "equation shown: {eq}"
+                        );
+                        let _ = h;
+                        return Ok(p);
+                    }
+                    ensure!(t0.elapsed() < Duration::from_secs(10), "no probe answer");
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+            })
+            .await;
+        let scene_json = s
+            .step("the shown scene", s.js("return window.phong.state.shown;"))
+            .await;
+        let png_bytes = s.step("the shown frame", s.png()).await;
+        s.step("the probe's numbers are phong-core's", async {
+            let (x, y) = (
+                p["x"].as_u64().context("x")? as u32,
+                p["y"].as_u64().context("y")? as u32,
+            );
+            ensure!((155..=175).contains(&x) && (80..=100).contains(&y), "pixel ({x}, {y})");
+            let hit = &p["hit"];
+            ensure!(hit["name"] == json!("teapot"), "hit {hit}");
+            // The pixel the page shows, within 1/255 of the probe's value.
+            let (w, _, px, n) = decode(&png_bytes)?;
+            let i = ((y * w + x) as usize) * n;
+            for k in 0..3 {
+                let v = p["value8"][k].as_i64().context("value8")?;
+                ensure!(
+                    (i64::from(px[i + k]) - v).abs() <= 1,
+                    "channel {k}: pixel {} vs probe {v}",
+                    px[i + k]
+                );
+            }
+            // The shaded point projects to the pixel's centre.
+            let scene = phong_scene::parse_scene_json(&scene_json, &|_: &str| Err("no meshes".to_string()))
+                .map_err(|e| anyhow!("{e}"))?
+                .scene;
+            let v3 = |v: &Value| -> Result<Vec3> {
+                Ok(Vec3::new(
+                    v[0].as_f64().context("x")? as f32,
+                    v[1].as_f64().context("y")? as f32,
+                    v[2].as_f64().context("z")? as f32,
+                ))
+            };
+            let pos = v3(&hit["position"])?;
+            let clip = scene.camera.clip_from_world(320.0 / 180.0) * pos.extend(1.0);
+            let ndc = clip.xy() / clip.w;
+            let (sx, sy) = ((ndc.x + 1.0) * 160.0, (1.0 - ndc.y) * 90.0);
+            ensure!(
+                (sx - (x as f32 + 0.5)).abs() < 0.01 && (sy - (y as f32 + 0.5)).abs() < 0.01,
+                "P projects to ({sx}, {sy})"
+            );
+            // shade() at the probe's point and normal gives the probe's terms.
+            let obj = &scene.objects[hit["object"].as_u64().context("object")? as usize];
+            let normal = v3(&hit["normal"])?;
+            let view = scene.camera.view(obj.shading.viewer);
+            let sh = phong_core::shade(
+                &phong_core::SurfacePoint { position: pos, normal },
+                &view,
+                &obj.material,
+                &scene.lighting,
+                &obj.shading.options,
+            );
+            for (key, c) in [
+                ("ambient", sh.ambient),
+                ("diffuse", sh.diffuse),
+                ("specular", sh.specular),
+                ("color", sh.color),
+            ] {
+                let got = v3(&hit[key])?;
+                ensure!(
+                    (got - Vec3::new(c.r, c.g, c.b)).abs().max_element() < 1e-5,
+                    "{key}: {got} vs shade {c:?}"
+                );
+            }
+            // Per light: N·L from the scene's own light, and the terms sum to the totals.
+            let n = normal.normalize();
+            let mut diffuse = Vec3::ZERO;
+            for (l, light) in hit["lights"]
+                .as_array()
+                .context("lights")?
+                .iter()
+                .zip(scene.lighting.lights())
+            {
+                let to_light = light.incidence(pos).to_light;
+                let ndl = l["n_dot_l"].as_f64().context("n_dot_l")? as f32;
+                ensure!((ndl - n.dot(to_light)).abs() < 1e-5, "N·L {ndl} vs {}", n.dot(to_light));
+                diffuse += v3(&l["diffuse"])?;
+            }
+            ensure!(
+                (diffuse - v3(&hit["diffuse"])?).abs().max_element() < 1e-5,
+                "per-light diffuse sums"
+            );
+            Ok(())
+        })
+        .await;
+    });
+}
+
+#[test]
+fn downloaded_toml_renders_the_page_image_byte_for_byte() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("toml", "?size=400x240", &[]).await.expect("the page opens");
+        s.step("change a few things", async {
+            s.control("Material").await?.select_by_value("polished_bronze").await?;
+            s.idle().await?;
+            s.control("Model").await?.select_by_value("blinn-phong").await?;
+            s.idle().await?;
+            s.set_input("Shininess", "500").await?;
+            s.idle().await?;
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Add light']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await?;
+            let frame = s.client.find(Locator::Id("frame")).await?;
+            let drag = MouseActions::new("mouse".into())
+                .then(PointerAction::MoveToElement {
+                    element: frame,
+                    duration: None,
+                    x: 0.0,
+                    y: 0.0,
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                })
+                .then(PointerAction::MoveBy {
+                    duration: Some(Duration::from_millis(100)),
+                    x: 40.0,
+                    y: 15.0,
+                })
+                .then(PointerAction::Up {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            s.client.perform_actions(drag).await?;
+            s.idle().await
+        })
+        .await;
+        let dir = tempfile::tempdir().expect("tmp");
+        s.step("render the TOML with phong render", async {
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Download TOML']"))
+                .await?
+                .click()
+                .await?;
+            let t0 = Instant::now();
+            let toml = loop {
+                let t = s.js("return window.phong.lastToml || null;").await?;
+                if let Some(t) = t.as_str() {
+                    break t.to_string();
+                }
+                ensure!(t0.elapsed() < Duration::from_secs(10), "no TOML");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            };
+            let file = dir.path().join("scene.toml");
+            std::fs::write(&file, &toml)?;
+            let out = dir.path().join("out.png");
+            let st = Command::new(env!("CARGO_BIN_EXE_phong"))
+                .arg("render")
+                .arg(&file)
+                .arg("-o")
+                .arg(&out)
+                .output()?;
+            ensure!(
+                st.status.success(),
+                "phong render: {}",
+                String::from_utf8_lossy(&st.stderr)
+            );
+            let page = s.png().await?;
+            let cli = std::fs::read(&out)?;
+            ensure!(
+                page == cli,
+                "the page's PNG ({} bytes) is not phong render's ({} bytes)",
+                page.len(),
+                cli.len()
+            );
+            ensure!(
+                toml.contains("shininess = 31.62") && toml.contains("model = \"blinn-phong\""),
+                "{toml}"
+            );
+            Ok(())
+        })
+        .await;
+        s.step("the URL reproduces the view", async {
+            let before = s.png().await?;
+            let href = s.js("return location.href;").await?;
+            s.client.goto(href.as_str().context("href")?).await?;
+            s.idle().await?;
+            s.js("window.phong.keepPng = true; window.phong.rerender(); return true;")
+                .await?;
+            s.idle().await?;
+            ensure!(s.png().await? == before, "the link shows another image");
+            Ok(())
+        })
+        .await;
+    });
+}
+
+#[test]
+fn loading_an_obj_renders_it() {
+    if !browser_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tmp");
+    let obj = dir.path().join("box.obj");
+    let mtl = dir.path().join("box.mtl");
+    let mut text = String::from("mtllib box.mtl\nusemtl red\n");
+    for z in [-1, 1] {
+        for y in [-1, 1] {
+            for x in [-1, 1] {
+                text.push_str(&format!("v {x} {y} {z}\n"));
+            }
+        }
+    }
+    text.push_str("f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+    std::fs::write(&obj, text).expect("obj");
+    std::fs::write(&mtl, "newmtl red\nKa 0.2 0 0\nKd 0.9 0 0\nKs 0.5 0.5 0.5\nNs 40\n").expect("mtl");
+    run(async {
+        let s = open("obj", "?size=320x180", &[]).await.expect("the page opens");
+        s.step("load box.obj and box.mtl", async {
+            let input = s.client.find(Locator::Id("load-model")).await?;
+            input
+                .send_keys(&format!("{}\n{}", obj.display(), mtl.display()))
+                .await?;
+            let t0 = Instant::now();
+            loop {
+                let st = s.js("return window.phong.loaded || null;").await?;
+                if st["name"] == json!("box.obj") {
+                    ensure!(st["triangles"] == json!(12), "loaded {st}");
+                    break;
+                }
+                let e = s.js("return document.getElementById('error').textContent;").await?;
+                ensure!(t0.elapsed() < Duration::from_secs(10), "not loaded: {e}");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            s.idle().await?;
+            let (_, _, px, n) = decode(&s.png().await?)?;
+            let red = px.chunks(n).filter(|p| p[0] > 60 && p[1] < 30 && p[2] < 30).count();
+            ensure!(red > 2000, "only {red} red pixels");
+            let shapes = s
+                .js("return [...document.getElementById('shape').options].map(o => o.value);")
+                .await?;
+            ensure!(
+                shapes.as_array().is_some_and(|a| a.contains(&json!("box.obj"))),
+                "Shape lists it: {shapes}"
+            );
+            Ok(())
+        })
+        .await;
+        s.step("a broken OBJ says why", async {
+            let bad = obj.with_file_name("bad.obj");
+            std::fs::write(&bad, "v 1 2\nf 1 2 3\n")?;
+            s.client
+                .find(Locator::Id("load-model"))
+                .await?
+                .send_keys(&bad.display().to_string())
+                .await?;
+            let t0 = Instant::now();
+            loop {
+                let e = s.js("return document.getElementById('error').textContent;").await?;
+                if e.as_str().unwrap_or("").contains("bad.obj") {
+                    ensure!(
+                        e.as_str().unwrap_or("").contains(":1:"),
+                        "the message names the line: {e}"
+                    );
+                    return Ok(());
+                }
+                ensure!(t0.elapsed() < Duration::from_secs(10), "no error shown");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+        })
+        .await;
+    });
+}
+
+#[test]
+fn bad_values_are_explained_next_to_their_control() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("errors", "?size=320x180", &[]).await.expect("the page opens");
+        let slot = |id: &'static str| {
+            let s = &s;
+            async move {
+                let v = s
+                    .js(&format!(
+                        "return document.querySelector('.err[data-for=\"{id}\"]').textContent;"
+                    ))
+                    .await?;
+                Ok::<String, anyhow::Error>(v.as_str().unwrap_or("").to_string())
+            }
+        };
+        s.step("a position that is not 3 numbers", async {
+            s.type_into("Light 1 position", "1, two, 3").await?;
+            s.idle().await?;
+            let m = slot("light-1-position").await?;
+            ensure!(m.contains("expected 3 numbers"), "message: {m:?}");
+            Ok(())
+        })
+        .await;
+        s.step("an attenuation the model refuses", async {
+            s.type_into("Light 1 attenuation", "0, 0, 0").await?;
+            s.idle().await?;
+            let m = slot("light-1-attenuation").await?;
+            ensure!(m.contains("constant"), "message: {m:?}");
+            let e = s.js("return document.getElementById('error').textContent;").await?;
+            ensure!(
+                e.as_str().unwrap_or("").starts_with("light[0].attenuation"),
+                "error line: {e}"
+            );
+            s.type_into("Light 1 attenuation", "1, 0, 0").await?;
+            s.idle().await?;
+            ensure!(slot("light-1-attenuation").await?.is_empty(), "the message clears");
+            Ok(())
+        })
+        .await;
+        s.step("opengl with normalization", async {
+            s.control("Normalization").await?.select_by_value("phong").await?;
+            s.idle().await?;
+            s.control("Model").await?.select_by_value("opengl").await?;
+            s.idle().await?;
+            let m = slot("normalization").await?;
+            ensure!(m.contains("no normalization"), "message: {m:?}");
+            Ok(())
+        })
+        .await;
+        if let Ok(dir) = std::env::var("PHONG_SCREENSHOT_DIR") {
+            s.control("Normalization")
+                .await
+                .expect("control")
+                .select_by_value("none")
+                .await
+                .expect("none");
+            s.control("Antialias")
+                .await
+                .expect("control")
+                .select_by_value("4")
+                .await
+                .expect("4");
+            s.idle().await.expect("idle");
+            s.shot(&Path::new(&dir).join("explorer.png")).await;
+        }
+        let _ = &s.url;
+    });
+}
+
+/// The latency benchmark (BENCHMARKS.md): drag the Shininess slider for `PHONG_BENCH_MOVES`
+/// moves at 1280x720 and print the median and 95th percentile from input to painted frame.
+#[test]
+#[ignore = "a benchmark: cargo test --release -p phong-cli --test browser -- --ignored --nocapture"]
+fn bench_slider_latency() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("bench", "?size=1280x720", &[]).await.expect("the page opens");
+        let moves: usize = std::env::var("PHONG_BENCH_MOVES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(120);
+        s.step("drag the slider", async {
+            s.js("window.phong.keepPng = false; window.phong.frames.length = 0; return true;").await?;
+            let slider = s.control("Shininess").await?;
+            let mut drag = MouseActions::new("mouse".into())
+                .then(PointerAction::MoveToElement {
+                    element: slider,
+                    duration: None,
+                    x: -50.0,
+                    y: 0.0,
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            for i in 0..moves {
+                let dx = if (i / 40) % 2 == 0 { 2.0 } else { -2.0 };
+                drag = drag.then(PointerAction::MoveBy {
+                    duration: Some(Duration::from_millis(16)),
+                    x: dx,
+                    y: 0.0,
+                });
+            }
+            drag = drag.then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            });
+            s.client.perform_actions(drag).await?;
+            s.idle().await?;
+            let frames = s.js("return window.phong.frames;").await?;
+            let mut ms: Vec<f64> = frames
+                .as_array()
+                .context("frames")?
+                .iter()
+                .filter(|f| f["preview"] == json!(true))
+                .filter_map(|f| f["ms"].as_f64())
+                .collect();
+            let mut render: Vec<f64> = frames
+                .as_array()
+                .context("frames")?
+                .iter()
+                .filter(|f| f["preview"] == json!(true))
+                .filter_map(|f| f["render_ms"].as_f64())
+                .collect();
+            if ms.is_empty() {
+                bail!("no frames");
+            }
+            ms.sort_by(f64::total_cmp);
+            render.sort_by(f64::total_cmp);
+            let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+            println!(
+                "phong serve latency, 1280x720 preview frames while dragging: frames={} median={:.1}ms p95={:.1}ms max={:.1}ms (server render+encode median={:.1}ms)",
+                ms.len(),
+                q(&ms, 0.5),
+                q(&ms, 0.95),
+                q(&ms, 1.0),
+                q(&render, 0.5)
+            );
+            Ok(())
+        })
+        .await;
+    });
+}
