@@ -635,8 +635,21 @@ fn serve(a: ServeArgs) -> Result<()> {
             eprintln!("phong: could not open a browser ({e}); open {url} yourself");
         }
         let state = std::sync::Arc::new(phong_serve::AppState::new(backend, scene, library));
+        // Ctrl-C (SIGINT) or SIGTERM: stop taking connections, finish the renders in flight.
         let shutdown = async {
-            let _ = tokio::signal::ctrl_c().await;
+            let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()).ok();
+            let term = async {
+                match term.as_mut() {
+                    Some(t) => {
+                        t.recv().await;
+                    }
+                    None => std::future::pending().await,
+                }
+            };
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {}
+                _ = term => {}
+            }
             eprintln!("phong: stopping (renders in flight finish first)");
         };
         phong_serve::serve(listener, state, shutdown).await.context("serving")?;
