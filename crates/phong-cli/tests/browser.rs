@@ -75,6 +75,10 @@ struct Session {
 }
 
 async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<Session> {
+    open_sized(name, query, server_args, (1400, 1000)).await
+}
+
+async fn open_sized(name: &'static str, query: &str, server_args: &[&str], window: (u32, u32)) -> Result<Session> {
     let (server, url) = start_server(server_args);
     let port = free_port();
     let driver = Proc(
@@ -97,7 +101,7 @@ async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<S
         json!({"binary": CHROMIUM, "args": [
             "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
             "--disable-component-update", "--no-first-run", "--disable-quic", "--disable-sync",
-            format!("--user-data-dir={}", profile.path().display()), "--window-size=1400,1000"]}),
+            format!("--user-data-dir={}", profile.path().display()), format!("--window-size={},{}", window.0, window.1)]}),
     );
     let client = ClientBuilder::new(hyper_util::client::legacy::connect::HttpConnector::new())
         .capabilities(caps)
@@ -233,8 +237,15 @@ fn every_control_changes_the_image() {
         s.step("the page shows an image", async {
             let (w, h, ..) = decode(&s.png().await?)?;
             ensure!((w, h) == (320, 180), "frame {w}x{h}");
-            let natural = s.js("return document.getElementById('frame').naturalWidth;").await?;
-            ensure!(natural == json!(320), "the img shows the frame: naturalWidth {natural}");
+            let shown = s.js("return document.getElementById('frame').width;").await?;
+            ensure!(shown == json!(320), "the canvas shows the frame: width {shown}");
+            // The canvas holds the PNG's pixels.
+            let canvas = s
+                .js("const c = document.getElementById('frame'); return Array.from(c.getContext('2d').getImageData(0, 0, c.width, c.height).data);")
+                .await?;
+            let (_, _, px, n) = decode(&s.png().await?)?;
+            let canvas: Vec<u8> = canvas.as_array().context("pixels")?.iter().map(|v| v.as_u64().unwrap_or(0) as u8).collect();
+            ensure!(canvas.chunks(4).zip(px.chunks(n)).all(|(c, p)| c[..3] == p[..3]), "the canvas is not the PNG");
             Ok(())
         })
         .await;
@@ -939,23 +950,48 @@ fn bad_values_are_explained_next_to_their_control() {
             Ok(())
         })
         .await;
-        if let Ok(dir) = std::env::var("PHONG_SCREENSHOT_DIR") {
-            s.control("Normalization")
-                .await
-                .expect("control")
-                .select_by_value("none")
-                .await
-                .expect("none");
-            s.control("Antialias")
-                .await
-                .expect("control")
-                .select_by_value("4")
-                .await
-                .expect("4");
-            s.idle().await.expect("idle");
-            s.shot(&Path::new(&dir).join("explorer.png")).await;
-        }
         let _ = &s.url;
+    });
+}
+
+/// README's picture of the page: the default scene with a probed pixel, saved as
+/// `$PHONG_SCREENSHOT_DIR/explorer.png`.
+#[test]
+#[ignore = "writes README's screenshot: PHONG_SCREENSHOT_DIR=docs/images cargo test -p phong-cli --test browser readme -- --ignored"]
+fn readme_screenshot() {
+    if !browser_available() {
+        return;
+    }
+    let dir = std::env::var("PHONG_SCREENSHOT_DIR").unwrap_or_else(|_| env!("CARGO_TARGET_TMPDIR").to_string());
+    run(async {
+        let s = open_sized("readme", "", &[], (1500, 1500))
+            .await
+            .expect("the page opens");
+        s.step("probe the teapot", async {
+            let frame = s.client.find(Locator::Id("frame")).await?;
+            let click = MouseActions::new("mouse".into())
+                .then(PointerAction::MoveToElement {
+                    element: frame,
+                    duration: None,
+                    x: 30.0,
+                    y: -40.0,
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                })
+                .then(PointerAction::Up {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            s.client.perform_actions(click).await?;
+            let t0 = Instant::now();
+            while s.js("return window.phong.probe || null;").await?.is_null() {
+                ensure!(t0.elapsed() < Duration::from_secs(10), "no probe answer");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            s.idle().await
+        })
+        .await;
+        s.shot(&Path::new(&dir).join("explorer.png")).await;
     });
 }
 
@@ -968,7 +1004,14 @@ fn bench_slider_latency() {
         return;
     }
     run(async {
-        let s = open("bench", "?size=1280x720", &[]).await.expect("the page opens");
+        // A window wide enough to show the 1280x720 frame at its own size beside the panel.
+        let query = format!(
+            "?size=1280x720{}",
+            std::env::var("PHONG_BENCH_QUERY").unwrap_or_default()
+        );
+        let s = open_sized("bench", &query, &[], (1720, 1100))
+            .await
+            .expect("the page opens");
         let moves: usize = std::env::var("PHONG_BENCH_MOVES")
             .ok()
             .and_then(|v| v.parse().ok())
@@ -1017,11 +1060,26 @@ fn bench_slider_latency() {
             if ms.is_empty() {
                 bail!("no frames");
             }
+            for k in ["wait", "response", "body", "decode", "paint", "bytes"] {
+                let mut v: Vec<f64> = frames
+                    .as_array()
+                    .context("frames")?
+                    .iter()
+                    .filter(|f| f["preview"] == json!(true))
+                    .filter_map(|f| f[k].as_f64())
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                if !v.is_empty() {
+                    println!("  {k}: median {:.1}", v[v.len() / 2]);
+                }
+            }
             ms.sort_by(f64::total_cmp);
             render.sort_by(f64::total_cmp);
             let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
             println!(
-                "phong serve latency, 1280x720 preview frames while dragging: frames={} median={:.1}ms p95={:.1}ms max={:.1}ms (server render+encode median={:.1}ms)",
+                "phong serve latency, 1280x720 ({query}), preview frames of {}x{} while dragging: frames={} median={:.1}ms p95={:.1}ms max={:.1}ms (server parse+render median={:.1}ms)",
+                frames[0]["w"],
+                frames[0]["h"],
                 ms.len(),
                 q(&ms, 0.5),
                 q(&ms, 0.95),

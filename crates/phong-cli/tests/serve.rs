@@ -157,3 +157,52 @@ fn a_public_address_is_warned_about() {
     assert!(a.contains("serving the explorer at http://127.0.0.1:"), "{a}");
     assert!(b.contains("anyone who can reach this port can use the server"), "{b}");
 }
+
+#[test]
+fn the_gpu_backend_serves_the_cpu_image() {
+    let gpu = phong()
+        .args(["serve", "--port", "0", "--backend", "gpu"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn();
+    let mut gpu = gpu.expect("starts");
+    let mut url = String::new();
+    BufReader::new(gpu.stdout.take().expect("stdout"))
+        .read_line(&mut url)
+        .expect("line");
+    if url.is_empty() {
+        let out = gpu.wait_with_output().expect("exit");
+        assert!(
+            std::env::var("PHONG_REQUIRE_GPU").is_err(),
+            "PHONG_REQUIRE_GPU=1 but: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        eprintln!(
+            "skipped: no GPU adapter ({})",
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+        return;
+    }
+    let mut cpu = phong()
+        .args(["serve", "--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("starts");
+    let mut cpu_url = String::new();
+    BufReader::new(cpu.stdout.take().expect("stdout"))
+        .read_line(&mut cpu_url)
+        .expect("line");
+    let addr = |u: &str| u.trim().trim_start_matches("http://").trim_end_matches('/').to_string();
+    let scene = serde_json::json!({"image": {"width": 96, "height": 64},
+        "light": [{"type": "point", "position": [1, 2, 3], "attenuation": [1, 0.1, 0]}],
+        "object": [{"shape": "torus", "material": "emerald"}]})
+    .to_string();
+    let (c1, a) = request(&addr(&url), "POST", "/api/render?format=rgba", &scene).expect("gpu frame");
+    let (c2, b) = request(&addr(&cpu_url), "POST", "/api/render?format=rgba", &scene).expect("cpu frame");
+    let _ = (gpu.kill(), cpu.kill(), gpu.wait(), cpu.wait());
+    assert_eq!((c1, c2), (200, 200));
+    assert_eq!(a.len(), 96 * 64 * 4);
+    let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+    assert!(worst <= 1, "the GPU's frame differs from the CPU's by {worst}/255");
+}

@@ -391,34 +391,57 @@ async fn materials() -> Response {
     axum::Json(list).into_response()
 }
 
-/// `POST /api/render`: a JSON scene to the PNG `phong render` writes for it.
+/// `POST /api/render[?format=png|rgba]`: a JSON scene to the PNG `phong render` writes for
+/// it, or to its pixels as RGBA bytes (`x-phong-width` and `x-phong-height` give the size).
 async fn render(
     State(state): State<Arc<AppState>>,
     ConnectInfo(peer): ConnectInfo<SocketAddr>,
+    Query(q): Query<HashMap<String, String>>,
     headers: HeaderMap,
     body: Body,
 ) -> Result<Response, ApiError> {
+    let raw = match q.get("format").map(String::as_str) {
+        None | Some("png") => false,
+        Some("rgba") => true,
+        Some(other) => {
+            return Err(ApiError::at(
+                "format",
+                format!("`format` is \"png\" or \"rgba\", got \"{other}\""),
+            ));
+        }
+    };
     let client = client_id(&headers, peer);
     let bytes = read_body(body, SERVE_MAX_BODY, "SERVE_MAX_BODY").await?;
     let value = parse_json(&bytes)?;
     touch(&state, &client);
     let c = client.clone();
-    let (png, ms) = run_job(&state, &client, move |st| {
-        let scene = scene_from_json(st, &c, &value)?;
+    let (bytes, size, ms) = run_job(&state, &client, move |st| {
         let t = Instant::now();
-        let png = st
+        let scene = scene_from_json(st, &c, &value)?;
+        let bytes = st
             .backend
-            .png(&scene)
+            .frame(&scene, raw)
             .map_err(|e| ApiError::new(StatusCode::UNPROCESSABLE_ENTITY, e))?;
-        Ok((png, t.elapsed().as_secs_f64() * 1e3))
+        Ok((
+            bytes,
+            (scene.image.width, scene.image.height),
+            t.elapsed().as_secs_f64() * 1e3,
+        ))
     })
     .await?;
-    let mut r = (StatusCode::OK, png).into_response();
+    let mut r = (StatusCode::OK, bytes).into_response();
     let h = r.headers_mut();
-    h.insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
+    let kind = if raw { "application/octet-stream" } else { "image/png" };
+    h.insert(header::CONTENT_TYPE, HeaderValue::from_static(kind));
     h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
-    if let Ok(v) = HeaderValue::from_str(&format!("{ms:.2}")) {
-        h.insert("x-phong-render-ms", v);
+    for (k, v) in [
+        ("x-phong-render-ms", format!("{ms:.2}")),
+        ("x-phong-width", size.0.to_string()),
+        ("x-phong-height", size.1.to_string()),
+    ] {
+        if let Ok(v) = HeaderValue::from_str(&v) {
+            h.insert(k, v);
+        }
     }
     Ok(r)
 }

@@ -42,8 +42,9 @@ impl Backend {
     }
 
     /// `scene` as the PNG file `phong render` writes for it (labels drawn, the same encoder),
-    /// byte for byte.
-    pub fn png(&self, scene: &Scene) -> Result<Vec<u8>, String> {
+    /// byte for byte; with `raw`, the same pixels as RGBA bytes, row by row (the page shows
+    /// these while the user drags: no encoding here, no decoding in the browser).
+    pub fn frame(&self, scene: &Scene, raw: bool) -> Result<Vec<u8>, String> {
         let fail = |e: &dyn std::fmt::Display| format!("rendering failed: {e}");
         match self {
             Backend::Cpu { pool, renderers } => {
@@ -53,19 +54,17 @@ impl Backend {
                     // 8 bits where that is exact, as `phong render` does; else f32.
                     let eight = renderer.render_8bit(scene, &options).map_err(|e| fail(&e))?;
                     match eight {
-                        Some((image, _)) if scene.labels.is_empty() => {
-                            phong_scene::encode_png8(image).map_err(|e| fail(&e))
-                        }
+                        Some((image, _)) if scene.labels.is_empty() => encode8(image, raw),
                         Some((image, _)) => {
                             let mut image = image.clone();
                             phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                            phong_scene::encode_png8(&image).map_err(|e| fail(&e))
+                            encode8(&image, raw)
                         }
                         None => {
                             let (image, _) = renderer.render(scene, &options).map_err(|e| fail(&e))?;
                             let mut image = image.clone();
                             phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                            phong_scene::encode_png(&image, scene.image.encoding).map_err(|e| fail(&e))
+                            encode(&image, scene.image.encoding, raw)
                         }
                     }
                 });
@@ -78,8 +77,24 @@ impl Backend {
                 let gpu = gpu.lock().map_err(|_| "the GPU renderer failed earlier".to_string())?;
                 let (mut image, _) = gpu.render(scene).map_err(|e| fail(&e))?;
                 phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                phong_scene::encode_png(&image, scene.image.encoding).map_err(|e| fail(&e))
+                encode(&image, scene.image.encoding, raw)
             }
         }
+    }
+}
+
+fn encode8(image: &phong_core::Image8, raw: bool) -> Result<Vec<u8>, String> {
+    if raw {
+        Ok(image.to_bytes(true))
+    } else {
+        phong_scene::encode_png8(image).map_err(|e| format!("encoding the PNG failed: {e}"))
+    }
+}
+
+fn encode(image: &phong_core::Image, encoding: phong_core::Encoding, raw: bool) -> Result<Vec<u8>, String> {
+    if raw {
+        Ok(image.to_bytes(encoding, true))
+    } else {
+        phong_scene::encode_png(image, encoding).map_err(|e| format!("encoding the PNG failed: {e}"))
     }
 }

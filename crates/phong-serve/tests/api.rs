@@ -143,6 +143,12 @@ async fn render_answers_the_png_of_phong_render() {
     let (w, h, px) = decode(&r.body);
     assert_eq!((w, h), (64, 48));
     assert_eq!(px, image.to_bytes(scene.image.encoding, false));
+    // The raw form: the same pixels as RGBA.
+    let raw = call(&st, "POST", "/api/render?format=rgba", "a", small_scene().to_string()).await;
+    assert_eq!(raw.status, StatusCode::OK);
+    assert_eq!(raw.body, image.to_bytes(scene.image.encoding, true));
+    let r = call(&st, "POST", "/api/render?format=gif", "a", small_scene().to_string()).await;
+    assert_eq!(refused(&r), (400, "format".into(), String::new()));
 }
 
 #[tokio::test]

@@ -101,10 +101,16 @@ function frameSize() {
   return [w, Math.max(36, Math.round((w * 9) / 16))];
 }
 
+// Previews (while the user drags) have one sample, and half the size where the frame has
+// more than half a megapixel (`?preview=full` keeps the size); the full frame follows.
 function sceneFor(preview, overrides) {
   const s = clone(S.scene);
   s.image = s.image || {};
-  const [w, h] = frameSize();
+  let [w, h] = frameSize();
+  if (preview && S.previewScale !== 1 && w * h > 500000) {
+    w = Math.max(1, Math.round(w / 2));
+    h = Math.max(1, Math.round(h / 2));
+  }
   s.image.width = w;
   s.image.height = h;
   if (preview) s.image.antialias = 1;
@@ -197,18 +203,35 @@ async function pump() {
   inflight = true;
   hooks.active++;
   try {
-    const r = await post('/api/render', job.scene);
-    const blob = await r.blob();
-    if (hooks.keepPng) hooks.lastPng = await blobBase64(blob);
-    const url = URL.createObjectURL(blob);
-    const img = $('frame');
-    const old = img.src;
-    img.src = url;
-    await img.decode();
-    if (old.startsWith('blob:')) URL.revokeObjectURL(old);
+    // Previews come as raw RGBA pixels (no PNG to encode or decode); full frames as the PNG
+    // file `phong render` writes, which the page keeps for download.
+    const tSend = performance.now();
+    const r = await post(job.preview ? '/api/render?format=rgba' : '/api/render', job.scene);
+    const tHeaders = performance.now();
+    const blob = job.preview ? null : await r.blob();
+    const buffer = job.preview ? await r.arrayBuffer() : null;
+    const tBody = performance.now();
+    const canvas = $('frame');
+    const w = Number(r.headers.get('x-phong-width')), h = Number(r.headers.get('x-phong-height'));
+    let picture;
+    if (job.preview) {
+      picture = new ImageData(new Uint8ClampedArray(buffer), w, h);
+    } else {
+      if (hooks.keepPng) hooks.lastPng = await blobBase64(blob);
+      picture = await createImageBitmap(blob, { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+    }
+    const tDecoded = performance.now();
+    if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+    const ctx = canvas.getContext('2d');
+    if (job.preview) ctx.putImageData(picture, 0, 0);
+    else { ctx.clearRect(0, 0, w, h); ctx.drawImage(picture, 0, 0); picture.close(); }
     requestAnimationFrame(() => {
       const painted = performance.now();
-      hooks.frames.push({ ms: painted - job.t0, preview: job.preview, render_ms: Number(r.headers.get('x-phong-render-ms')), w: job.scene.image.width, h: job.scene.image.height });
+      hooks.frames.push({
+        ms: painted - job.t0, preview: job.preview, render_ms: Number(r.headers.get('x-phong-render-ms')),
+        wait: tSend - job.t0, response: tHeaders - tSend, body: tBody - tHeaders, decode: tDecoded - tBody, paint: painted - tDecoded,
+        bytes: job.preview ? buffer.byteLength : blob.size, w, h,
+      });
       if (hooks.frames.length > 5000) hooks.frames.shift();
     });
     S.shown = job.scene;
@@ -894,10 +917,13 @@ function saveUrl() {
 
 async function start() {
   const q = new URLSearchParams(location.search);
+  S.previewScale = q.get('preview') === 'full' ? 1 : 0.5;
   const m = /^(\d+)x(\d+)$/.exec(q.get('size') || '');
   if (m) {
+    // A fixed image size, shown at its own size where it fits (no scaling in the browser).
     S.size = [Number(m[1]), Number(m[2])];
     $('viewport').style.aspectRatio = `${S.size[0]} / ${S.size[1]}`;
+    $('viewport').style.maxWidth = `${S.size[0]}px`;
   }
   const [mats, initial] = await Promise.all([fetch('/api/materials').then((r) => r.json()), fetch('/api/scene').then((r) => r.json())]);
   S.materials = mats;
