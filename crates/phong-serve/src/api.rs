@@ -292,13 +292,25 @@ fn scene_from_json(state: &AppState, client: &str, value: &Value) -> Result<Scen
         if let Some(p) = state.library.get(name) {
             return Ok((*p).clone());
         }
-        let mut clients = state
-            .uploads
-            .lock()
-            .map_err(|_| "the upload store failed".to_string())?;
-        match clients.get_mut(client).and_then(|u| u.parts(name)) {
+        let found = {
+            let clients = state
+                .uploads
+                .lock()
+                .map_err(|_| "the upload store failed".to_string())?;
+            clients.get(client).and_then(|u| u.lookup(name))
+        };
+        match found {
             Some(Ok(p)) => Ok((*p).clone()),
-            Some(Err(e)) => Err(e),
+            // Parsed outside the lock (this runs on a blocking thread).
+            Some(Err(files)) => {
+                let parts = crate::models::parse_upload(name, &files)?;
+                if let Ok(mut clients) = state.uploads.lock()
+                    && let Some(u) = clients.get_mut(client)
+                {
+                    u.remember(name, &files, &parts);
+                }
+                Ok((*parts).clone())
+            }
             None => Err(format!(
                 "no model named \"{name}\": upload it first (PUT /api/models/{name}); the server opens no file a \
                  request names"
@@ -589,37 +601,56 @@ async fn upload(
     let client = client_id(&headers, peer);
     let bytes = read_body(body, SERVE_MAX_UPLOAD, "SERVE_MAX_UPLOAD").await?;
     let is_obj = name.to_ascii_lowercase().ends_with(".obj");
-    let mut clients = state
-        .uploads
-        .lock()
-        .map_err(|_| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "the upload store failed"))?;
-    if !clients.contains_key(&client) && clients.len() >= SERVE_MAX_CLIENTS {
-        return Err(ApiError::limit(
-            StatusCode::SERVICE_UNAVAILABLE,
-            "SERVE_MAX_CLIENTS",
-            format!("{SERVE_MAX_CLIENTS} clients hold uploads (SERVE_MAX_CLIENTS); try again later"),
-        ));
-    }
-    let u = clients.entry(client).or_default();
-    u.last_used = Some(Instant::now());
-    u.put(&name, bytes.to_vec())
-        .map_err(|m| ApiError::limit(StatusCode::PAYLOAD_TOO_LARGE, "SERVE_MAX_UPLOADS", m))?;
-    // An OBJ is parsed now, so that a broken file is reported to the upload, not the render.
-    let mut info = json!({"name": name, "files": u.names()});
-    if is_obj {
-        match u.parts(&name) {
-            Some(Ok(parts)) => {
+    let files = {
+        let mut clients = state
+            .uploads
+            .lock()
+            .map_err(|_| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "the upload store failed"))?;
+        if !clients.contains_key(&client) && clients.len() >= SERVE_MAX_CLIENTS {
+            return Err(ApiError::limit(
+                StatusCode::SERVICE_UNAVAILABLE,
+                "SERVE_MAX_CLIENTS",
+                format!("{SERVE_MAX_CLIENTS} clients hold uploads (SERVE_MAX_CLIENTS); try again later"),
+            ));
+        }
+        let u = clients.entry(client.clone()).or_default();
+        u.last_used = Some(Instant::now());
+        u.put(&name, bytes.to_vec())
+            .map_err(|m| ApiError::limit(StatusCode::PAYLOAD_TOO_LARGE, "SERVE_MAX_UPLOADS", m))?;
+        u.lookup(&name)
+    };
+    let mut info = json!({"name": name});
+    // An OBJ is parsed now (off the async threads), so that a broken file is reported to the
+    // upload, not to a render.
+    if is_obj && let Some(Err(files)) = files {
+        let n = name.clone();
+        let parsed = tokio::task::spawn_blocking(move || {
+            let parts = crate::models::parse_upload(&n, &files);
+            (parts, files)
+        })
+        .await
+        .map_err(|_| ApiError::new(StatusCode::INTERNAL_SERVER_ERROR, "parsing the upload failed"))?;
+        let mut clients = state
+            .uploads
+            .lock()
+            .map_err(|_| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "the upload store failed"))?;
+        let u = clients.entry(client.clone()).or_default();
+        match parsed {
+            (Ok(parts), files) => {
+                u.remember(&name, &files, &parts);
                 let tris: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
                 info["triangles"] = json!(tris);
                 info["parts"] = json!(parts.len());
                 info["scene"] = crate::models::model_scene(&name, &parts);
             }
-            Some(Err(e)) => {
+            (Err(e), _) => {
                 u.remove(&name);
                 return Err(ApiError::at("file", e));
             }
-            None => {}
         }
+    }
+    if let Ok(clients) = state.uploads.lock() {
+        info["files"] = json!(clients.get(&client).map(Uploads::names).unwrap_or_default());
     }
     Ok((StatusCode::CREATED, axum::Json(info)).into_response())
 }

@@ -87,34 +87,48 @@ impl Uploads {
         n
     }
 
-    /// The parts of uploaded OBJ `name`, its MTL libraries from the other uploads (parsed once
-    /// per set of uploads); `Err` is the message for the scene's `mesh` key.
-    pub fn parts(&mut self, name: &str) -> Option<Result<Arc<Vec<ObjPart>>, String>> {
+    /// The parts of uploaded OBJ `name` if parsed already; else its files, to parse with
+    /// [`parse_upload`] outside the store's lock. `None`: no such upload.
+    pub fn lookup(&self, name: &str) -> Option<Result<Arc<Vec<ObjPart>>, Files>> {
         if let Some(p) = self.parsed.get(name) {
             return Some(Ok(p.clone()));
         }
-        let data = self.files.get(name)?.clone();
-        let Ok(src) = std::str::from_utf8(&data) else {
-            return Some(Err(format!("uploaded {name} is not UTF-8 text")));
-        };
-        let files = &self.files;
-        let read = |mtl: &Path| -> std::io::Result<String> {
-            let key = mtl.to_string_lossy();
-            let key = key.rsplit(['/', '\\']).next().unwrap_or(&key);
-            let f = files.get(key).ok_or_else(|| {
-                std::io::Error::new(std::io::ErrorKind::NotFound, "not uploaded (upload it with the OBJ)")
-            })?;
-            String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
-        };
-        let mut warnings = Vec::new();
-        let out = phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings)
-            .map(Arc::new)
-            .map_err(|e| e.to_string());
-        if let Ok(p) = &out {
-            self.parsed.insert(name.to_string(), p.clone());
-        }
-        Some(out)
+        self.files.contains_key(name).then(|| Err(Files(self.files.clone())))
     }
+
+    /// Keeps `parts` as the parse of `name`, unless the uploads changed since `files` was taken.
+    pub fn remember(&mut self, name: &str, files: &Files, parts: &Arc<Vec<ObjPart>>) {
+        let same = files.0.len() == self.files.len()
+            && files
+                .0
+                .iter()
+                .all(|(k, v)| self.files.get(k).is_some_and(|f| Arc::ptr_eq(f, v)));
+        if same {
+            self.parsed.insert(name.to_string(), parts.clone());
+        }
+    }
+}
+
+/// A client's uploaded files at one moment (shared, not copied).
+pub struct Files(HashMap<String, Arc<Vec<u8>>>);
+
+/// Parses uploaded OBJ `name` with its MTL libraries from `files`; `Err` is the message for
+/// the scene's `mesh` key (or the upload).
+pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, String> {
+    let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
+    let src = std::str::from_utf8(data).map_err(|_| format!("uploaded {name} is not UTF-8 text"))?;
+    let read = |mtl: &Path| -> std::io::Result<String> {
+        let key = mtl.to_string_lossy();
+        let key = key.rsplit(['/', '\\']).next().unwrap_or(&key);
+        let f = files.0.get(key).ok_or_else(|| {
+            std::io::Error::new(std::io::ErrorKind::NotFound, "not uploaded (upload it with the OBJ)")
+        })?;
+        String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
+    };
+    let mut warnings = Vec::new();
+    phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings)
+        .map(Arc::new)
+        .map_err(|e| e.to_string())
 }
 
 /// Drops the uploads of clients idle for [`SERVE_IDLE_SECONDS`], every minute.
