@@ -206,3 +206,61 @@ fn the_gpu_backend_serves_the_cpu_image() {
     let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
     assert!(worst <= 1, "the GPU's frame differs from the CPU's by {worst}/255");
 }
+
+/// A served scene file's frame is `phong render`'s PNG of that file, byte for byte.
+fn served_equals_rendered(input: &str) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = dir.path().join("cli.png");
+    let st = phong()
+        .arg("render")
+        .arg(input)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("render");
+    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    let mut child = phong()
+        .arg("serve")
+        .arg(input)
+        .args(["--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("starts");
+    let mut url = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut url)
+        .expect("the URL");
+    let addr = url
+        .trim()
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let (code, body) = request(&addr, "GET", "/api/scene", "").expect("scene");
+    assert_eq!(code, 200);
+    let initial: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    assert!(!initial["models"].as_array().expect("models").is_empty(), "{initial}");
+    let (code, png) = request(&addr, "POST", "/api/render", &initial["scene"].to_string()).expect("render");
+    let _ = (child.kill(), child.wait());
+    assert_eq!(code, 200, "{}", String::from_utf8_lossy(&png));
+    assert!(
+        png == std::fs::read(&out).expect("cli png"),
+        "{input}: the served PNG is not phong render's"
+    );
+}
+
+#[test]
+fn a_served_scene_file_renders_as_phong_render_does() {
+    served_equals_rendered(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/scenes/models.toml"
+    ));
+}
+
+#[test]
+fn a_served_model_renders_as_phong_render_does() {
+    served_equals_rendered(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/scenes/assets/knot.obj"
+    ));
+}

@@ -18,8 +18,8 @@ pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
 pub use obj::{ObjPart, load_obj, load_obj_text};
 pub use png_out::{encode_png, encode_png8, write_png, write_png8};
 pub use toml_scene::{
-    INTERPOLATIONS, MODEL_BACKGROUND, MODEL_LIGHTS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model,
-    model_view, parse_choice, parse_scene, parse_scene_with,
+    INTERPOLATIONS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model, model_scene, model_view, parse_choice,
+    parse_scene, parse_scene_with,
 };
 
 use std::path::Path;

@@ -892,63 +892,52 @@ fn transform(ctx: &Ctx, o: &RawObject) -> Result<Mat4, Error> {
     Ok(Mat4::from_scale_rotation_translation(s, q, t))
 }
 
-/// A scene for an OBJ model alone: its MTL materials (or OpenGL's default),
-/// a perspective camera framing its bounding sphere, and three lights (key,
-/// fill, back), 4 samples per pixel.
+/// A scene for an OBJ model alone: [`model_scene`] read by the scene reader, the OBJ's parts
+/// as its mesh (so that `phong render MODEL.obj` and `phong serve MODEL.obj` draw the same).
 pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
     let mut warnings = Vec::new();
     let parts = load_obj(path, &mut warnings)?;
-    let shading = ShadingSettings {
-        options: ShadingOptions::default(),
-        interpolation: Interpolation::Phong,
-        viewer: Viewer::Local,
-        output: Output::Color,
-    };
-    let mut objects = Vec::new();
-    for p in parts {
-        let mesh = if p.has_normals {
-            p.mesh
-        } else {
-            p.mesh.with_crease_normals(60.0)
-        };
-        objects.push(Object {
-            name: p.name,
-            mesh,
-            material: p.material.unwrap_or_default(),
-            shading,
-        });
-    }
-    let bounds = objects
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let json = model_scene(&name, &parts);
+    let lookup = |_: &str| Ok(parts.clone());
+    let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
+        path: path.to_path_buf(),
+        line: 1,
+        col: 1,
+        key: Some(e.path),
+        message: format!("the model cannot be framed: {}", e.message),
+    })?;
+    warnings.append(&mut loaded.warnings);
+    loaded.warnings = warnings;
+    Ok(loaded)
+}
+
+/// The scene of a model alone, as JSON with the scene file's schema: its MTL materials (or
+/// OpenGL's default), a perspective camera framing its bounding sphere ([`model_view`]),
+/// three lights (key, fill, back), 4 samples per pixel, the model as its only object
+/// (`mesh = name`).
+pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
+    let bounds = parts
         .iter()
-        .filter_map(|o| o.mesh.bounds())
+        .filter_map(|p| p.mesh.bounds())
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-    let view = model_view(bounds);
-    let camera = Camera::new(
-        view.position,
-        view.target,
-        Vec3::Y,
-        Projection::Perspective { fov_y_deg: view.fov },
-        view.near,
-        view.far,
-    )
-    .expect("framed camera");
-    let light = |(d, c): ([f32; 3], f32)| {
-        Light::directional(Vec3::from(d), LightColor::uniform(Color::splat(c)).unwrap()).unwrap()
-    };
-    let lighting = Lighting::new(Color::splat(0.2), MODEL_LIGHTS.map(light).to_vec()).expect("valid");
-    let scene = Scene {
-        image: ImageSettings {
-            background: MODEL_BACKGROUND,
-            samples: 4,
-            ..ImageSettings::default()
-        },
-        camera,
-        lighting,
-        shading,
-        objects,
-        labels: Vec::new(),
-    };
-    Ok(Loaded { scene, warnings })
+    let v = model_view(bounds);
+    let bg = MODEL_BACKGROUND;
+    let lights: Vec<_> = MODEL_LIGHTS
+        .iter()
+        .map(|(d, c)| serde_json::json!({"type": "directional", "direction": d, "color": [c, c, c]}))
+        .collect();
+    serde_json::json!({
+        "image": {"background": [bg[0], bg[1], bg[2]], "antialias": 4},
+        "camera": {"position": v.position.to_array(), "target": v.target.to_array(), "fov": v.fov,
+                   "near": v.near, "far": v.far},
+        "shading": {"viewer": "local"},
+        "light": lights,
+        "object": [{"mesh": name}],
+    })
 }
 
 /// The view of a model alone: a perspective camera, its vertical field of view 45°, looking
@@ -969,14 +958,14 @@ pub struct ModelView {
 }
 
 /// The lights of a model alone, `(direction, grey level)`: key, fill and back.
-pub const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
+const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
     ([1.0, -1.0, -1.0], 0.8),
     ([-1.0, -0.3, -0.5], 0.35),
     ([0.0, -0.5, 1.0], 0.3),
 ];
 
 /// The background of a model alone.
-pub const MODEL_BACKGROUND: [f32; 4] = [0.08, 0.08, 0.1, 1.0];
+const MODEL_BACKGROUND: [f32; 4] = [0.08, 0.08, 0.1, 1.0];
 
 /// [`ModelView`] for a model with bounds `bounds` (the unit cube's when `None`).
 pub fn model_view(bounds: Option<(Vec3, Vec3)>) -> ModelView {

@@ -5,7 +5,6 @@
 use crate::api::AppState;
 use phong_core::limits::{SERVE_IDLE_SECONDS, SERVE_MAX_UPLOAD_TOTAL, SERVE_MAX_UPLOADS};
 use phong_scene::ObjPart;
-use serde_json::json;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -143,25 +142,7 @@ pub async fn sweep_idle(state: Arc<AppState>) {
     }
 }
 
-/// The page's scene for a model alone: `phong render MODEL.obj`'s camera, lights and
-/// background, the model as its only object.
+/// The page's scene for a model alone: `phong render MODEL.obj`'s.
 pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
-    let bounds = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-    let v = phong_scene::model_view(bounds);
-    let bg = phong_scene::MODEL_BACKGROUND;
-    let lights: Vec<_> = phong_scene::MODEL_LIGHTS
-        .iter()
-        .map(|(d, c)| json!({"type": "directional", "direction": d, "color": [c, c, c]}))
-        .collect();
-    json!({
-        "image": {"width": 960, "height": 540, "background": [bg[0], bg[1], bg[2]], "antialias": 4},
-        "camera": {"position": v.position.to_array(), "target": v.target.to_array(), "fov": v.fov,
-                   "near": v.near, "far": v.far},
-        "shading": {"viewer": "local"},
-        "light": lights,
-        "object": [{"mesh": name}],
-    })
+    phong_scene::model_scene(name, parts)
 }
