@@ -1023,7 +1023,7 @@ fn bench_slider_latency() {
                 .then(PointerAction::MoveToElement {
                     element: slider,
                     duration: None,
-                    x: -50.0,
+                    x: -40.0,
                     y: 0.0,
                 })
                 .then(PointerAction::Down {
