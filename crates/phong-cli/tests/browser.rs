@@ -184,6 +184,38 @@ impl Session {
         Ok(())
     }
 
+    /// A pointer gesture as a user makes it: press at `at` from `element`'s centre, move by
+    /// each of `moves` (`ms` milliseconds each), release. No moves: a click.
+    async fn gesture(
+        &self,
+        element: fantoccini::elements::Element,
+        at: (f64, f64),
+        moves: &[(f64, f64)],
+        ms: u64,
+    ) -> Result<()> {
+        let mut g = MouseActions::new("mouse".into())
+            .then(PointerAction::MoveToElement {
+                element,
+                duration: None,
+                x: at.0,
+                y: at.1,
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            });
+        for &(x, y) in moves {
+            g = g.then(PointerAction::MoveBy {
+                duration: Some(Duration::from_millis(ms)),
+                x,
+                y,
+            });
+        }
+        g = g.then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+        Ok(self.client.perform_actions(g).await?)
+    }
+
     async fn shot(&self, file: &Path) {
         if let Ok(png) = self.client.screenshot().await {
             let _ = std::fs::create_dir_all(file.parent().unwrap_or(Path::new(".")));
@@ -378,27 +410,7 @@ fn dragging_a_light_moves_the_highlight() {
         let before = s.step("the highlight", async { brightest(&s.png().await?) }).await;
         s.step("drag the light's marker", async {
             let marker = s.client.find(Locator::Css("#markers [data-light='0'] circle")).await?;
-            let mut drag = MouseActions::new("mouse".into())
-                .then(PointerAction::MoveToElement {
-                    element: marker,
-                    duration: None,
-                    x: 0.0,
-                    y: 0.0,
-                })
-                .then(PointerAction::Down {
-                    button: MOUSE_BUTTON_LEFT,
-                });
-            for _ in 0..12 {
-                drag = drag.then(PointerAction::MoveBy {
-                    duration: Some(Duration::from_millis(20)),
-                    x: -12.0,
-                    y: 6.0,
-                });
-            }
-            drag = drag.then(PointerAction::Up {
-                button: MOUSE_BUTTON_LEFT,
-            });
-            s.client.perform_actions(drag).await?;
+            s.gesture(marker, (0.0, 0.0), &[(-12.0, 6.0); 12], 20).await?;
             s.idle().await
         })
         .await;
@@ -419,25 +431,7 @@ fn dragging_a_light_moves_the_highlight() {
             let before = s.js("return window.phong.state.scene.camera.position;").await?;
             let png0 = s.png().await?;
             let frame = s.client.find(Locator::Id("frame")).await?;
-            let drag = MouseActions::new("mouse".into())
-                .then(PointerAction::MoveToElement {
-                    element: frame,
-                    duration: None,
-                    x: -150.0,
-                    y: -80.0,
-                })
-                .then(PointerAction::Down {
-                    button: MOUSE_BUTTON_LEFT,
-                })
-                .then(PointerAction::MoveBy {
-                    duration: Some(Duration::from_millis(100)),
-                    x: 60.0,
-                    y: 0.0,
-                })
-                .then(PointerAction::Up {
-                    button: MOUSE_BUTTON_LEFT,
-                });
-            s.client.perform_actions(drag).await?;
+            s.gesture(frame, (-150.0, -80.0), &[(60.0, 0.0)], 100).await?;
             s.idle().await?;
             let after = s.js("return window.phong.state.scene.camera.position;").await?;
             ensure!(after != before, "camera did not move");
@@ -596,20 +590,7 @@ fn probe_agrees_with_phong_core_and_the_pixel() {
                 let frame = s.client.find(Locator::Id("frame")).await?;
                 let (_, _, w, h) = frame.rectangle().await?;
                 // 10 pixels right of the image's centre, in CSS pixels of the shown image.
-                let click = MouseActions::new("mouse".into())
-                    .then(PointerAction::MoveToElement {
-                        element: frame,
-                        duration: None,
-                        x: 10.0 * w / 320.0,
-                        y: 0.0,
-                    })
-                    .then(PointerAction::Down {
-                        button: MOUSE_BUTTON_LEFT,
-                    })
-                    .then(PointerAction::Up {
-                        button: MOUSE_BUTTON_LEFT,
-                    });
-                s.client.perform_actions(click).await?;
+                s.gesture(frame, (10.0 * w / 320.0, 0.0), &[], 0).await?;
                 let t0 = Instant::now();
                 loop {
                     let p = s.js("return window.phong.probe || null;").await?;
@@ -739,25 +720,7 @@ fn downloaded_toml_renders_the_page_image_byte_for_byte() {
                 .await?;
             s.idle().await?;
             let frame = s.client.find(Locator::Id("frame")).await?;
-            let drag = MouseActions::new("mouse".into())
-                .then(PointerAction::MoveToElement {
-                    element: frame,
-                    duration: None,
-                    x: 0.0,
-                    y: 0.0,
-                })
-                .then(PointerAction::Down {
-                    button: MOUSE_BUTTON_LEFT,
-                })
-                .then(PointerAction::MoveBy {
-                    duration: Some(Duration::from_millis(100)),
-                    x: 40.0,
-                    y: 15.0,
-                })
-                .then(PointerAction::Up {
-                    button: MOUSE_BUTTON_LEFT,
-                });
-            s.client.perform_actions(drag).await?;
+            s.gesture(frame, (0.0, 0.0), &[(40.0, 15.0)], 100).await?;
             s.idle().await
         })
         .await;
@@ -969,20 +932,7 @@ fn readme_screenshot() {
             .expect("the page opens");
         s.step("probe the teapot", async {
             let frame = s.client.find(Locator::Id("frame")).await?;
-            let click = MouseActions::new("mouse".into())
-                .then(PointerAction::MoveToElement {
-                    element: frame,
-                    duration: None,
-                    x: 30.0,
-                    y: -40.0,
-                })
-                .then(PointerAction::Down {
-                    button: MOUSE_BUTTON_LEFT,
-                })
-                .then(PointerAction::Up {
-                    button: MOUSE_BUTTON_LEFT,
-                });
-            s.client.perform_actions(click).await?;
+            s.gesture(frame, (30.0, -40.0), &[], 0).await?;
             let t0 = Instant::now();
             while s.js("return window.phong.probe || null;").await?.is_null() {
                 ensure!(t0.elapsed() < Duration::from_secs(10), "no probe answer");
@@ -1019,28 +969,7 @@ fn bench_slider_latency() {
         s.step("drag the slider", async {
             s.js("window.phong.keepPng = false; window.phong.frames.length = 0; return true;").await?;
             let slider = s.control("Shininess").await?;
-            let mut drag = MouseActions::new("mouse".into())
-                .then(PointerAction::MoveToElement {
-                    element: slider,
-                    duration: None,
-                    x: -40.0,
-                    y: 0.0,
-                })
-                .then(PointerAction::Down {
-                    button: MOUSE_BUTTON_LEFT,
-                });
-            for i in 0..moves {
-                let dx = if (i / 40) % 2 == 0 { 2.0 } else { -2.0 };
-                drag = drag.then(PointerAction::MoveBy {
-                    duration: Some(Duration::from_millis(16)),
-                    x: dx,
-                    y: 0.0,
-                });
-            }
-            drag = drag.then(PointerAction::Up {
-                button: MOUSE_BUTTON_LEFT,
-            });
-            s.client.perform_actions(drag).await?;
+            s.gesture(slider, (-40.0, 0.0), &(0..moves).map(|i| { let dx = if (i / 40) % 2 == 0 { 2.0 } else { -2.0 }; (dx, 0.0) }).collect::<Vec<_>>(), 16).await?;
             s.idle().await?;
             let frames = s.js("return window.phong.frames;").await?;
             let mut ms: Vec<f64> = frames

@@ -30,6 +30,28 @@ fn request(addr: &str, method: &str, path: &str, body: &str) -> std::io::Result<
     Ok((code, out[start..].to_vec()))
 }
 
+/// `phong serve ARGS --port 0`, its stderr piped, and the address it prints.
+fn serve(args: &[&str]) -> (std::process::Child, String) {
+    let mut child = phong()
+        .arg("serve")
+        .args(args)
+        .args(["--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    let mut url = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut url)
+        .expect("the URL");
+    let addr = url
+        .trim()
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    (child, addr)
+}
+
 #[test]
 fn a_port_in_use_is_a_clear_error() {
     let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("a port");
@@ -69,21 +91,7 @@ fn a_bad_scene_file_is_refused_before_serving() {
 
 #[test]
 fn stops_cleanly_with_renders_in_flight() {
-    let mut child = phong()
-        .args(["serve", "--port", "0", "--threads", "2"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starts");
-    let mut url = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut url)
-        .expect("the URL");
-    let addr = url
-        .trim()
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
+    let (mut child, addr) = serve(&["--threads", "2"]);
     // The default scene's first page load, then slow frames in flight.
     let (code, scene) = request(&addr, "GET", "/api/scene", "").expect("scene");
     assert_eq!(code, 200);
@@ -160,17 +168,9 @@ fn a_public_address_is_warned_about() {
 
 #[test]
 fn the_gpu_backend_serves_the_cpu_image() {
-    let gpu = phong()
-        .args(["serve", "--port", "0", "--backend", "gpu"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn();
-    let mut gpu = gpu.expect("starts");
-    let mut url = String::new();
-    BufReader::new(gpu.stdout.take().expect("stdout"))
-        .read_line(&mut url)
-        .expect("line");
-    if url.is_empty() {
+    let (gpu, gpu_addr) = serve(&["--backend", "gpu"]);
+    let mut gpu = gpu;
+    if gpu_addr.is_empty() {
         let out = gpu.wait_with_output().expect("exit");
         assert!(
             std::env::var("PHONG_REQUIRE_GPU").is_err(),
@@ -183,23 +183,13 @@ fn the_gpu_backend_serves_the_cpu_image() {
         );
         return;
     }
-    let mut cpu = phong()
-        .args(["serve", "--port", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("starts");
-    let mut cpu_url = String::new();
-    BufReader::new(cpu.stdout.take().expect("stdout"))
-        .read_line(&mut cpu_url)
-        .expect("line");
-    let addr = |u: &str| u.trim().trim_start_matches("http://").trim_end_matches('/').to_string();
+    let (mut cpu, cpu_addr) = serve(&[]);
     let scene = serde_json::json!({"image": {"width": 96, "height": 64},
         "light": [{"type": "point", "position": [1, 2, 3], "attenuation": [1, 0.1, 0]}],
         "object": [{"shape": "torus", "material": "emerald"}]})
     .to_string();
-    let (c1, a) = request(&addr(&url), "POST", "/api/render?format=rgba", &scene).expect("gpu frame");
-    let (c2, b) = request(&addr(&cpu_url), "POST", "/api/render?format=rgba", &scene).expect("cpu frame");
+    let (c1, a) = request(&gpu_addr, "POST", "/api/render?format=rgba", &scene).expect("gpu frame");
+    let (c2, b) = request(&cpu_addr, "POST", "/api/render?format=rgba", &scene).expect("cpu frame");
     let _ = (gpu.kill(), cpu.kill(), gpu.wait(), cpu.wait());
     assert_eq!((c1, c2), (200, 200));
     assert_eq!(a.len(), 96 * 64 * 4);
@@ -219,23 +209,7 @@ fn served_equals_rendered(input: &str) {
         .output()
         .expect("render");
     assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
-    let mut child = phong()
-        .arg("serve")
-        .arg(input)
-        .args(["--port", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("starts");
-    let mut url = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut url)
-        .expect("the URL");
-    let addr = url
-        .trim()
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
+    let (mut child, addr) = serve(&[input]);
     let (code, body) = request(&addr, "GET", "/api/scene", "").expect("scene");
     assert_eq!(code, 200);
     let initial: serde_json::Value = serde_json::from_slice(&body).expect("json");

@@ -47,7 +47,9 @@ pub use image::{Canvas, Encoding, Image, Image8};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;
-pub use scene::{ImageSettings, Interpolation, Label, Object, Output, Scene, ShadingSettings};
+pub use scene::{
+    ImageSettings, Interpolation, Label, Object, Output, Scene, ShadingSettings, depth_color, normal_color,
+};
 pub use shading::{
     Lighting, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, lyon,
     pow_positive, shade, specular_factor,

@@ -2,7 +2,10 @@
 //! validated (world space, linear RGB). File formats build it; renderers
 //! read it.
 
-use crate::{Camera, Color, Encoding, Lighting, Material, Mesh, ShadingOptions, Viewer};
+use crate::{
+    Camera, Color, Encoding, Lighting, Material, Mesh, Shading, ShadingOptions, SurfacePoint, View, Viewer, shade,
+};
+use glam::Vec3;
 
 /// Where lighting is computed (seed 001: per-vertex vs per-fragment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -32,6 +35,37 @@ pub enum Output {
     Normal,
     /// Linear view depth, white at `near` to black at `far`.
     Depth,
+}
+
+impl Output {
+    /// The term of `s` this output shows (the colour for the normal and depth outputs, which
+    /// are not terms of the equation).
+    #[inline]
+    pub fn term(self, s: &Shading) -> Color {
+        match self {
+            Output::Ambient => s.ambient,
+            Output::Diffuse => s.diffuse,
+            Output::Specular => s.specular,
+            _ => s.color,
+        }
+    }
+}
+
+/// The normal output's colour for unit normal `n`: `0.5·n + 0.5`, black for a zero normal.
+#[inline]
+pub fn normal_color(n: Vec3) -> Color {
+    if n == Vec3::ZERO {
+        Color::BLACK
+    } else {
+        Color::new(n.x * 0.5 + 0.5, n.y * 0.5 + 0.5, n.z * 0.5 + 0.5)
+    }
+}
+
+/// The depth output's grey for world point `p`: 1 at `near` to 0 at `far`, clamped.
+#[inline]
+pub fn depth_color(camera: &Camera, p: Vec3) -> Color {
+    let d = camera.depth_of(p);
+    Color::splat((1.0 - (d - camera.near()) / (camera.far() - camera.near())).clamp(0.0, 1.0))
 }
 
 /// The image's settings.
@@ -87,6 +121,26 @@ pub struct Object {
     pub material: Material,
     /// How it is shaded.
     pub shading: ShadingSettings,
+}
+
+impl Object {
+    /// Lights a point of this object as the renderers do: two-sided lighting is the caller's,
+    /// decided by the polygon's facing (a back face is lit with its normal flipped, OpenGL's
+    /// rule), so the per-point flip of [`shade`] is off.
+    #[inline]
+    pub fn shade(&self, lighting: &Lighting, view: &View, position: Vec3, normal: Vec3) -> Shading {
+        let options = ShadingOptions {
+            two_sided: false,
+            ..self.shading.options
+        };
+        shade(
+            &SurfacePoint { position, normal },
+            view,
+            &self.material,
+            lighting,
+            &options,
+        )
+    }
 }
 
 /// Text drawn over the image, centred at the projection of a world point

@@ -61,7 +61,7 @@ use crate::{Error, RenderOptions, RenderStats};
 use glam::{Vec3, Vec4};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
 use phong_core::mesh::facet_normal;
-use phong_core::{Color, Encoding, Interpolation, Object, Output, Scene, Shading, SurfacePoint, View, shade};
+use phong_core::{Color, Encoding, Interpolation, Object, Output, Scene, View, depth_color, normal_color};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -138,17 +138,6 @@ fn map3<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
 }
 
 pub use phong_core::limits::sample_pattern;
-
-/// The term of `s` that `output` shows (normal and depth are not terms).
-#[inline]
-fn term(output: Output, s: &Shading) -> Color {
-    match output {
-        Output::Ambient => s.ambient,
-        Output::Diffuse => s.diffuse,
-        Output::Specular => s.specular,
-        _ => s.color,
-    }
-}
 
 /// The kernel's term for a lit output; `None` for the normal and depth outputs.
 fn lit_term(output: Output) -> Option<Term> {
@@ -768,14 +757,14 @@ impl<'a> Frame<'a> {
                 world: p,
                 normal: n,
                 color: if gouraud {
-                    let s = shade_at(scene, obj, &view, p, n);
-                    Vec3::from(term(output, &s).to_array())
+                    let s = obj.shade(&scene.lighting, &view, p, n);
+                    Vec3::from(output.term(&s).to_array())
                 } else {
                     Vec3::ZERO
                 },
                 color_back: if gouraud && two_sided {
-                    let s = shade_at(scene, obj, &view, p, -n);
-                    Vec3::from(term(output, &s).to_array())
+                    let s = obj.shade(&scene.lighting, &view, p, -n);
+                    Vec3::from(output.term(&s).to_array())
                 } else {
                     Vec3::ZERO
                 },
@@ -822,9 +811,9 @@ impl<'a> Frame<'a> {
                 let flat = (interpolation == Interpolation::Flat).then(|| {
                     let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
                     let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                    let front = term(output, &shade_at(scene, obj, &view, centroid, fnorm));
+                    let front = output.term(&obj.shade(&scene.lighting, &view, centroid, fnorm));
                     let back = if two_sided {
-                        term(output, &shade_at(scene, obj, &view, centroid, -fnorm))
+                        output.term(&obj.shade(&scene.lighting, &view, centroid, -fnorm))
                     } else {
                         front
                     };
@@ -1114,23 +1103,6 @@ fn plane_equations(
         attr,
         pad: 0.0,
     }
-}
-
-/// Lights a point of `obj`. Two-sided lighting is the renderer's: OpenGL decides by polygon
-/// facing (a back face is lit with its normals flipped), so the core's per-point flip is off.
-#[inline]
-fn shade_at(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3) -> Shading {
-    let options = phong_core::ShadingOptions {
-        two_sided: false,
-        ..obj.shading.options
-    };
-    shade(
-        &SurfacePoint { position, normal },
-        view,
-        &obj.material,
-        &scene.lighting,
-        &options,
-    )
 }
 
 impl Frame<'_> {
@@ -2032,17 +2004,9 @@ impl Frame<'_> {
                     None if t.back => -lerp3(|v| v.normal).normalize_or_zero(),
                     None => lerp3(|v| v.normal).normalize_or_zero(),
                 };
-                if n == Vec3::ZERO {
-                    Color::BLACK
-                } else {
-                    Color::new(n.x * 0.5 + 0.5, n.y * 0.5 + 0.5, n.z * 0.5 + 0.5)
-                }
+                normal_color(n)
             }
-            Output::Depth => {
-                let cam = &scene.camera;
-                let d = cam.depth_of(lerp3(|v| v.world));
-                Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
-            }
+            Output::Depth => depth_color(&scene.camera, lerp3(|v| v.world)),
             _ => match (corners.flat, obj.shading.interpolation) {
                 (Some((c, _)), _) => c,
                 (None, Interpolation::Gouraud) => {
@@ -2057,7 +2021,7 @@ impl Frame<'_> {
                     let n = lerp3(|v| v.normal);
                     let n = if t.back { -n } else { n };
                     let view = &self.views[self.object(id)];
-                    term(output, &shade_at(scene, obj, view, lerp3(|v| v.world), n))
+                    output.term(&obj.shade(&scene.lighting, view, lerp3(|v| v.world), n))
                 }
             },
         };

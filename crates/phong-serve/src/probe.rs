@@ -12,7 +12,7 @@ use glam::{DVec3, Vec3};
 use phong_core::mesh::facet_normal;
 use phong_core::{
     Color, Interpolation, Light, Lighting, Material, Object, Output, Scene, Shading, ShadingOptions, SpecularModel,
-    SurfacePoint, View, shade, specular_factor,
+    SurfacePoint, View, depth_color, normal_color, shade, specular_factor,
 };
 use serde::Serialize;
 
@@ -157,16 +157,6 @@ fn v3(v: Vec3) -> [f32; 3] {
     v.to_array()
 }
 
-/// The term an output shows.
-fn term(output: Output, s: &Shading) -> Color {
-    match output {
-        Output::Ambient => s.ambient,
-        Output::Diffuse => s.diffuse,
-        Output::Specular => s.specular,
-        _ => s.color,
-    }
-}
-
 fn output_name(o: Output) -> &'static str {
     match o {
         Output::Color => "color",
@@ -223,22 +213,6 @@ fn trace(scene: &Scene, x: u32, y: u32) -> Option<(usize, usize, [f64; 3], bool)
     best.map(|(_, o, t, b, back)| (o, t, b, back))
 }
 
-/// Shades a point of `obj` as the renderers do: two-sided lighting is decided by facing, so
-/// the core's per-point flip is off.
-fn shade_obj(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: Vec3) -> Shading {
-    let options = ShadingOptions {
-        two_sided: false,
-        ..obj.shading.options
-    };
-    shade(
-        &SurfacePoint { position, normal },
-        view,
-        &obj.material,
-        &scene.lighting,
-        &options,
-    )
-}
-
 /// Probes pixel `(x, y)` of `scene` (inside the image: checked by the caller).
 pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     let encoding = scene.image.encoding;
@@ -277,27 +251,17 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         Interpolation::Flat => ((ps[0] + ps[1] + ps[2]) / 3.0, facet_normal(ps[0], ps[1], ps[2]) * flip),
         _ => (lerp(ps), lerp(ns) * flip),
     };
-    let at = shade_obj(scene, obj, &view, position, normal);
+    let at = obj.shade(&scene.lighting, &view, position, normal);
     let mut vertices = Vec::new();
     let value = match output {
-        Output::Normal => {
-            let n = normal.normalize_or_zero();
-            if n == Vec3::ZERO {
-                Color::BLACK
-            } else {
-                Color::new(n.x * 0.5 + 0.5, n.y * 0.5 + 0.5, n.z * 0.5 + 0.5)
-            }
-        }
-        Output::Depth => {
-            let cam = &scene.camera;
-            let d = cam.depth_of(lerp(ps));
-            Color::splat((1.0 - (d - cam.near()) / (cam.far() - cam.near())).clamp(0.0, 1.0))
-        }
+        // Flat: the facet normal as it is; else the interpolated one, renormalised (as drawn).
+        Output::Normal if interpolation == Interpolation::Flat => normal_color(normal),
+        Output::Normal => normal_color(normal.normalize_or_zero()),
+        Output::Depth => depth_color(&scene.camera, lerp(ps)),
         _ if interpolation == Interpolation::Gouraud => {
             let mut c = Color::BLACK;
             for k in 0..3 {
-                let s = shade_obj(scene, obj, &view, ps[k], ns[k] * flip);
-                let v = term(output, &s);
+                let v = output.term(&obj.shade(&scene.lighting, &view, ps[k], ns[k] * flip));
                 vertices.push(VertexValue {
                     position: v3(ps[k]),
                     normal: v3(ns[k] * flip),
@@ -312,7 +276,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
             );
             c
         }
-        _ => term(output, &at),
+        _ => output.term(&at),
     };
     let value = c3(value);
     let hit = hit_terms(scene, obj, &view, position, normal, &at);
