@@ -835,6 +835,28 @@ fn loading_an_obj_renders_it() {
             Ok(())
         })
         .await;
+        s.step("drop an OBJ on the viewport", async {
+            // A drop event carrying a file, as dragging one from a file manager gives.
+            s.js(r#"
+                const obj = 'v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n';
+                const dt = new DataTransfer();
+                dt.items.add(new File([obj], 'tri.obj'));
+                document.getElementById('viewport').dispatchEvent(new DragEvent('drop', {dataTransfer: dt, bubbles: true}));
+                return true;"#)
+                .await?;
+            let t0 = Instant::now();
+            loop {
+                let st = s.js("return window.phong.loaded || null;").await?;
+                if st["name"] == json!("tri.obj") {
+                    ensure!(st["triangles"] == json!(1), "loaded {st}");
+                    break;
+                }
+                ensure!(t0.elapsed() < Duration::from_secs(10), "the dropped model did not load");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            s.idle().await
+        })
+        .await;
         s.step("a broken OBJ says why", async {
             let bad = obj.with_file_name("bad.obj");
             std::fs::write(&bad, "v 1 2\nf 1 2 3\n")?;
@@ -845,7 +867,9 @@ fn loading_an_obj_renders_it() {
                 .await?;
             let t0 = Instant::now();
             loop {
-                let e = s.js("return document.getElementById('error').textContent;").await?;
+                let e = s
+                    .js("return document.querySelector('.err[data-for=\"load-model\"]').textContent;")
+                    .await?;
                 if e.as_str().unwrap_or("").contains("bad.obj") {
                     ensure!(
                         e.as_str().unwrap_or("").contains(":1:"),

@@ -500,3 +500,60 @@ async fn twenty_clients_at_once_all_get_frames() {
         assert_eq!(t.await.expect("task"), vec![160, 168, 176]);
     }
 }
+
+#[tokio::test]
+async fn the_probe_value_is_the_rendered_pixel() {
+    let st = state();
+    // Every interpolation and output, one sample: the probe's bytes are the PNG's, within 1.
+    for (interp, output) in [
+        ("phong", "color"),
+        ("gouraud", "color"),
+        ("flat", "color"),
+        ("phong", "specular"),
+        ("gouraud", "diffuse"),
+        ("flat", "normal"),
+        ("phong", "normal"),
+        ("phong", "depth"),
+    ] {
+        let scene = json!({"image": {"width": 97, "height": 61},
+            "camera": {"position": [1.5, 1.2, 3.5]},
+            "shading": {"model": "blinn-phong", "interpolation": interp, "output": output, "two_sided": true},
+            "light": [{"type": "point", "position": [2, 2, 2], "attenuation": [1, 0.2, 0.05]},
+                      {"type": "spot", "position": [-1, 3, 1], "direction": [0.3, -1, -0.2], "cutoff": 35, "exponent": 4}],
+            "object": [{"shape": "torus", "segments": 24, "material": "pearl"},
+                       {"shape": "plane", "position": [0, -0.6, 0], "scale": 2, "material": "cyan_plastic"}]});
+        let r = render(&st, scene.clone()).await;
+        assert_eq!(r.status, StatusCode::OK);
+        let (w, _, px) = decode(&r.body);
+        let (mut hits, mut gouraud_vertices) = (0, 0);
+        for k in 0..60u32 {
+            let (x, y) = ((k * 37) % 97, (k * 23) % 61);
+            let p = call(
+                &st,
+                "POST",
+                "/api/probe",
+                "a",
+                json!({"scene": scene, "x": x, "y": y}).to_string(),
+            )
+            .await
+            .json();
+            let i = ((y * w + x) * 3) as usize;
+            for c in 0..3 {
+                let v = p["value8"][c].as_i64().expect("byte");
+                assert!(
+                    (i64::from(px[i + c]) - v).abs() <= 1,
+                    "{interp}/{output} pixel ({x}, {y}) channel {c}: image {} probe {v}",
+                    px[i + c]
+                );
+            }
+            if !p["hit"].is_null() {
+                hits += 1;
+                gouraud_vertices += p["hit"]["vertices"].as_array().map_or(0, Vec::len);
+            }
+        }
+        assert!(hits > 20, "{interp}/{output}: only {hits} probes hit");
+        // Gouraud lit outputs report the three vertices the pixel interpolates.
+        let lit = !matches!(output, "normal" | "depth");
+        assert_eq!(gouraud_vertices > 0, interp == "gouraud" && lit, "{interp}/{output}");
+    }
+}

@@ -893,10 +893,13 @@ async function loadFiles(files) {
       if (!r.ok) throw info;
       if (info.scene) objInfo = info;
     } catch (e) {
-      showError({ error: `${f.name}: ${e.error || e}`, path: e.path });
+      const message = `${f.name}: ${e.error || e}`;
+      document.querySelector('.err[data-for="load-model"]').textContent = message;
+      $('error').textContent = message;
       return;
     }
   }
+  document.querySelector('.err[data-for="load-model"]').textContent = '';
   if (!objInfo) { $('status').textContent = 'uploaded ' + files.map((f) => f.name).join(', '); return; }
   if (!S.models.includes(objInfo.name)) S.models.push(objInfo.name);
   // As `phong render MODEL.obj`: the model alone, framed, with its materials and three lights.
