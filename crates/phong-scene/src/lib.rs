@@ -16,7 +16,7 @@ mod toml_scene;
 pub use error::Error;
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
 pub use obj::{ObjPart, load_obj, load_obj_text};
-pub use png_out::{encode_png, encode_png8, write_png, write_png8};
+pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model, model_scene, model_view, parse_choice,
     parse_scene, parse_scene_with,

@@ -43,10 +43,20 @@ fn write_bytes(path: &Path, size: (u32, u32), bytes: &[u8], alpha: bool, encodin
         source,
     };
     let buf = encode(size, bytes, alpha, encoding).map_err(err)?;
+    write_file(path, &buf)
+}
+
+/// Writes `bytes` to `path` atomically: to a temporary file beside it, then renamed over it.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let err = |source: std::io::Error| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let buf = bytes;
     let tmp = temp_path(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&buf)?;
+        f.write_all(buf)?;
         f.sync_all()?;
         std::fs::rename(&tmp, path)
     })();

@@ -1,0 +1,494 @@
+//! Fitting a material to a target image of a known scene, by variable projection.
+//!
+//! For a fixed exponent `s` the rendered object is, per channel, linear in the material's
+//! colours: `c = e·E + a·A + d·D + k·S(s)`, where `E`, `A`, `D`, `S` are the renderer's own
+//! term images of the object with a unit colour in that term (emission, ambient, diffuse,
+//! specular), every other object black but still occluding. So the colours come from a
+//! box-constrained linear least-squares solve ([`crate::lsq`]), and `s` alone is searched:
+//! a grid on `log s`, then golden-section search between the best grid point's neighbours.
+//!
+//! Where the model clamps, linearity breaks: a pixel whose sum passed 1 is 255 in the target,
+//! and pixels the target clipped (0 or 255 in a channel) are left out of that channel's solve,
+//! so the clamp never enters the fit. Pixels partly covered by the object (antialiased edges)
+//! or covered by something in front are left out too: the `E` image tells them (exactly 1 on
+//! the object's own pixels).
+
+use crate::FitError;
+use phong_core::{Color, Encoding, Image, Material, Output, Scene, named_materials};
+use phong_raster::{RenderOptions, Renderer};
+use std::path::Path;
+
+/// A target image in linear colour, with the channels that were clipped.
+pub struct Target {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Linear RGB per pixel.
+    pub rgb: Vec<[f32; 3]>,
+    /// Per pixel and channel: 0 or the largest value (clipped).
+    pub clipped: Vec<[bool; 3]>,
+}
+
+impl Target {
+    /// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette), decoding its values
+    /// from `encoding` to linear.
+    pub fn read(path: &Path, encoding: Encoding) -> Result<Target, FitError> {
+        let bad = |why: String| FitError::Input(format!("{}: {why}", path.display()));
+        let bytes = std::fs::read(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        let mut dec = png::Decoder::new(std::io::Cursor::new(bytes));
+        dec.set_transformations(png::Transformations::EXPAND);
+        let mut r = dec.read_info().map_err(|e| bad(format!("not a PNG image: {e}")))?;
+        let size = r.output_buffer_size().ok_or_else(|| bad("the image is too large".into()))?;
+        let mut buf = vec![0; size];
+        let info = r.next_frame(&mut buf).map_err(|e| bad(format!("cannot decode: {e}")))?;
+        let (w, h) = (info.width, info.height);
+        let channels = info.color_type.samples();
+        let sixteen = info.bit_depth == png::BitDepth::Sixteen;
+        let max = if sixteen { 65535.0 } else { 255.0 };
+        let at = |i: usize| -> f32 {
+            if sixteen {
+                f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]]))
+            } else {
+                f32::from(buf[i])
+            }
+        };
+        let mut rgb = Vec::with_capacity((w * h) as usize);
+        let mut clipped = Vec::with_capacity((w * h) as usize);
+        for p in 0..(w * h) as usize {
+            let base = p * channels;
+            let raw: [f32; 3] = if channels < 3 {
+                [at(base); 3]
+            } else {
+                [at(base), at(base + 1), at(base + 2)]
+            };
+            clipped.push(raw.map(|v| v == 0.0 || v == max));
+            rgb.push(raw.map(|v| decode(v / max, encoding)));
+        }
+        Ok(Target {
+            width: w,
+            height: h,
+            rgb,
+            clipped,
+        })
+    }
+}
+
+/// An encoded value in `[0, 1]` to linear.
+fn decode(v: f32, encoding: Encoding) -> f32 {
+    match encoding {
+        Encoding::Linear => v,
+        Encoding::Srgb if v <= 0.04045 => v / 12.92,
+        Encoding::Srgb => ((v + 0.055) / 1.055).powf(2.4),
+    }
+}
+
+/// Which material parameters the fit may change (the others keep the scene's values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Free {
+    /// `a_m`.
+    pub ambient: bool,
+    /// `d_m`.
+    pub diffuse: bool,
+    /// `s_m`.
+    pub specular: bool,
+    /// `s`.
+    pub shininess: bool,
+    /// `e_m`.
+    pub emission: bool,
+}
+
+impl Free {
+    /// Parses `ambient,diffuse,...`.
+    pub fn parse(list: &str) -> Result<Free, FitError> {
+        let mut f = Free {
+            ambient: false,
+            diffuse: false,
+            specular: false,
+            shininess: false,
+            emission: false,
+        };
+        for w in list.split(',').map(str::trim).filter(|w| !w.is_empty()) {
+            match w {
+                "ambient" => f.ambient = true,
+                "diffuse" => f.diffuse = true,
+                "specular" => f.specular = true,
+                "shininess" => f.shininess = true,
+                "emission" => f.emission = true,
+                other => {
+                    return Err(FitError::Input(format!(
+                        "--free: unknown parameter \"{other}\"; expected ambient, diffuse, specular, shininess, emission"
+                    )));
+                }
+            }
+        }
+        if f == Free::parse_none() {
+            return Err(FitError::Input(
+                "--free names no parameter: nothing to fit (e.g. --free diffuse,specular,shininess)".into(),
+            ));
+        }
+        Ok(f)
+    }
+
+    fn parse_none() -> Free {
+        Free {
+            ambient: false,
+            diffuse: false,
+            specular: false,
+            shininess: false,
+            emission: false,
+        }
+    }
+
+    /// The default: the colours and the exponent, not emission.
+    pub fn default_set() -> Free {
+        Free {
+            ambient: true,
+            diffuse: true,
+            specular: true,
+            shininess: true,
+            emission: false,
+        }
+    }
+
+    /// In the solve's order: emission, ambient, diffuse, specular.
+    fn colours(&self) -> [bool; 4] {
+        [self.emission, self.ambient, self.diffuse, self.specular]
+    }
+}
+
+/// The result of an image fit.
+pub struct ImageFit {
+    /// The fitted material.
+    pub material: Material,
+    /// RMSE in linear colour over the fitted pixels' channels, of the fitted material's render.
+    pub rmse: f64,
+    /// `20·log10(1/rmse)`.
+    pub psnr: f64,
+    /// Pixels fitted (fully covered by the object, in the mask).
+    pub pixels: usize,
+    /// What the target does not determine, in words.
+    pub undetermined: Vec<String>,
+    /// `(s, rmse of the linear fit)` for every exponent tried, in order of `s`.
+    pub curve: Vec<(f32, f64)>,
+    /// The scene rendered with the fitted material.
+    pub image: Image,
+    /// The nearest classic material and its RMSE (rendered through the same basis).
+    pub nearest: (&'static str, f64),
+    /// Which pixels were fitted.
+    pub used: Vec<bool>,
+}
+
+/// Term images of the object for the solve: `E` (coverage), `A`, `D`, and `S(s)` on demand.
+struct Basis<'a> {
+    scene: Scene,
+    object: usize,
+    renderer: Renderer,
+    options: RenderOptions<'a>,
+    e: Image,
+    a: Image,
+    d: Image,
+}
+
+impl<'a> Basis<'a> {
+    fn new(scene: &Scene, object: usize, options: RenderOptions<'a>) -> Result<Basis<'a>, FitError> {
+        let mut base = scene.clone();
+        base.image.background = [0.0, 0.0, 0.0, 1.0];
+        base.labels.clear();
+        let black = Material::new(Color::BLACK, Color::BLACK, Color::BLACK, Color::BLACK, 0.0).expect("valid");
+        for (i, o) in base.objects.iter_mut().enumerate() {
+            if i != object {
+                o.material = black;
+            }
+        }
+        let mut b = Basis {
+            scene: base,
+            object,
+            renderer: Renderer::new(),
+            options,
+            e: Image::new(1, 1, [0.0; 4]).expect("1x1"),
+            a: Image::new(1, 1, [0.0; 4]).expect("1x1"),
+            d: Image::new(1, 1, [0.0; 4]).expect("1x1"),
+        };
+        let w = Color::WHITE;
+        let z = Color::BLACK;
+        b.e = b.term(Material::new(z, z, z, w, 0.0).expect("valid"), Output::Ambient)?;
+        b.a = b.term(Material::new(w, z, z, z, 0.0).expect("valid"), Output::Ambient)?;
+        b.d = b.term(Material::new(z, w, z, z, 0.0).expect("valid"), Output::Diffuse)?;
+        Ok(b)
+    }
+
+    /// The object's `output` term image with material `m`.
+    fn term(&mut self, m: Material, output: Output) -> Result<Image, FitError> {
+        let o = &mut self.scene.objects[self.object];
+        o.material = m;
+        o.shading.output = output;
+        let (img, _) = self
+            .renderer
+            .render(&self.scene, &self.options)
+            .map_err(|e| FitError::Render(e.to_string()))?;
+        Ok(img.clone())
+    }
+
+    fn specular(&mut self, s: f32) -> Result<Image, FitError> {
+        let (w, z) = (Color::WHITE, Color::BLACK);
+        self.term(Material::new(z, z, w, z, s).expect("valid"), Output::Specular)
+    }
+}
+
+/// The per-channel normal equations at one exponent, over the used pixels.
+fn normals(b: &Basis, s_img: &Image, target: &Target, used: &[bool], fixed: &[[f64; 4]; 3], free: &[bool; 4]) -> [crate::lsq::Normal<4>; 3] {
+    let mut n = [crate::lsq::Normal::<4>::default(); 3];
+    let (e, a, d, sp) = (b.e.pixels(), b.a.pixels(), b.d.pixels(), s_img.pixels());
+    for (p, &u) in used.iter().enumerate() {
+        if !u {
+            continue;
+        }
+        for c in 0..3 {
+            if target.clipped[p][c] {
+                continue;
+            }
+            let row = [f64::from(e[p][c]), f64::from(a[p][c]), f64::from(d[p][c]), f64::from(sp[p][c])];
+            // Terms that are not free are moved to the target's side.
+            let mut t = f64::from(target.rgb[p][c]);
+            let mut r = [0.0; 4];
+            for k in 0..4 {
+                if free[k] {
+                    r[k] = row[k];
+                } else {
+                    t -= row[k] * fixed[c][k];
+                }
+            }
+            n[c].add(&r, t);
+        }
+    }
+    n
+}
+
+/// Solves the colours at one exponent: per channel `[e, a, d, k]` and the summed residual.
+fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3]) -> ([[f64; 4]; 3], f64) {
+    let mut x = [[0.0; 4]; 3];
+    let mut r = 0.0;
+    for c in 0..3 {
+        let start = [0.0; 4].map(|_| 0.0);
+        let (xc, rc) = n[c].solve(free, &start, 0.0, 1.0);
+        for k in 0..4 {
+            x[c][k] = if free[k] { xc[k] } else { fixed[c][k] };
+        }
+        r += rc;
+    }
+    (x, r)
+}
+
+fn material_of(x: &[[f64; 4]; 3], s: f32) -> Material {
+    let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
+    Material::new(col(1), col(2), col(3), col(0), s).expect("colours in [0, 1], s >= 0")
+}
+
+/// Finds the object by name (case-insensitive) or index.
+pub fn find_object(scene: &Scene, which: Option<&str>) -> Result<usize, FitError> {
+    let names = || scene.objects.iter().enumerate().map(|(i, o)| format!("{i}: {}", o.name)).collect::<Vec<_>>().join(", ");
+    match which {
+        None if scene.objects.len() == 1 => Ok(0),
+        None => Err(FitError::Input(format!(
+            "the scene has {} objects; choose one with --object NAME|INDEX ({})",
+            scene.objects.len(),
+            names()
+        ))),
+        Some(w) => {
+            if let Ok(i) = w.parse::<usize>() {
+                return if i < scene.objects.len() {
+                    Ok(i)
+                } else {
+                    Err(FitError::Input(format!("--object {i}: the scene's objects are {}", names())))
+                };
+            }
+            scene
+                .objects
+                .iter()
+                .position(|o| o.name.eq_ignore_ascii_case(w))
+                .ok_or_else(|| FitError::Input(format!("--object \"{w}\": no such object; the scene's objects are {}", names())))
+        }
+    }
+}
+
+/// Fits object `object`'s material in `scene` to `target`; `mask` (one flag a pixel) limits
+/// the pixels.
+pub fn fit_image(
+    scene: &Scene,
+    object: usize,
+    target: &Target,
+    free: Free,
+    mask: Option<&[bool]>,
+    options: RenderOptions,
+) -> Result<ImageFit, FitError> {
+    let (w, h) = (scene.image.width, scene.image.height);
+    if (target.width, target.height) != (w, h) {
+        return Err(FitError::Input(format!(
+            "the target is {}x{} but the scene's image is {w}x{h}",
+            target.width, target.height
+        )));
+    }
+    let start = scene.objects[object].material;
+    let mut basis = Basis::new(scene, object, options)?;
+    let used: Vec<bool> = basis
+        .e
+        .pixels()
+        .iter()
+        .enumerate()
+        .map(|(p, px)| px[0] >= 0.999 && mask.is_none_or(|m| m[p]))
+        .collect();
+    let pixels = used.iter().filter(|&&u| u).count();
+    if pixels == 0 {
+        return Err(FitError::Input(format!(
+            "no pixel shows object {object} ({}) whole{}: nothing to fit",
+            scene.objects[object].name,
+            if mask.is_some() { " inside the mask" } else { "" }
+        )));
+    }
+    let unclipped = used
+        .iter()
+        .zip(&target.clipped)
+        .filter(|(u, c)| **u && c.iter().any(|x| !x))
+        .count();
+    if unclipped == 0 {
+        return Err(FitError::Input(format!(
+            "every one of the object's {pixels} pixels is clipped (0 or 255) in the target: nothing to fit"
+        )));
+    }
+    let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
+    let (se, sa, sd, ss) = (c3(start.emission()), c3(start.ambient()), c3(start.diffuse()), c3(start.specular()));
+    let fixed: [[f64; 4]; 3] = [0, 1, 2].map(|c| [se[c], sa[c], sd[c], ss[c]]);
+    let mut free_c = free.colours();
+    let mut undetermined = Vec::new();
+    // Emission and ambient are one unknown where the ambient light is the same everywhere.
+    if free_c[0] && free_c[1] {
+        let n = normals(&basis, &basis.d.clone(), target, &used, &fixed, &[true, true, false, false]);
+        let g = n[0].g;
+        if g[0][0] * g[1][1] - g[0][1] * g[1][0] <= 1e-9 * g[0][0] * g[1][1] {
+            free_c[0] = false;
+            undetermined.push(
+                "emission: the ambient light is uniform here, so only e_m + a_m⊗a is determined; emission kept at the scene's value"
+                    .into(),
+            );
+        }
+    }
+    let mut curve: Vec<(f32, f64)> = Vec::new();
+    let mut eval = |s: f32, basis: &mut Basis| -> Result<([[f64; 4]; 3], f64), FitError> {
+        let si = basis.specular(s)?;
+        let n = normals(basis, &si, target, &used, &fixed, &free_c);
+        let (x, r) = solve(&n, &free_c, &fixed);
+        let count: usize = n.iter().map(|n| n.rows).sum::<usize>().max(1);
+        curve.push((s, (r / count as f64).sqrt()));
+        Ok((x, r))
+    };
+    let (x, s_best) = if free.shininess && free_c[3] || free.shininess && start.specular() != Color::BLACK {
+        // Grid on log s over [1, 1000], then golden section between the best's neighbours.
+        let grid: Vec<f32> = (0..=24).map(|k| 10f32.powf(3.0 * k as f32 / 24.0)).collect();
+        let mut results = Vec::new();
+        for &s in &grid {
+            results.push(eval(s, &mut basis)?);
+        }
+        let best = (0..grid.len()).min_by(|&i, &j| results[i].1.total_cmp(&results[j].1)).expect("a grid");
+        let (mut lo, mut hi) = (
+            grid[best.saturating_sub(1)].ln(),
+            grid[(best + 1).min(grid.len() - 1)].ln(),
+        );
+        let phi = 0.618_034_f32;
+        let mut x1 = hi - phi * (hi - lo);
+        let mut x2 = lo + phi * (hi - lo);
+        let mut f1 = eval(x1.exp(), &mut basis)?;
+        let mut f2 = eval(x2.exp(), &mut basis)?;
+        for _ in 0..14 {
+            if f1.1 < f2.1 {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - phi * (hi - lo);
+                f1 = eval(x1.exp(), &mut basis)?;
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + phi * (hi - lo);
+                f2 = eval(x2.exp(), &mut basis)?;
+            }
+        }
+        let mut cands = vec![(results[best].clone(), grid[best]), (f1, x1.exp()), (f2, x2.exp())];
+        cands.sort_by(|a, b| a.0.1.total_cmp(&b.0.1));
+        let ((x, _), s) = cands.remove(0);
+        (x, s)
+    } else {
+        let (x, _) = eval(start.shininess(), &mut basis)?;
+        (x, start.shininess())
+    };
+    curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let material = material_of(&x, s_best).with_alpha(start.alpha()).unwrap_or_else(|_| material_of(&x, s_best));
+    // The highlight: how much the fitted specular term adds anywhere on the fitted pixels.
+    let si = basis.specular(s_best)?;
+    let peak = used
+        .iter()
+        .zip(si.pixels())
+        .filter(|(u, _)| **u)
+        .map(|(_, p)| (0..3).map(|c| f64::from(p[c]) * x[c][3]).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    if free.specular && peak < 2.0 / 255.0 {
+        undetermined.push(format!(
+            "specular and shininess: no highlight is visible on the fitted pixels (the fitted specular term adds at most {:.4}); their values are not determined",
+            peak
+        ));
+    }
+    // The fitted material rendered as the scene shows it.
+    let mut fitted_scene = scene.clone();
+    fitted_scene.objects[object].material = material;
+    let image = phong_raster::render(&fitted_scene, &basis.options).map_err(|e| FitError::Render(e.to_string()))?;
+    let rmse = rmse_of(&image, target, &used, scene.image.encoding);
+    // The nearest classic material, through the same basis.
+    let mut nearest = ("", f64::INFINITY);
+    for m in named_materials() {
+        let mm = m.material;
+        let xs: [[f64; 4]; 3] = [0, 1, 2].map(|c| {
+            let g = |col: Color| [col.r, col.g, col.b][c] as f64;
+            [g(mm.emission()), g(mm.ambient()), g(mm.diffuse()), g(mm.specular())]
+        });
+        let si = basis.specular(mm.shininess())?;
+        let n = normals(&basis, &si, target, &used, &[[0.0; 4]; 3], &[true; 4]);
+        let (r, count) = (0..3).fold((0.0, 0), |(r, k), c| (r + n[c].residual(&xs[c]), k + n[c].rows));
+        let e = (r / count.max(1) as f64).sqrt();
+        if e < nearest.1 {
+            nearest = (m.name, e);
+        }
+    }
+    Ok(ImageFit {
+        material,
+        rmse,
+        psnr: 20.0 * (1.0 / rmse.max(1e-12)).log10(),
+        pixels,
+        undetermined,
+        curve,
+        image,
+        nearest,
+        used,
+    })
+}
+
+/// RMSE of `image` (as the PNG would store it, decoded to linear) against the target over the
+/// used, unclipped pixel channels.
+fn rmse_of(image: &Image, target: &Target, used: &[bool], encoding: Encoding) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (p, px) in image.pixels().iter().enumerate() {
+        if !used[p] {
+            continue;
+        }
+        for c in 0..3 {
+            if target.clipped[p][c] {
+                continue;
+            }
+            let v = decode(f32::from(encoding.encode(px[c])) / 255.0, encoding);
+            let d = f64::from(v - target.rgb[p][c]);
+            sum += d * d;
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
