@@ -254,7 +254,10 @@ fn main() -> ExitCode {
                 c.downcast_ref::<InputError>().is_some()
                     || c.downcast_ref::<phong_scene::Error>().is_some_and(|e| e.is_input())
                     || c.downcast_ref::<phong_core::Error>().is_some()
-                    || matches!(c.downcast_ref::<phong_fit::FitError>(), Some(phong_fit::FitError::Input(_)))
+                    || matches!(
+                        c.downcast_ref::<phong_fit::FitError>(),
+                        Some(phong_fit::FitError::Input(_))
+                    )
                     || matches!(
                         c.downcast_ref::<phong_serve::StartError>(),
                         Some(phong_serve::StartError::Input(_) | phong_serve::StartError::Usage(_))
@@ -707,9 +710,15 @@ fn serve(a: ServeArgs) -> Result<()> {
 
 /// `phong fit`: the material, its errors and what the target leaves undetermined.
 fn fit(a: FitArgs) -> Result<()> {
-    let name_ok = !a.name.is_empty() && a.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    let name_ok = !a.name.is_empty()
+        && a.name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if !name_ok {
-        bail!(InputError(format!("--name must be letters, digits, '-' or '_', got \"{}\"", a.name)));
+        bail!(InputError(format!(
+            "--name must be letters, digits, '-' or '_', got \"{}\"",
+            a.name
+        )));
     }
     if let Some(dir) = &a.report
         && dir.exists()
@@ -719,7 +728,9 @@ fn fit(a: FitArgs) -> Result<()> {
     }
     let (material, comment) = match (&a.brdf, &a.scene) {
         (Some(_), Some(_)) => bail!(InputError("give a scene and --target, or --brdf, not both".into())),
-        (None, None) => bail!(InputError("phong fit needs SCENE.toml --target TARGET.png, or --brdf SPEC".into())),
+        (None, None) => bail!(InputError(
+            "phong fit needs SCENE.toml --target TARGET.png, or --brdf SPEC".into()
+        )),
         (Some(spec), None) => fit_brdf(&a, spec)?,
         (None, Some(scene)) => fit_image(&a, scene)?,
     };
@@ -760,7 +771,10 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
     if let Some(t) = a.threads
         && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
     {
-        bail!(InputError(format!("--threads must be from 1 to {}, got {t}", phong_core::limits::MAX_THREADS)));
+        bail!(InputError(format!(
+            "--threads must be from 1 to {}, got {t}",
+            phong_core::limits::MAX_THREADS
+        )));
     }
     let free = phong_fit::image::Free::parse(&a.free)?;
     let loaded = phong_scene::load(scene_path)?;
@@ -771,13 +785,19 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
     let object = phong_fit::image::find_object(&scene, a.object.as_deref())?;
     if let Some(m) = &a.model {
         let model = input(parse_choice("--model", m, MODELS))?;
-        apply_model(&mut scene.objects[object].shading.options, model, (3, phong_core::LyonLambda::Dot));
+        apply_model(
+            &mut scene.objects[object].shading.options,
+            model,
+            (3, phong_core::LyonLambda::Dot),
+        );
     }
     let encoding = match a.target_encoding.as_deref() {
         None => scene.image.encoding,
         Some("linear") => phong_core::Encoding::Linear,
         Some("srgb") => phong_core::Encoding::Srgb,
-        Some(o) => bail!(InputError(format!("--target-encoding must be linear or srgb, got \"{o}\""))),
+        Some(o) => bail!(InputError(format!(
+            "--target-encoding must be linear or srgb, got \"{o}\""
+        ))),
     };
     let target = phong_fit::image::Target::read(target_path, encoding)?;
     let mask = match &a.mask {
@@ -793,7 +813,12 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
                     target.height
                 )));
             }
-            Some(m.rgb.iter().map(|p| p.iter().cloned().fold(0.0, f32::max) > 0.5).collect::<Vec<_>>())
+            Some(
+                m.rgb
+                    .iter()
+                    .map(|p| p.iter().cloned().fold(0.0, f32::max) > 0.5)
+                    .collect::<Vec<_>>(),
+            )
         }
         None => None,
     };
@@ -812,18 +837,30 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
         elapsed.as_secs_f64() * 1e3
     );
     print_material(&fit.material);
-    println!("  rmse {:.5} (linear colour, fitted pixels), psnr {:.2} dB", fit.rmse, fit.psnr);
-    println!("  nearest classic material: {} (rmse {:.5})", fit.nearest.0, fit.nearest.1);
+    println!(
+        "  rmse {:.5} (linear colour, fitted pixels), psnr {:.2} dB",
+        fit.rmse, fit.psnr
+    );
+    println!(
+        "  nearest classic material: {} (rmse {:.5})",
+        fit.nearest.0, fit.nearest.1
+    );
     for u in &fit.undetermined {
         println!("  undetermined: {u}");
     }
     if let Some(dir) = report_dir(a)? {
-        phong_fit::report::write(&dir.join("comparison.png"), &phong_fit::report::comparison(&target, &fit.image, &fit.used))?;
+        phong_fit::report::write(
+            &dir.join("comparison.png"),
+            &phong_fit::report::comparison(&target, &fit.image, &fit.used),
+        )?;
         phong_fit::report::write(
             &dir.join("error.png"),
             &phong_fit::report::error_plot(&fit.curve, fit.material.shininess(), "RMSE against the exponent s"),
         )?;
-        println!("wrote {}/comparison.png (target | fit | 4x difference) and error.png", dir.display());
+        println!(
+            "wrote {}/comparison.png (target | fit | 4x difference) and error.png",
+            dir.display()
+        );
     }
     let comment = format!(
         "# phong fit of {} to {}: rmse {:.5}, psnr {:.2} dB\n",
@@ -837,17 +874,25 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
 
 fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
     if a.target.is_some() || a.object.is_some() || a.mask.is_some() {
-        bail!(InputError("--brdf fits a reflectance: --target, --object and --mask are for images".into()));
+        bail!(InputError(
+            "--brdf fits a reflectance: --target, --object and --mask are for images".into()
+        ));
     }
     let model = match a.model.as_deref().unwrap_or("blinn-phong") {
         "phong" => phong_core::SpecularModel::Phong,
         "blinn-phong" => phong_core::SpecularModel::BlinnPhong,
-        o => bail!(InputError(format!("--model for a BRDF fit is phong or blinn-phong, got \"{o}\""))),
+        o => bail!(InputError(format!(
+            "--model for a BRDF fit is phong or blinn-phong, got \"{o}\""
+        ))),
     };
     let brdf = phong_fit::brdf::Brdf::parse(spec)?;
     let t0 = Instant::now();
     let fit = phong_fit::brdf::fit_brdf(&brdf, model)?;
-    let norm = if model == phong_core::SpecularModel::Phong { "phong" } else { "blinn-phong" };
+    let norm = if model == phong_core::SpecularModel::Phong {
+        "phong"
+    } else {
+        "blinn-phong"
+    };
     println!(
         "phong fit: {spec}, {} samples, {} exponents tried, {:.0} ms",
         fit.samples,
@@ -855,22 +900,33 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
         t0.elapsed().as_secs_f64() * 1e3
     );
     print_material(&fit.material);
-    println!("  rmse {:.5} (cosine-weighted f·cos θ), for model = \"{}\", normalization = \"{norm}\"", fit.rmse, a.model.as_deref().unwrap_or("blinn-phong"));
+    println!(
+        "  rmse {:.5} (cosine-weighted f·cos θ), for model = \"{}\", normalization = \"{norm}\"",
+        fit.rmse,
+        a.model.as_deref().unwrap_or("blinn-phong")
+    );
     if let Some(dir) = report_dir(a)? {
         let m = fit.material;
         let opts = fit.options;
         let phong = |l: [f64; 3], v: [f64; 3]| -> f64 {
             let lighting = phong_core::Lighting::new(
                 phong_core::Color::BLACK,
-                vec![phong_core::Light::directional(
-                    -phong_core::glam::Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32),
-                    phong_core::LightColor::uniform(phong_core::Color::WHITE).expect("white"),
-                )
-                .expect("unit")],
+                vec![
+                    phong_core::Light::directional(
+                        -phong_core::glam::Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32),
+                        phong_core::LightColor::uniform(phong_core::Color::WHITE).expect("white"),
+                    )
+                    .expect("unit"),
+                ],
             )
             .expect("light");
-            let view = phong_core::View::Infinite { to_viewer: phong_core::glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) };
-            let p = phong_core::SurfacePoint { position: phong_core::glam::Vec3::ZERO, normal: phong_core::glam::Vec3::Z };
+            let view = phong_core::View::Infinite {
+                to_viewer: phong_core::glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
+            };
+            let p = phong_core::SurfacePoint {
+                position: phong_core::glam::Vec3::ZERO,
+                normal: phong_core::glam::Vec3::Z,
+            };
             let s = phong_core::shade(&p, &view, &m, &lighting, &opts);
             f64::from(s.diffuse.g + s.specular.g)
         };
@@ -880,7 +936,10 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
             &dir.join("error.png"),
             &phong_fit::report::error_plot(&fit.curve, fit.material.shininess(), "RMSE against the exponent s"),
         )?;
-        println!("wrote {}/lobes.png (green channel: target orange, fit blue) and error.png", dir.display());
+        println!(
+            "wrote {}/lobes.png (green channel: target orange, fit blue) and error.png",
+            dir.display()
+        );
     }
     let comment = format!(
         "# phong fit of {spec}: rmse {:.5}; render with [shading] model = \"{}\", normalization = \"{norm}\"\n",

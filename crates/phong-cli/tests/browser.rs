@@ -941,6 +941,70 @@ fn bad_values_are_explained_next_to_their_control() {
     });
 }
 
+#[test]
+fn fitting_a_target_image_in_the_page() {
+    if !browser_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tmp");
+    run(async {
+        let s = open("fit", "?size=240x160", &[]).await.expect("the page opens");
+        let ruby = phong_core::Material::named("ruby").expect("ruby");
+        let target = dir.path().join("target.png");
+        s.step("a target: the scene with ruby", async {
+            s.control("Material").await?.select_by_value("ruby").await?;
+            s.idle().await?;
+            std::fs::write(&target, s.png().await?)?;
+            s.control("Material").await?.select_by_value("jade").await?;
+            s.idle().await
+        })
+        .await;
+        s.step("fit and apply", async {
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Fit']"))
+                .await?
+                .click()
+                .await?;
+            s.client
+                .find(Locator::Id("fit-target"))
+                .await?
+                .send_keys(&target.display().to_string())
+                .await?;
+            s.client.find(Locator::Id("fit-run")).await?.click().await?;
+            let t0 = Instant::now();
+            while s.js("return window.phong.fit || null;").await?.is_null() {
+                let e = s
+                    .js("return document.querySelector('.err[data-for=\"fit-target\"]').textContent;")
+                    .await?;
+                ensure!(t0.elapsed() < Duration::from_secs(20), "no fit: {e}");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            let text = s
+                .js("return document.getElementById('fit-result').textContent;")
+                .await?;
+            ensure!(text.as_str().unwrap_or("").contains("psnr"), "{text}");
+            s.client.find(Locator::Id("fit-apply")).await?.click().await?;
+            s.idle().await?;
+            let m = s.js("return window.phong.state.scene.object[0].material;").await?;
+            let d = m["diffuse"].as_array().context("diffuse")?;
+            for (k, want) in [ruby.diffuse().r, ruby.diffuse().g, ruby.diffuse().b]
+                .iter()
+                .enumerate()
+            {
+                let got = d[k].as_f64().context("number")?;
+                ensure!(
+                    (got - f64::from(*want)).abs() < 0.02,
+                    "diffuse[{k}] {got} vs ruby's {want}"
+                );
+            }
+            let sh = m["shininess"].as_f64().context("shininess")?;
+            ensure!((sh / f64::from(ruby.shininess()) - 1.0).abs() < 0.05, "shininess {sh}");
+            Ok(())
+        })
+        .await;
+    });
+}
+
 /// README's picture of the page: the default scene with a probed pixel, saved as
 /// `$PHONG_SCREENSHOT_DIR/explorer.png`.
 #[test]

@@ -105,3 +105,7 @@ pub const SERVE_RENDERS_PER_CLIENT: usize = 6;
 /// `phong serve`: renders in flight in all; more wait for none: they answer 503 at once,
 /// because a queued frame is a stale frame for an interactive client.
 pub const SERVE_RENDERS_TOTAL: usize = 32;
+
+/// `phong serve`: largest body of a fit request (the scene and a base64 target PNG): a
+/// 1920×1080 photograph as PNG is up to about 8 MB, 11 MB in base64.
+pub const SERVE_MAX_FIT_BODY: usize = 16 << 20;

@@ -75,7 +75,10 @@ impl Merl {
     /// [`Merl::read`] of the file's bytes.
     pub fn parse(bytes: &[u8]) -> Result<Merl, String> {
         if bytes.len() < 12 {
-            return Err(format!("a MERL file starts with 12 bytes of dimensions; it has {} bytes", bytes.len()));
+            return Err(format!(
+                "a MERL file starts with 12 bytes of dimensions; it has {} bytes",
+                bytes.len()
+            ));
         }
         let dim = |i: usize| i32::from_le_bytes([bytes[4 * i], bytes[4 * i + 1], bytes[4 * i + 2], bytes[4 * i + 3]]);
         let dims = [dim(0), dim(1), dim(2)];
@@ -85,7 +88,10 @@ impl Merl {
         let n = TH * TD * PD;
         let want = 12 + 3 * n * 8;
         if bytes.len() != want {
-            return Err(format!("{} bytes; a MERL file of these dimensions has {want} (truncated?)", bytes.len()));
+            return Err(format!(
+                "{} bytes; a MERL file of these dimensions has {want} (truncated?)",
+                bytes.len()
+            ));
         }
         let data = bytes[12..]
             .chunks_exact(8)
@@ -176,7 +182,9 @@ impl Brdf {
         let mut alpha = None;
         let (mut f0, mut kd, mut ks) = (None, None, None);
         for kv in rest.split(',').filter(|s| !s.is_empty()) {
-            let (k, v) = kv.split_once('=').ok_or_else(|| bad(format!("\"{kv}\" is not KEY=VALUE")))?;
+            let (k, v) = kv
+                .split_once('=')
+                .ok_or_else(|| bad(format!("\"{kv}\" is not KEY=VALUE")))?;
             let nums: Vec<f64> = v
                 .split('/')
                 .map(|x| x.trim().parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0))
@@ -201,10 +209,26 @@ impl Brdf {
         }
         let kd = kd.unwrap_or([0.0; 3]);
         Ok(match kind {
-            "ggx" => Brdf::Ggx { alpha, f0: f0.unwrap_or([0.04; 3]), kd },
-            "beckmann" => Brdf::Beckmann { alpha, f0: f0.unwrap_or([0.04; 3]), kd },
-            "ward" => Brdf::Ward { alpha, ks: ks.unwrap_or([0.05; 3]), kd },
-            other => return Err(bad(format!("unknown kind \"{other}\"; expected ggx, beckmann, ward or merl"))),
+            "ggx" => Brdf::Ggx {
+                alpha,
+                f0: f0.unwrap_or([0.04; 3]),
+                kd,
+            },
+            "beckmann" => Brdf::Beckmann {
+                alpha,
+                f0: f0.unwrap_or([0.04; 3]),
+                kd,
+            },
+            "ward" => Brdf::Ward {
+                alpha,
+                ks: ks.unwrap_or([0.05; 3]),
+                kd,
+            },
+            other => {
+                return Err(bad(format!(
+                    "unknown kind \"{other}\"; expected ggx, beckmann, ward or merl"
+                )));
+            }
         })
     }
 
@@ -233,7 +257,9 @@ impl Brdf {
                 let a2 = alpha * alpha;
                 let tan2 = (1.0 - nh * nh) / (nh * nh);
                 let dd = (-tan2 / a2).exp() / (PI * a2 * nh.powi(4));
-                let g = (2.0 * nh * nv / vh.max(1e-9)).min(2.0 * nh * nl / vh.max(1e-9)).min(1.0);
+                let g = (2.0 * nh * nv / vh.max(1e-9))
+                    .min(2.0 * nh * nl / vh.max(1e-9))
+                    .min(1.0);
                 let spec = dd * g / (4.0 * nl * nv);
                 let base = lambert(kd);
                 [0, 1, 2].map(|c| base[c] + spec * schlick(f0[c]))
@@ -304,7 +330,11 @@ fn samples(brdf: &Brdf) -> Vec<Sample> {
                 let pd = (k as f64 + 0.5) / np as f64 * PI;
                 // d in the half vector's frame, then rotated by θ_h about y.
                 let d = [td.sin() * pd.cos(), td.sin() * pd.sin(), td.cos()];
-                let l = [d[0] * th.cos() + d[2] * th.sin(), d[1], -d[0] * th.sin() + d[2] * th.cos()];
+                let l = [
+                    d[0] * th.cos() + d[2] * th.sin(),
+                    d[1],
+                    -d[0] * th.sin() + d[2] * th.cos(),
+                ];
                 let hl = h[0] * l[0] + h[2] * l[2];
                 let v = [2.0 * hl * h[0] - l[0], -l[1], 2.0 * hl * h[2] - l[2]];
                 if l[2] <= 0.01 || v[2] <= 0.01 {
@@ -312,7 +342,12 @@ fn samples(brdf: &Brdf) -> Vec<Sample> {
                 }
                 let Some(f) = brdf.eval(l, v) else { continue };
                 let w = 4.0 * td.cos() * th.sin() * td.sin() * dth * (PI / 2.0 / nd as f64) * (PI / np as f64);
-                out.push(Sample { l, v, w, t: f.map(|x| x * l[2]) });
+                out.push(Sample {
+                    l,
+                    v,
+                    w,
+                    t: f.map(|x| x * l[2]),
+                });
             }
         }
     }
@@ -333,8 +368,11 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
         Lighting::new(
             Color::BLACK,
             vec![
-                Light::directional(-Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32), LightColor::uniform(Color::WHITE).expect("white"))
-                    .expect("unit direction"),
+                Light::directional(
+                    -Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32),
+                    LightColor::uniform(Color::WHITE).expect("white"),
+                )
+                .expect("unit direction"),
             ],
         )
         .expect("a light")
@@ -384,8 +422,13 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
     };
     let grid: Vec<f32> = (0..=30).map(|k| 10f32.powf(4.0 * k as f32 / 30.0)).collect();
     let results: Vec<_> = grid.iter().map(|&s| eval(s)).collect();
-    let best = (0..grid.len()).min_by(|&i, &j| results[i].1.total_cmp(&results[j].1)).expect("grid");
-    let (mut lo, mut hi) = (grid[best.saturating_sub(1)].ln(), grid[(best + 1).min(grid.len() - 1)].ln());
+    let best = (0..grid.len())
+        .min_by(|&i, &j| results[i].1.total_cmp(&results[j].1))
+        .expect("grid");
+    let (mut lo, mut hi) = (
+        grid[best.saturating_sub(1)].ln(),
+        grid[(best + 1).min(grid.len() - 1)].ln(),
+    );
     let phi = 0.618_034_f32;
     let (mut x1, mut x2) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
     let (mut f1, mut f2) = (eval(x1.exp()), eval(x2.exp()));

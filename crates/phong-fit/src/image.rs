@@ -34,12 +34,27 @@ impl Target {
     /// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette), decoding its values
     /// from `encoding` to linear.
     pub fn read(path: &Path, encoding: Encoding) -> Result<Target, FitError> {
-        let bad = |why: String| FitError::Input(format!("{}: {why}", path.display()));
-        let bytes = std::fs::read(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        let bytes =
+            std::fs::read(path).map_err(|e| FitError::Input(format!("{}: cannot read: {e}", path.display())))?;
+        Target::decode(&bytes, encoding).map_err(|e| FitError::Input(format!("{}: {e}", path.display())))
+    }
+
+    /// [`Target::read`] of a PNG file's bytes.
+    pub fn decode(bytes: &[u8], encoding: Encoding) -> Result<Target, String> {
+        let bad = |why: String| why;
         let mut dec = png::Decoder::new(std::io::Cursor::new(bytes));
         dec.set_transformations(png::Transformations::EXPAND);
         let mut r = dec.read_info().map_err(|e| bad(format!("not a PNG image: {e}")))?;
-        let size = r.output_buffer_size().ok_or_else(|| bad("the image is too large".into()))?;
+        let max = phong_core::limits::MAX_IMAGE_DIMENSION;
+        let (iw, ih) = (r.info().width, r.info().height);
+        if iw > max || ih > max {
+            return Err(bad(format!(
+                "{iw}x{ih} is larger than any scene image ({max} pixels on a side)"
+            )));
+        }
+        let size = r
+            .output_buffer_size()
+            .ok_or_else(|| bad("the image is too large".into()))?;
         let mut buf = vec![0; size];
         let info = r.next_frame(&mut buf).map_err(|e| bad(format!("cannot decode: {e}")))?;
         let (w, h) = (info.width, info.height);
@@ -237,7 +252,14 @@ impl<'a> Basis<'a> {
 }
 
 /// The per-channel normal equations at one exponent, over the used pixels.
-fn normals(b: &Basis, s_img: &Image, target: &Target, used: &[bool], fixed: &[[f64; 4]; 3], free: &[bool; 4]) -> [crate::lsq::Normal<4>; 3] {
+fn normals(
+    b: &Basis,
+    s_img: &Image,
+    target: &Target,
+    used: &[bool],
+    fixed: &[[f64; 4]; 3],
+    free: &[bool; 4],
+) -> [crate::lsq::Normal<4>; 3] {
     let mut n = [crate::lsq::Normal::<4>::default(); 3];
     let (e, a, d, sp) = (b.e.pixels(), b.a.pixels(), b.d.pixels(), s_img.pixels());
     for (p, &u) in used.iter().enumerate() {
@@ -248,7 +270,12 @@ fn normals(b: &Basis, s_img: &Image, target: &Target, used: &[bool], fixed: &[[f
             if target.clipped[p][c] {
                 continue;
             }
-            let row = [f64::from(e[p][c]), f64::from(a[p][c]), f64::from(d[p][c]), f64::from(sp[p][c])];
+            let row = [
+                f64::from(e[p][c]),
+                f64::from(a[p][c]),
+                f64::from(d[p][c]),
+                f64::from(sp[p][c]),
+            ];
             // Terms that are not free are moved to the target's side.
             let mut t = f64::from(target.rgb[p][c]);
             let mut r = [0.0; 4];
@@ -287,7 +314,15 @@ fn material_of(x: &[[f64; 4]; 3], s: f32) -> Material {
 
 /// Finds the object by name (case-insensitive) or index.
 pub fn find_object(scene: &Scene, which: Option<&str>) -> Result<usize, FitError> {
-    let names = || scene.objects.iter().enumerate().map(|(i, o)| format!("{i}: {}", o.name)).collect::<Vec<_>>().join(", ");
+    let names = || {
+        scene
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| format!("{i}: {}", o.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     match which {
         None if scene.objects.len() == 1 => Ok(0),
         None => Err(FitError::Input(format!(
@@ -300,14 +335,22 @@ pub fn find_object(scene: &Scene, which: Option<&str>) -> Result<usize, FitError
                 return if i < scene.objects.len() {
                     Ok(i)
                 } else {
-                    Err(FitError::Input(format!("--object {i}: the scene's objects are {}", names())))
+                    Err(FitError::Input(format!(
+                        "--object {i}: the scene's objects are {}",
+                        names()
+                    )))
                 };
             }
             scene
                 .objects
                 .iter()
                 .position(|o| o.name.eq_ignore_ascii_case(w))
-                .ok_or_else(|| FitError::Input(format!("--object \"{w}\": no such object; the scene's objects are {}", names())))
+                .ok_or_else(|| {
+                    FitError::Input(format!(
+                        "--object \"{w}\": no such object; the scene's objects are {}",
+                        names()
+                    ))
+                })
         }
     }
 }
@@ -357,13 +400,25 @@ pub fn fit_image(
         )));
     }
     let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
-    let (se, sa, sd, ss) = (c3(start.emission()), c3(start.ambient()), c3(start.diffuse()), c3(start.specular()));
+    let (se, sa, sd, ss) = (
+        c3(start.emission()),
+        c3(start.ambient()),
+        c3(start.diffuse()),
+        c3(start.specular()),
+    );
     let fixed: [[f64; 4]; 3] = [0, 1, 2].map(|c| [se[c], sa[c], sd[c], ss[c]]);
     let mut free_c = free.colours();
     let mut undetermined = Vec::new();
     // Emission and ambient are one unknown where the ambient light is the same everywhere.
     if free_c[0] && free_c[1] {
-        let n = normals(&basis, &basis.d.clone(), target, &used, &fixed, &[true, true, false, false]);
+        let n = normals(
+            &basis,
+            &basis.d.clone(),
+            target,
+            &used,
+            &fixed,
+            &[true, true, false, false],
+        );
         let g = n[0].g;
         if g[0][0] * g[1][1] - g[0][1] * g[1][0] <= 1e-9 * g[0][0] * g[1][1] {
             free_c[0] = false;
@@ -382,14 +437,16 @@ pub fn fit_image(
         curve.push((s, (r / count as f64).sqrt()));
         Ok((x, r))
     };
-    let (x, s_best) = if free.shininess && free_c[3] || free.shininess && start.specular() != Color::BLACK {
+    let (x, s_best) = if free.shininess && (free_c[3] || start.specular() != Color::BLACK) {
         // Grid on log s over [1, 1000], then golden section between the best's neighbours.
         let grid: Vec<f32> = (0..=24).map(|k| 10f32.powf(3.0 * k as f32 / 24.0)).collect();
         let mut results = Vec::new();
         for &s in &grid {
             results.push(eval(s, &mut basis)?);
         }
-        let best = (0..grid.len()).min_by(|&i, &j| results[i].1.total_cmp(&results[j].1)).expect("a grid");
+        let best = (0..grid.len())
+            .min_by(|&i, &j| results[i].1.total_cmp(&results[j].1))
+            .expect("a grid");
         let (mut lo, mut hi) = (
             grid[best.saturating_sub(1)].ln(),
             grid[(best + 1).min(grid.len() - 1)].ln(),
@@ -414,7 +471,7 @@ pub fn fit_image(
                 f2 = eval(x2.exp(), &mut basis)?;
             }
         }
-        let mut cands = vec![(results[best].clone(), grid[best]), (f1, x1.exp()), (f2, x2.exp())];
+        let mut cands = vec![(results[best], grid[best]), (f1, x1.exp()), (f2, x2.exp())];
         cands.sort_by(|a, b| a.0.1.total_cmp(&b.0.1));
         let ((x, _), s) = cands.remove(0);
         (x, s)
@@ -423,7 +480,9 @@ pub fn fit_image(
         (x, start.shininess())
     };
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let material = material_of(&x, s_best).with_alpha(start.alpha()).unwrap_or_else(|_| material_of(&x, s_best));
+    let material = material_of(&x, s_best)
+        .with_alpha(start.alpha())
+        .unwrap_or_else(|_| material_of(&x, s_best));
     // The highlight: how much the fitted specular term adds anywhere on the fitted pixels.
     let si = basis.specular(s_best)?;
     let peak = used

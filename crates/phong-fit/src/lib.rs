@@ -5,6 +5,9 @@
 //! projection: for a fixed exponent the colours are a box-constrained linear least-squares
 //! solve ([`lsq`]), exact; the exponent alone is searched. [`report`] writes the pictures.
 
+// Index loops over channels and unknowns read as the sums of the normal equations they compute.
+#![allow(clippy::needless_range_loop)]
+
 pub mod brdf;
 pub mod image;
 pub mod lsq;

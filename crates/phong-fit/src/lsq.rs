@@ -78,7 +78,12 @@ impl<const N: usize> Normal<N> {
                     _ => {}
                 }
             }
-            let solved: Vec<usize> = idx.iter().zip(&states).filter(|(_, s)| **s == 0).map(|(i, _)| *i).collect();
+            let solved: Vec<usize> = idx
+                .iter()
+                .zip(&states)
+                .filter(|(_, s)| **s == 0)
+                .map(|(i, _)| *i)
+                .collect();
             if !solved.is_empty() {
                 // G_ss x_s = h_s − G_sf x_f.
                 let m = solved.len();
@@ -174,7 +179,11 @@ mod tests {
         let mut seed = 99;
         for _ in 0..20 {
             let mut n = Normal::<3>::default();
-            let x_true = [rng(&mut seed) * 3.0 - 1.0, rng(&mut seed) * 3.0 - 1.0, rng(&mut seed) * 3.0 - 1.0];
+            let x_true = [
+                rng(&mut seed) * 3.0 - 1.0,
+                rng(&mut seed) * 3.0 - 1.0,
+                rng(&mut seed) * 3.0 - 1.0,
+            ];
             for _ in 0..50 {
                 let b = [rng(&mut seed), rng(&mut seed), rng(&mut seed)];
                 let t: f64 = (0..3).map(|i| b[i] * x_true[i]).sum::<f64>() + (rng(&mut seed) - 0.5) * 0.1;
@@ -186,7 +195,11 @@ mod tests {
                 for b in 0..=20 {
                     for c in 0..=20 {
                         let y = [a as f64 / 20.0, b as f64 / 20.0, c as f64 / 20.0];
-                        assert!(r <= n.residual(&y) + 1e-9, "{x:?} {r} worse than {y:?} {}", n.residual(&y));
+                        assert!(
+                            r <= n.residual(&y) + 1e-9,
+                            "{x:?} {r} worse than {y:?} {}",
+                            n.residual(&y)
+                        );
                     }
                 }
             }

@@ -35,8 +35,14 @@ pub fn error_plot(curve: &[(f32, f64)], chosen: f32, title: &str) -> Image {
     let (m, top) = (60.0, 40.0);
     let (x0, x1) = (m, w as f32 - 20.0);
     let (y0, y1) = (h as f32 - 40.0, top);
-    let pts: Vec<(f32, f64)> = curve.iter().filter(|(s, e)| *s > 0.0 && e.is_finite()).copied().collect();
-    let (smin, smax) = pts.iter().fold((f32::MAX, f32::MIN), |(a, b), (s, _)| (a.min(s.log10()), b.max(s.log10())));
+    let pts: Vec<(f32, f64)> = curve
+        .iter()
+        .filter(|(s, e)| *s > 0.0 && e.is_finite())
+        .copied()
+        .collect();
+    let (smin, smax) = pts.iter().fold((f32::MAX, f32::MIN), |(a, b), (s, _)| {
+        (a.min(s.log10()), b.max(s.log10()))
+    });
     let emax = pts.iter().fold(0.0f64, |a, (_, e)| a.max(*e)).max(1e-9);
     let sx = |s: f32| x0 + (s.log10() - smin) / (smax - smin).max(1e-6) * (x1 - x0);
     let sy = |e: f64| y0 - (e / emax) as f32 * (y0 - y1);
@@ -44,17 +50,48 @@ pub fn error_plot(curve: &[(f32, f64)], chosen: f32, title: &str) -> Image {
     line(&mut img, (x0, y0), (x1, y0), grey);
     line(&mut img, (x0, y0), (x0, y1), grey);
     for win in pts.windows(2) {
-        line(&mut img, (sx(win[0].0), sy(win[0].1)), (sx(win[1].0), sy(win[1].1)), Color::new(0.94, 0.7, 0.16));
+        line(
+            &mut img,
+            (sx(win[0].0), sy(win[0].1)),
+            (sx(win[1].0), sy(win[1].1)),
+            Color::new(0.94, 0.7, 0.16),
+        );
     }
     if chosen > 0.0 {
-        line(&mut img, (sx(chosen), y0), (sx(chosen), y1), Color::new(0.3, 0.75, 0.95));
+        line(
+            &mut img,
+            (sx(chosen), y0),
+            (sx(chosen), y1),
+            Color::new(0.3, 0.75, 0.95),
+        );
     }
     let white = Color::splat(0.9);
     phong_core::text::draw_text(&mut img, 10, 10, title, white, 2);
-    phong_core::text::draw_text(&mut img, x0 as i64, (y0 + 10.0) as i64, &format!("s = {:.3}", 10f32.powf(smin)), white, 1);
-    phong_core::text::draw_text(&mut img, (x1 - 90.0) as i64, (y0 + 10.0) as i64, &format!("s = {:.0}", 10f32.powf(smax)), white, 1);
+    phong_core::text::draw_text(
+        &mut img,
+        x0 as i64,
+        (y0 + 10.0) as i64,
+        &format!("s = {:.3}", 10f32.powf(smin)),
+        white,
+        1,
+    );
+    phong_core::text::draw_text(
+        &mut img,
+        (x1 - 90.0) as i64,
+        (y0 + 10.0) as i64,
+        &format!("s = {:.0}", 10f32.powf(smax)),
+        white,
+        1,
+    );
     phong_core::text::draw_text(&mut img, 4, (y1 - 4.0) as i64, &format!("{emax:.4}"), white, 1);
-    phong_core::text::draw_text(&mut img, (sx(chosen) + 4.0) as i64, (y1 + 4.0) as i64, &format!("fit s = {chosen:.2}"), white, 1);
+    phong_core::text::draw_text(
+        &mut img,
+        (sx(chosen) + 4.0) as i64,
+        (y1 + 4.0) as i64,
+        &format!("fit s = {chosen:.2}"),
+        white,
+        1,
+    );
     img
 }
 
@@ -80,11 +117,12 @@ pub fn lobe_plot(target: impl Fn([f64; 3], [f64; 3]) -> Option<f64>, fit: impl F
         let ti = ti.to_radians();
         let l = [-ti.sin(), 0.0, ti.cos()];
         let curve = |f: &dyn Fn([f64; 3]) -> Option<f64>| -> Vec<(f64, f64)> {
-            (-85..=85).filter_map(|a| {
-                let t = (a as f64).to_radians();
-                f([t.sin(), 0.0, t.cos()]).map(|y| (a as f64, y))
-            })
-            .collect()
+            (-85..=85)
+                .filter_map(|a| {
+                    let t = (a as f64).to_radians();
+                    f([t.sin(), 0.0, t.cos()]).map(|y| (a as f64, y))
+                })
+                .collect()
         };
         let tc = curve(&|v| target(l, v));
         let fc = curve(&|v| Some(fit(l, v)));
@@ -96,11 +134,25 @@ pub fn lobe_plot(target: impl Fn([f64; 3], [f64; 3]) -> Option<f64>, fit: impl F
         line(&mut img, (x0, y0), (x1, y0), Color::splat(0.35));
         for (c, col) in [(&tc, Color::new(0.94, 0.7, 0.16)), (&fc, Color::new(0.3, 0.75, 0.95))] {
             for win in c.windows(2) {
-                line(&mut img, (px(win[0].0), py(win[0].1)), (px(win[1].0), py(win[1].1)), col);
+                line(
+                    &mut img,
+                    (px(win[0].0), py(win[0].1)),
+                    (px(win[1].0), py(win[1].1)),
+                    col,
+                );
             }
         }
-        phong_core::text::draw_text(&mut img, x0 as i64 + 4, 12, &format!("light at {:.0} deg", angles[k]), Color::splat(0.9), 1);
+        phong_core::text::draw_text(
+            &mut img,
+            x0 as i64 + 4,
+            12,
+            &format!("light at {:.0} deg", angles[k]),
+            Color::splat(0.9),
+            1,
+        );
     }
+    phong_core::text::draw_text(&mut img, 20, h as i64 - 16, "target", Color::new(0.94, 0.7, 0.16), 1);
+    phong_core::text::draw_text(&mut img, 80, h as i64 - 16, "fit", Color::new(0.3, 0.75, 0.95), 1);
     img
 }
 

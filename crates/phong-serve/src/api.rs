@@ -12,8 +12,8 @@ use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post, put};
 use phong_core::limits::{
-    SERVE_MAX_BODY, SERVE_MAX_CLIENTS, SERVE_MAX_LIGHTS, SERVE_MAX_PIXELS, SERVE_MAX_SAMPLES, SERVE_MAX_TRIANGLES,
-    SERVE_MAX_UPLOAD, SERVE_RENDERS_PER_CLIENT, SERVE_RENDERS_TOTAL,
+    SERVE_MAX_BODY, SERVE_MAX_CLIENTS, SERVE_MAX_FIT_BODY, SERVE_MAX_LIGHTS, SERVE_MAX_PIXELS, SERVE_MAX_SAMPLES,
+    SERVE_MAX_TRIANGLES, SERVE_MAX_UPLOAD, SERVE_RENDERS_PER_CLIENT, SERVE_RENDERS_TOTAL,
 };
 use phong_core::{Scene, SpecularModel, glam::Vec3, named_materials};
 use serde_json::{Value, json};
@@ -77,6 +77,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/render", post(render))
         .route("/api/probe", post(probe_pixel))
         .route("/api/toml", post(to_toml))
+        .route("/api/fit", post(fit))
         .route("/api/models", get(list_models))
         .route("/api/models/{name}", put(upload).delete(delete_model))
         .fallback(|| async { ApiError::new(StatusCode::NOT_FOUND, "no such page or API route") })
@@ -496,6 +497,87 @@ async fn probe_pixel(
             ));
         }
         Ok(probe(&scene, x, y))
+    })
+    .await?;
+    Ok(axum::Json(out).into_response())
+}
+
+/// `POST /api/fit`: `{"scene": {...}, "object": INDEX, "target": BASE64_PNG, "free":
+/// "ambient,diffuse,..."}` to the fitted material, its errors, what is undetermined, and the
+/// target | fit | difference picture (base64 PNG). The target has the scene's image size and
+/// the scene's encoding.
+async fn fit(
+    State(state): State<Arc<AppState>>,
+    ConnectInfo(peer): ConnectInfo<SocketAddr>,
+    headers: HeaderMap,
+    body: Body,
+) -> Result<Response, ApiError> {
+    use base64::Engine;
+    let client = client_id(&headers, peer);
+    let bytes = read_body(body, SERVE_MAX_FIT_BODY, "SERVE_MAX_FIT_BODY").await?;
+    let value = parse_json(&bytes)?;
+    let Some(scene_value) = value.get("scene").cloned() else {
+        return Err(ApiError::at(
+            "scene",
+            "the fit needs `scene`, `target` (a base64 PNG) and `object`",
+        ));
+    };
+    let png = value
+        .get("target")
+        .and_then(Value::as_str)
+        .and_then(|t| {
+            base64::engine::general_purpose::STANDARD
+                .decode(t.trim_start_matches("data:image/png;base64,"))
+                .ok()
+        })
+        .ok_or_else(|| ApiError::at("target", "`target` must be a PNG file in base64"))?;
+    let object = match value.get("object") {
+        None => 0,
+        Some(v) => v
+            .as_u64()
+            .map(|v| v as usize)
+            .ok_or_else(|| ApiError::at("object", "`object` must be an object's index"))?,
+    };
+    let free = match value.get("free").and_then(Value::as_str) {
+        None => phong_fit::image::Free::default_set(),
+        Some(f) => phong_fit::image::Free::parse(f).map_err(|e| ApiError::at("free", e.to_string()))?,
+    };
+    let c = client.clone();
+    let out = run_job(&state, &client, move |st| {
+        let scene = scene_from_json(st, &c, &scene_value)?;
+        if object >= scene.objects.len() {
+            return Err(ApiError::at(
+                "object",
+                format!("the scene has {} objects", scene.objects.len()),
+            ));
+        }
+        let target =
+            phong_fit::image::Target::decode(&png, scene.image.encoding).map_err(|e| ApiError::at("target", e))?;
+        let fit = phong_fit::image::fit_image(
+            &scene,
+            object,
+            &target,
+            free,
+            None,
+            phong_raster::RenderOptions::default(),
+        )
+        .map_err(|e| match e {
+            phong_fit::FitError::Input(m) => ApiError::at("target", m),
+            other => ApiError::new(StatusCode::UNPROCESSABLE_ENTITY, other.to_string()),
+        })?;
+        let picture = phong_fit::report::comparison(&target, &fit.image, &fit.used);
+        let picture = phong_scene::encode_png(&picture, scene.image.encoding)
+            .map_err(|e| ApiError::new(StatusCode::UNPROCESSABLE_ENTITY, e.to_string()))?;
+        let m = fit.material;
+        let c3 = |c: phong_core::Color| [c.r, c.g, c.b];
+        Ok(json!({
+            "material": {"ambient": c3(m.ambient()), "diffuse": c3(m.diffuse()), "specular": c3(m.specular()),
+                         "emission": c3(m.emission()), "shininess": m.shininess()},
+            "rmse": fit.rmse, "psnr": fit.psnr, "pixels": fit.pixels,
+            "nearest": {"name": fit.nearest.0, "rmse": fit.nearest.1},
+            "undetermined": fit.undetermined,
+            "comparison": base64::engine::general_purpose::STANDARD.encode(picture),
+        }))
     })
     .await?;
     Ok(axum::Json(out).into_response())

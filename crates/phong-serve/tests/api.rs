@@ -557,3 +557,54 @@ async fn the_probe_value_is_the_rendered_pixel() {
         assert_eq!(gouraud_vertices > 0, interp == "gouraud" && lit, "{interp}/{output}");
     }
 }
+
+#[tokio::test]
+async fn fit_recovers_the_material_of_a_rendered_target() {
+    use base64::Engine;
+    let st = state();
+    let scene = |material: Value| {
+        json!({"image": {"width": 96, "height": 96},
+               "light": [{"type": "point", "position": [2, 2, 3]}],
+               "object": [{"shape": "sphere", "segments": 48, "material": material}]})
+    };
+    let truth =
+        json!({"ambient": [0.1, 0.05, 0.05], "diffuse": [0.6, 0.2, 0.1], "specular": [0.5, 0.5, 0.5], "shininess": 30});
+    let target = render(&st, scene(truth)).await;
+    assert_eq!(target.status, StatusCode::OK);
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&target.body);
+    let body = json!({"scene": scene(json!("jade")), "object": 0, "target": b64});
+    let r = call(&st, "POST", "/api/fit", "a", body.to_string()).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+    let f = r.json();
+    let d = v3(&f["material"]["diffuse"]);
+    assert!((d[0] - 0.6).abs() < 0.01 && (d[1] - 0.2).abs() < 0.01, "{d:?}");
+    assert!((f["material"]["shininess"].as_f64().expect("s") / 30.0 - 1.0).abs() < 0.03);
+    assert!(f["psnr"].as_f64().expect("psnr") > 40.0);
+    assert!(f["comparison"].as_str().is_some_and(|c| !c.is_empty()));
+    // Bad targets.
+    for (target, object, path) in [
+        (json!("not base64!"), json!(0), "target"),
+        (json!(b64), json!(3), "object"),
+    ] {
+        let body = json!({"scene": scene(json!("jade")), "object": object, "target": target});
+        let r = call(&st, "POST", "/api/fit", "a", body.to_string()).await;
+        assert_eq!(refused(&r), (400, path.to_string(), String::new()));
+    }
+    let mut small = scene(json!("jade"));
+    small["image"]["width"] = json!(64);
+    let r = call(
+        &st,
+        "POST",
+        "/api/fit",
+        "a",
+        json!({"scene": small, "target": b64}).to_string(),
+    )
+    .await;
+    let (code, path, _) = refused(&r);
+    assert_eq!((code, path.as_str()), (400, "target"));
+    assert!(
+        r.json()["error"].as_str().unwrap_or("").contains("96x96"),
+        "{}",
+        r.json()
+    );
+}

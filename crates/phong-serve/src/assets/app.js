@@ -740,9 +740,17 @@ function bindControls() {
     S.scene.light.pop();
     buildLights(); drawMarkers(); changed(false);
   });
-  for (const v of ['render', 'terms', 'compare', 'lobe']) {
+  for (const v of ['render', 'terms', 'compare', 'lobe', 'fit']) {
     on(`view-${v}`, 'click', () => setView(v));
   }
+  on('fit-target', 'change', (e) => { S.fitTarget = e.target.files[0] || null; $('fit-result').textContent = S.fitTarget ? `target: ${S.fitTarget.name}` : ''; });
+  on('fit-run', 'click', runFit);
+  on('fit-apply', 'click', () => {
+    if (!S.fitted) return;
+    obj().material = clone(S.fitted);
+    syncControls();
+    setView('render');
+  });
   on('compare-with', 'change', (e) => { S.compare = e.target.value; changed(false); });
   on('compare-split', 'input', (e) => { S.split = Number(e.target.value); drawCompare(); saveUrl(); });
   on('compare-difference', 'change', (e) => { S.difference = e.target.checked; renderCompare(); saveUrl(); });
@@ -848,11 +856,43 @@ function buildLights() {
 
 function setView(v) {
   S.view = v;
-  for (const k of ['render', 'terms', 'compare', 'lobe']) {
+  for (const k of ['render', 'terms', 'compare', 'lobe', 'fit']) {
     $(`${k}-view`).hidden = k !== v;
     $(`view-${k}`).setAttribute('aria-pressed', String(k === v));
   }
   changed(false);
+}
+
+// ---------- the fit ----------
+async function runFit() {
+  const slot = document.querySelector('.err[data-for="fit-target"]');
+  slot.textContent = '';
+  if (!S.fitTarget) { slot.textContent = 'choose a target image first'; return; }
+  try {
+    const bitmap = await createImageBitmap(S.fitTarget);
+    const target = await blobBase64(S.fitTarget);
+    // The scene at the target's size (the same camera: its aspect is the image's).
+    const scene = sceneFor(false, (s) => { s.image.width = bitmap.width; s.image.height = bitmap.height; });
+    bitmap.close();
+    $('fit-result').textContent = 'fitting…';
+    const r = await post('/api/fit', { scene, object: S.sel, target, free: $('fit-free').value });
+    const f = await r.json();
+    hooks.fit = f;
+    S.fitted = f.material;
+    $('fit-picture').src = 'data:image/png;base64,' + f.comparison;
+    const m = f.material;
+    $('fit-result').textContent = [
+      `target | fit | 4×|difference|, ${f.pixels} pixels fitted`,
+      `ambient   ${vfmt(m.ambient, 4)}`, `diffuse   ${vfmt(m.diffuse, 4)}`, `specular  ${vfmt(m.specular, 4)}`,
+      `emission  ${vfmt(m.emission, 4)}`, `shininess ${fmt(m.shininess, 2)}`,
+      `rmse ${fmt(f.rmse, 5)} (linear), psnr ${fmt(f.psnr, 2)} dB; nearest classic material ${f.nearest.name} (rmse ${fmt(f.nearest.rmse, 5)})`,
+      ...f.undetermined.map((u) => 'undetermined: ' + u),
+    ].join('\n');
+    $('fit-apply').disabled = false;
+  } catch (e) {
+    slot.textContent = e.error || String(e);
+    $('fit-result').textContent = '';
+  }
 }
 
 // ---------- files ----------
