@@ -905,6 +905,11 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
         fit.rmse,
         a.model.as_deref().unwrap_or("blinn-phong")
     );
+    let mut table = String::from("  error by incident angle:\n");
+    for (lo, hi, e, n) in &fit.by_incidence {
+        table.push_str(&format!("    {lo:>4.0}-{hi:<3.0} deg  rmse {e:.5}  ({n} samples)\n"));
+    }
+    print!("{table}");
     if let Some(dir) = report_dir(a)? {
         let m = fit.material;
         let opts = fit.options;
@@ -932,12 +937,13 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
         };
         let target = |l: [f64; 3], v: [f64; 3]| brdf.eval(l, v).map(|f| f[1] * l[2]);
         phong_fit::report::write(&dir.join("lobes.png"), &phong_fit::report::lobe_plot(target, phong))?;
+        phong_scene::write_file(&dir.join("errors.txt"), table.as_bytes())?;
         phong_fit::report::write(
             &dir.join("error.png"),
             &phong_fit::report::error_plot(&fit.curve, fit.material.shininess(), "RMSE against the exponent s"),
         )?;
         println!(
-            "wrote {}/lobes.png (green channel: target orange, fit blue) and error.png",
+            "wrote {}/lobes.png (polar, green channel: target orange, fit blue), error.png and errors.txt",
             dir.display()
         );
     }

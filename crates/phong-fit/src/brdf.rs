@@ -301,6 +301,8 @@ pub struct BrdfFit {
     pub curve: Vec<(f32, f64)>,
     /// Samples used.
     pub samples: usize,
+    /// The error by incident angle: `(from °, to °, rmse, samples)`, 15° bins.
+    pub by_incidence: Vec<(f64, f64, f64, usize)>,
 }
 
 /// One sample: directions, weight, the target's `f·cos θ_l`.
@@ -453,11 +455,38 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
     let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
     let material = Material::new(Color::BLACK, col(0), col(1), Color::BLACK, s).expect("colours in [0, 1]");
+    // The error table: weighted RMS residual by incident angle.
+    let b = basis(s);
+    let mut bins = vec![(0.0f64, 0.0f64, 0usize); 6];
+    for (smp, (d, sp)) in samples.iter().zip(&b) {
+        let deg = smp.l[2].clamp(-1.0, 1.0).acos().to_degrees();
+        let k = ((deg / 15.0) as usize).min(5);
+        for c in 0..3 {
+            let e = x[c][0] * d + x[c][1] * sp - smp.t[c];
+            bins[k].0 += smp.w * e * e;
+            bins[k].1 += smp.w;
+        }
+        bins[k].2 += 1;
+    }
+    let by_incidence = bins
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.2 > 0)
+        .map(|(k, b)| {
+            (
+                k as f64 * 15.0,
+                k as f64 * 15.0 + 15.0,
+                (b.0 / b.1.max(1e-300)).sqrt(),
+                b.2,
+            )
+        })
+        .collect();
     Ok(BrdfFit {
         material,
         options,
         rmse,
         curve,
         samples: samples.len(),
+        by_incidence,
     })
 }

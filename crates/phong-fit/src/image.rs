@@ -9,7 +9,8 @@
 //!
 //! Where the model clamps, linearity breaks: a pixel whose sum passed 1 is 255 in the target,
 //! and pixels the target clipped (0 or 255 in a channel) are left out of that channel's solve,
-//! so the clamp never enters the fit. Pixels partly covered by the object (antialiased edges)
+//! so the clamp never enters the fit. Colours are bounded by 1 under a clamping model, and only
+//! by 0 under an unclamped one. Pixels partly covered by the object (antialiased edges)
 //! or covered by something in front are left out too: the `E` image tells them (exactly 1 on
 //! the object's own pixels).
 
@@ -293,12 +294,13 @@ fn normals(
 }
 
 /// Solves the colours at one exponent: per channel `[e, a, d, k]` and the summed residual.
-fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3]) -> ([[f64; 4]; 3], f64) {
+/// Colours are bounded by 1 where the model clamps (a clamped sum cannot tell more), else only
+/// by 0: an unclamped model may need values past 1 (a brighter exposure).
+fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3], hi: f64) -> ([[f64; 4]; 3], f64) {
     let mut x = [[0.0; 4]; 3];
     let mut r = 0.0;
     for c in 0..3 {
-        let start = [0.0; 4].map(|_| 0.0);
-        let (xc, rc) = n[c].solve(free, &start, 0.0, 1.0);
+        let (xc, rc) = n[c].solve(free, &[0.0; 4], 0.0, hi);
         for k in 0..4 {
             x[c][k] = if free[k] { xc[k] } else { fixed[c][k] };
         }
@@ -309,7 +311,7 @@ fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3]
 
 fn material_of(x: &[[f64; 4]; 3], s: f32) -> Material {
     let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
-    Material::new(col(1), col(2), col(3), col(0), s).expect("colours in [0, 1], s >= 0")
+    Material::new(col(1), col(2), col(3), col(0), s).expect("colours >= 0, s >= 0")
 }
 
 /// Finds the object by name (case-insensitive) or index.
@@ -428,11 +430,16 @@ pub fn fit_image(
             );
         }
     }
+    let hi = if scene.objects[object].shading.options.clamp {
+        1.0
+    } else {
+        f64::INFINITY
+    };
     let mut curve: Vec<(f32, f64)> = Vec::new();
     let mut eval = |s: f32, basis: &mut Basis| -> Result<([[f64; 4]; 3], f64), FitError> {
         let si = basis.specular(s)?;
         let n = normals(basis, &si, target, &used, &fixed, &free_c);
-        let (x, r) = solve(&n, &free_c, &fixed);
+        let (x, r) = solve(&n, &free_c, &fixed, hi);
         let count: usize = n.iter().map(|n| n.rows).sum::<usize>().max(1);
         curve.push((s, (r / count as f64).sqrt()));
         Ok((x, r))

@@ -57,13 +57,13 @@ impl<const N: usize> Normal<N> {
     }
 
     /// The minimiser over `lo ≤ x ≤ hi` (only the unknowns with `free[i]`; the others stay at
-    /// `fixed[i]`), and its residual.
+    /// `fixed[i]`), and its residual. `hi` may be infinite (no upper bound).
     pub fn solve(&self, free: &[bool; N], fixed: &[f64; N], lo: f64, hi: f64) -> ([f64; N], f64) {
         let mut best = (*fixed, self.residual(fixed));
         let idx: Vec<usize> = (0..N).filter(|&i| free[i]).collect();
         let n = idx.len();
         // Each free unknown: 0 = solved, 1 = at lo, 2 = at hi.
-        for code in 0..3usize.pow(n as u32) {
+        'candidates: for code in 0..3usize.pow(n as u32) {
             let mut x = *fixed;
             let mut states = vec![0; n];
             let mut c = code;
@@ -74,7 +74,8 @@ impl<const N: usize> Normal<N> {
             for (k, &i) in idx.iter().enumerate() {
                 match states[k] {
                     1 => x[i] = lo,
-                    2 => x[i] = hi,
+                    2 if hi.is_finite() => x[i] = hi,
+                    2 => continue 'candidates,
                     _ => {}
                 }
             }
@@ -204,6 +205,16 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn without_an_upper_bound_values_pass_one() {
+        let mut n = Normal::<1>::default();
+        for k in 1..10 {
+            n.add(&[k as f64], 2.5 * k as f64);
+        }
+        assert!((n.solve(&[true], &[0.0], 0.0, f64::INFINITY).0[0] - 2.5).abs() < 1e-12);
+        assert_eq!(n.solve(&[true], &[0.0], 0.0, 1.0).0[0], 1.0);
     }
 
     #[test]

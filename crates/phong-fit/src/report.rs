@@ -107,52 +107,56 @@ fn line(img: &mut Image, a: (f32, f32), b: (f32, f32), c: Color) {
     }
 }
 
-/// The lobes of a BRDF fit in the plane of incidence at several incident angles: target
-/// (orange) against fit (blue), `f·cos θ_l` against the outgoing angle.
+/// Polar plots of a BRDF fit's lobes in the plane of incidence, light at 0°, 30° and 60°:
+/// the radius is `f·cos θ_l` towards each outgoing direction; target orange, fit blue.
 pub fn lobe_plot(target: impl Fn([f64; 3], [f64; 3]) -> Option<f64>, fit: impl Fn([f64; 3], [f64; 3]) -> f64) -> Image {
-    let (w, h) = (900u32, 300u32);
+    let (w, h) = (960u32, 340u32);
     let mut img = Image::new(w, h, [0.05, 0.05, 0.07, 1.0]).expect("a valid size");
     let angles = [0.0f64, 30.0, 60.0];
-    for (k, ti) in angles.iter().enumerate() {
-        let ti = ti.to_radians();
+    let orange = Color::new(0.94, 0.7, 0.16);
+    let blue = Color::new(0.3, 0.75, 0.95);
+    for (k, deg) in angles.iter().enumerate() {
+        let ti = deg.to_radians();
         let l = [-ti.sin(), 0.0, ti.cos()];
-        let curve = |f: &dyn Fn([f64; 3]) -> Option<f64>| -> Vec<(f64, f64)> {
-            (-85..=85)
+        let lobe = |f: &dyn Fn([f64; 3]) -> Option<f64>| -> Vec<(f64, f64)> {
+            (-89..=89)
                 .filter_map(|a| {
-                    let t = (a as f64).to_radians();
-                    f([t.sin(), 0.0, t.cos()]).map(|y| (a as f64, y))
+                    let t = f64::from(a).to_radians();
+                    f([t.sin(), 0.0, t.cos()]).map(|r| (t, r))
                 })
                 .collect()
         };
-        let tc = curve(&|v| target(l, v));
-        let fc = curve(&|v| Some(fit(l, v)));
-        let ymax = tc.iter().chain(&fc).fold(1e-9f64, |a, (_, y)| a.max(*y));
-        let (x0, x1) = (k as f32 * 300.0 + 20.0, k as f32 * 300.0 + 290.0);
-        let (y0, y1) = (h as f32 - 30.0, 40.0);
-        let px = |a: f64| x0 + ((a + 85.0) / 170.0) as f32 * (x1 - x0);
-        let py = |y: f64| y0 - (y / ymax) as f32 * (y0 - y1);
-        line(&mut img, (x0, y0), (x1, y0), Color::splat(0.35));
-        for (c, col) in [(&tc, Color::new(0.94, 0.7, 0.16)), (&fc, Color::new(0.3, 0.75, 0.95))] {
+        let tc = lobe(&|v| target(l, v));
+        let fc = lobe(&|v| Some(fit(l, v)));
+        let rmax = tc.iter().chain(&fc).fold(1e-9f64, |a, (_, r)| a.max(*r));
+        let (cx, cy, radius) = (k as f32 * 320.0 + 160.0, h as f32 - 30.0, 140.0);
+        let at = |t: f64, r: f64| {
+            (
+                cx + (t.sin() * r / rmax) as f32 * radius,
+                cy - (t.cos() * r / rmax) as f32 * radius,
+            )
+        };
+        // The surface, the normal and the incident direction.
+        let grey = Color::splat(0.35);
+        line(&mut img, (cx - radius, cy), (cx + radius, cy), grey);
+        line(&mut img, (cx, cy), (cx, cy - radius), grey);
+        line(&mut img, (cx, cy), at(-ti, rmax * 0.9), Color::splat(0.8));
+        for (c, col) in [(&tc, orange), (&fc, blue)] {
             for win in c.windows(2) {
-                line(
-                    &mut img,
-                    (px(win[0].0), py(win[0].1)),
-                    (px(win[1].0), py(win[1].1)),
-                    col,
-                );
+                line(&mut img, at(win[0].0, win[0].1), at(win[1].0, win[1].1), col);
             }
         }
         phong_core::text::draw_text(
             &mut img,
-            x0 as i64 + 4,
+            (cx - 150.0) as i64,
             12,
-            &format!("light at {:.0} deg", angles[k]),
+            &format!("light at {deg:.0} deg"),
             Color::splat(0.9),
             1,
         );
     }
-    phong_core::text::draw_text(&mut img, 20, h as i64 - 16, "target", Color::new(0.94, 0.7, 0.16), 1);
-    phong_core::text::draw_text(&mut img, 80, h as i64 - 16, "fit", Color::new(0.3, 0.75, 0.95), 1);
+    phong_core::text::draw_text(&mut img, 12, h as i64 - 16, "target", orange, 1);
+    phong_core::text::draw_text(&mut img, 72, h as i64 - 16, "fit", blue, 1);
     img
 }
 
