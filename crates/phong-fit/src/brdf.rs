@@ -457,7 +457,7 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
     let material = Material::new(Color::BLACK, col(0), col(1), Color::BLACK, s).expect("colours in [0, 1]");
     // The error table: weighted RMS residual by incident angle.
     let b = basis(s);
-    let mut bins = vec![(0.0f64, 0.0f64, 0usize); 6];
+    let mut bins = [(0.0f64, 0.0f64, 0usize); 6];
     for (smp, (d, sp)) in samples.iter().zip(&b) {
         let deg = smp.l[2].clamp(-1.0, 1.0).acos().to_degrees();
         let k = ((deg / 15.0) as usize).min(5);
