@@ -88,6 +88,11 @@ struct RunArgs {
 impl RunArgs {
     /// Checks the flags, loads the scene (printing its warnings) and applies the size overrides.
     fn load(&self) -> Result<phong_core::Scene> {
+        Ok(self.load_with_sources()?.0)
+    }
+
+    /// [`RunArgs::load`] and every file the scene read.
+    fn load_with_sources(&self) -> Result<(phong_core::Scene, Vec<PathBuf>)> {
         let max = phong_core::limits::MAX_IMAGE_DIMENSION;
         for (flag, v) in [("--width", self.width), ("--height", self.height)] {
             if let Some(v) = v
@@ -115,7 +120,7 @@ impl RunArgs {
         if let Some(h) = self.height {
             scene.image.height = h;
         }
-        Ok(scene)
+        Ok((scene, loaded.sources))
     }
 
     /// The CPU renderer's options.
@@ -239,13 +244,31 @@ fn input<T>(r: Result<T, String>) -> Result<T> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    // A panic is a bug: one line and exit 1, not a backtrace (RUST_BACKTRACE=1 still gives one).
+    if std::env::var_os("RUST_BACKTRACE").is_none() {
+        std::panic::set_hook(Box::new(|info| {
+            eprintln!("error: internal error (a bug in phong; please report it): {info}");
+        }));
+    }
+    let result = match std::panic::catch_unwind(move || run(cli)) {
+        Ok(r) => r,
+        Err(_) => return ExitCode::from(1),
+    };
+    report(result)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench(args),
         Command::Serve(args) => serve(args),
         Command::Fit(args) => fit(args),
         Command::Materials { name } => materials(name.as_deref()),
-    };
+    }
+}
+
+/// The exit code of a command's result, its error printed.
+fn report(result: Result<()>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -279,6 +302,27 @@ fn main() -> ExitCode {
             ExitCode::from(if is_input { 2 } else { 1 })
         }
     }
+}
+
+/// An error (exit 2) when `output` is one of the files read: the same path, a symlink to it, or
+/// a hard link (the same device and inode).
+fn refuse_overwriting(output: &std::path::Path, inputs: &[PathBuf]) -> Result<()> {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(out) = std::fs::metadata(output) else {
+        return Ok(()); // not there yet: it cannot be an input
+    };
+    for input in inputs {
+        if let Ok(m) = std::fs::metadata(input)
+            && (m.dev(), m.ino()) == (out.dev(), out.ino())
+        {
+            bail!(InputError(format!(
+                "the output {} is the input {}: refusing to overwrite it",
+                output.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The GPU when asked for (an error if there is none), or for `auto` when one is found.
@@ -386,7 +430,8 @@ fn render(a: RenderArgs) -> Result<()> {
     if !is_png {
         bail!(InputError(format!("output {} must be a .png file", a.output.display())));
     }
-    let mut scene = a.run.load()?;
+    let (mut scene, sources) = a.run.load_with_sources()?;
+    refuse_overwriting(&a.output, &sources)?;
     if let Some(s) = a.antialias {
         if !phong_core::limits::SAMPLE_COUNTS.contains(&s) {
             bail!(InputError(format!("--antialias must be 1, 4 or 16, got {s}")));
@@ -749,6 +794,14 @@ fn fit(a: FitArgs) -> Result<()> {
     Ok(())
 }
 
+/// [`refuse_overwriting`] for each of the fit's output files.
+fn refuse_overwriting_outputs(a: &FitArgs, inputs: &[PathBuf]) -> Result<()> {
+    for out in [&a.output, &a.mtl].into_iter().flatten() {
+        refuse_overwriting(out, inputs)?;
+    }
+    Ok(())
+}
+
 fn print_material(m: &Material) {
     println!("  ambient   {}", fmt3(m.ambient()));
     println!("  diffuse   {}", fmt3(m.diffuse()));
@@ -781,6 +834,14 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
+    let inputs: Vec<PathBuf> = loaded
+        .sources
+        .iter()
+        .chain([target_path])
+        .chain(&a.mask)
+        .cloned()
+        .collect();
+    refuse_overwriting_outputs(a, &inputs)?;
     let mut scene = loaded.scene;
     let object = phong_fit::image::find_object(&scene, a.object.as_deref())?;
     if let Some(m) = &a.model {
@@ -885,6 +946,9 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
             "--model for a BRDF fit is phong or blinn-phong, got \"{o}\""
         ))),
     };
+    if let Some(f) = spec.strip_prefix("merl:") {
+        refuse_overwriting_outputs(a, &[PathBuf::from(f)])?;
+    }
     let brdf = phong_fit::brdf::Brdf::parse(spec)?;
     let t0 = Instant::now();
     let fit = phong_fit::brdf::fit_brdf(&brdf, model)?;

@@ -109,3 +109,22 @@ pub const SERVE_RENDERS_TOTAL: usize = 32;
 /// `phong serve`: largest body of a fit request (the scene and a base64 target PNG): a
 /// 1920×1080 photograph as PNG is up to about 8 MB, 11 MB in base64.
 pub const SERVE_MAX_FIT_BODY: usize = 16 << 20;
+
+/// Largest scene file (TOML) read, in bytes: scenes are a few kilobytes of text; 16 MiB leaves
+/// room for generated scenes with thousands of objects and stops `/dev/zero`-like inputs early.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// Largest OBJ file read, in bytes: an OBJ of [`MAX_SCENE_TRIANGLES`] triangles with normals and
+/// texture coordinates is about 1.5 GB; 1 GiB of text keeps the read and its parse in memory.
+pub const MAX_MODEL_BYTES: u64 = 1 << 30;
+
+/// Largest MTL file read, in bytes: material libraries are kilobytes.
+pub const MAX_MTL_BYTES: u64 = 16 << 20;
+
+/// Largest image read as a fit's target or mask, in bytes: a 16384² RGBA 16-bit PNG barely
+/// compressed is 2 GiB; 512 MiB covers any photograph.
+pub const MAX_IMAGE_FILE_BYTES: u64 = 512 << 20;
+
+/// Most triangles in one scene, all shapes and meshes together (16M: about 1.5 GiB of meshes
+/// and transformed vertices), checked as each object is read, before its mesh is built.
+pub const MAX_SCENE_TRIANGLES: u64 = 1 << 24;

@@ -68,7 +68,13 @@ impl Merl {
     /// 3 × 1 458 000 float64 values, channel by channel.
     pub fn read(path: &Path) -> Result<Merl, FitError> {
         let bad = |why: String| FitError::Input(format!("{}: {why}", path.display()));
-        let bytes = std::fs::read(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        // A MERL file is 34 992 012 bytes; twice that is the bound.
+        let bytes = phong_scene::read_bounded(path, 70_000_000, "MERL file").map_err(|e| {
+            bad(format!(
+                "cannot read: {}",
+                std::error::Error::source(&e).map(|s| s.to_string()).unwrap_or_default()
+            ))
+        })?;
         Merl::parse(&bytes).map_err(bad)
     }
 

@@ -35,8 +35,17 @@ impl Target {
     /// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette), decoding its values
     /// from `encoding` to linear.
     pub fn read(path: &Path, encoding: Encoding) -> Result<Target, FitError> {
-        let bytes =
-            std::fs::read(path).map_err(|e| FitError::Input(format!("{}: cannot read: {e}", path.display())))?;
+        let bytes = phong_scene::read_bounded(
+            path,
+            phong_core::limits::MAX_IMAGE_FILE_BYTES,
+            "image (MAX_IMAGE_FILE_BYTES)",
+        )
+        .map_err(|e| {
+            FitError::Input(format!(
+                "{e}: {}",
+                std::error::Error::source(&e).map(|s| s.to_string()).unwrap_or_default()
+            ))
+        })?;
         Target::decode(&bytes, encoding).map_err(|e| FitError::Input(format!("{}: {e}", path.display())))
     }
 

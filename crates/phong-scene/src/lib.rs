@@ -11,12 +11,14 @@ mod error;
 mod json_scene;
 mod obj;
 mod png_out;
+mod read;
 mod toml_scene;
 
 pub use error::Error;
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
-pub use obj::{ObjPart, load_obj, load_obj_text};
+pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
+pub use read::{read_bounded, read_text};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model, model_scene, model_view, parse_choice,
     parse_scene, parse_scene_with,
@@ -31,6 +33,9 @@ pub struct Loaded {
     pub scene: phong_core::Scene,
     /// Warnings for the user.
     pub warnings: Vec<String>,
+    /// Every file read (the scene, its models and their MTL libraries), so that an output can
+    /// be checked not to be one of them.
+    pub sources: Vec<std::path::PathBuf>,
 }
 
 /// Loads a scene file (`.toml`) or a model (`.obj`, framed by a default camera and lights).
@@ -39,10 +44,13 @@ pub fn load(path: &Path) -> Result<Loaded, Error> {
     if is_obj {
         toml_scene::scene_for_model(path)
     } else {
-        let src = std::fs::read_to_string(path).map_err(|source| Error::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        parse_scene(&src, path)
+        let src = read_text(
+            path,
+            phong_core::limits::MAX_SCENE_BYTES,
+            "scene file (MAX_SCENE_BYTES)",
+        )?;
+        let mut loaded = parse_scene(&src, path)?;
+        loaded.sources.insert(0, path.to_path_buf());
+        Ok(loaded)
     }
 }

@@ -32,10 +32,7 @@ pub struct ObjPart {
 }
 
 fn read(path: &Path) -> Result<String, Error> {
-    std::fs::read_to_string(path).map_err(|source| Error::Read {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::read_text(path, phong_core::limits::MAX_MODEL_BYTES, "model (MAX_MODEL_BYTES)")
 }
 
 /// Offset of the `n`th whitespace-separated field of `line` (0 = keyword), for columns.
@@ -167,6 +164,23 @@ fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
     Ok(())
 }
 
+/// The MTL text as tobj can read it: a colour given as one number (`Kd 0.5`, which the format
+/// allows for grey) written as three, since tobj's reader panics on fewer than three.
+fn normalize_mtl(src: &str) -> String {
+    let mut out = String::with_capacity(src.len() + 64);
+    for line in src.split_inclusive('\n') {
+        let content = line.split('#').next().unwrap_or("");
+        let words: Vec<&str> = content.split_whitespace().collect();
+        match words.as_slice() {
+            [kw @ ("Ka" | "Kd" | "Ks" | "Ke"), v] => {
+                out.push_str(&format!("{kw} {v} {v} {v}\n"));
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
+}
+
 /// Checks an MTL file's values; returns the warnings (unsupported `illum`).
 fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), Error> {
     let c = Checker { path, src };
@@ -253,9 +267,39 @@ fn to_material(m: &tobj::Material) -> Material {
 
 /// Loads an OBJ file and its MTL materials: one part per group and material.
 pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
+    load_obj_sources(path, warnings, &mut Vec::new())
+}
+
+/// [`load_obj`], adding every file it reads (the OBJ, its MTL libraries) to `sources`.
+pub fn load_obj_sources(
+    path: &Path,
+    warnings: &mut Vec<String>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Vec<ObjPart>, Error> {
     let src = read(path)?;
+    sources.push(path.to_path_buf());
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    load_obj_text(path, &src, &|mtl| std::fs::read_to_string(dir.join(mtl)), warnings)
+    let read_mtl = std::cell::RefCell::new(Vec::new());
+    let out = load_obj_text(
+        path,
+        &src,
+        &|mtl| {
+            let p = dir.join(mtl);
+            read_mtl.borrow_mut().push(p.clone());
+            crate::read_text(
+                &p,
+                phong_core::limits::MAX_MTL_BYTES,
+                "material library (MAX_MTL_BYTES)",
+            )
+            .map_err(|e| match e {
+                Error::Read { source, .. } => source,
+                other => std::io::Error::other(other.to_string()),
+            })
+        },
+        warnings,
+    );
+    sources.extend(read_mtl.into_inner());
+    out
 }
 
 /// [`load_obj`] of an OBJ's text `src` (named `path` in messages), its MTL libraries read by
@@ -293,7 +337,7 @@ pub fn load_obj_text(
             *mtl_error.borrow_mut() = Some(e);
             return Err(tobj::LoadError::MaterialParseError);
         }
-        tobj::load_mtl_buf(&mut BufReader::new(text.as_bytes()))
+        tobj::load_mtl_buf(&mut BufReader::new(normalize_mtl(&text).as_bytes()))
     });
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);

@@ -4,7 +4,7 @@
 //! with the span toml gives; values that need checking are read as
 //! `Spanned` so that a bad one is reported at its own line and column.
 
-use crate::{Error, Loaded, ObjPart, load_obj};
+use crate::{Error, Loaded, ObjPart, load_obj_sources};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS, SAMPLE_COUNTS};
 use phong_core::{
@@ -252,6 +252,10 @@ struct Ctx<'a> {
     path: &'a Path,
     src: &'a str,
     warnings: Vec<String>,
+    /// Files read for the scene's meshes (OBJ and MTL).
+    sources: Vec<std::path::PathBuf>,
+    /// Triangles of the objects read so far (the per-scene budget).
+    triangles: std::cell::Cell<u64>,
     /// Where `mesh = "..."` names come from: `None` reads files beside the scene; `Some`
     /// looks them up in memory (the server's uploads) and never opens a file.
     meshes: Option<&'a MeshLookup<'a>>,
@@ -262,6 +266,23 @@ struct Ctx<'a> {
 pub type MeshLookup<'a> = dyn Fn(&str) -> Result<Vec<ObjPart>, String> + 'a;
 
 impl Ctx<'_> {
+    /// Counts an object's triangles against the scene's budget.
+    fn add_triangles(&self, n: u64, span: &std::ops::Range<usize>, key: &str) -> Result<(), Error> {
+        self.triangles.set(self.triangles.get().saturating_add(n));
+        let max = phong_core::limits::MAX_SCENE_TRIANGLES;
+        if self.triangles.get() > max {
+            return self.err(
+                span,
+                key,
+                format!(
+                    "the scene's objects have {} triangles so far; a scene may have at most {max} (MAX_SCENE_TRIANGLES)",
+                    self.triangles.get()
+                ),
+            );
+        }
+        Ok(())
+    }
+
     fn err<T>(&self, span: &std::ops::Range<usize>, key: &str, msg: impl Into<String>) -> Result<T, Error> {
         Err(Error::at(self.path, self.src, span.start, Some(key), msg.into()))
     }
@@ -346,12 +367,15 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         path,
         src,
         warnings: Vec::new(),
+        sources: Vec::new(),
+        triangles: std::cell::Cell::new(0),
         meshes,
     };
     let scene = build(&mut ctx, raw)?;
     Ok(Loaded {
         scene,
         warnings: ctx.warnings,
+        sources: ctx.sources,
     })
 }
 
@@ -786,6 +810,11 @@ fn object(
                     ),
                 );
             }
+            ctx.add_triangles(
+                triangles,
+                &o.segments.as_ref().map_or(span.clone(), |s| s.span()),
+                "segments",
+            )?;
             if kind != "torus" {
                 for (v, key) in [(&o.radius, "radius"), (&o.tube, "tube")] {
                     if let Some(v) = v {
@@ -825,6 +854,7 @@ fn object(
                 return ctx.err(&s.span(), "segments", "a mesh has no `segments`");
             }
             let mut warnings = Vec::new();
+            let mut sources = Vec::new();
             let parts = match ctx.meshes {
                 Some(lookup) => match lookup(m.get_ref()) {
                     Ok(parts) => parts,
@@ -832,14 +862,14 @@ fn object(
                 },
                 None => {
                     let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
-                    if !file.is_file() {
+                    if !file.exists() {
                         return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
                     }
                     let ext_ok = file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
                     if !ext_ok {
                         return ctx.err(&m.span(), "mesh", "only Wavefront .obj meshes are supported");
                     }
-                    load_obj(&file, &mut warnings)?
+                    load_obj_sources(&file, &mut warnings, &mut sources)?
                 }
             };
             let mut out = Vec::new();
@@ -853,7 +883,10 @@ fn object(
                     shading,
                 });
             }
+            let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();
             ctx.warnings.extend(warnings);
+            ctx.sources.extend(sources);
+            ctx.add_triangles(tris, &m.span(), "mesh")?;
             Ok(out)
         }
         _ => ctx.err(
@@ -895,8 +928,8 @@ fn transform(ctx: &Ctx, o: &RawObject) -> Result<Mat4, Error> {
 /// A scene for an OBJ model alone: [`model_scene`] read by the scene reader, the OBJ's parts
 /// as its mesh (so that `phong render MODEL.obj` and `phong serve MODEL.obj` draw the same).
 pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
-    let mut warnings = Vec::new();
-    let parts = load_obj(path, &mut warnings)?;
+    let (mut warnings, mut sources) = (Vec::new(), Vec::new());
+    let parts = load_obj_sources(path, &mut warnings, &mut sources)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -912,6 +945,7 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
     })?;
     warnings.append(&mut loaded.warnings);
     loaded.warnings = warnings;
+    loaded.sources = sources;
     Ok(loaded)
 }
 

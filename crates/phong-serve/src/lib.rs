@@ -60,10 +60,7 @@ pub fn initial_scene(file: Option<&Path>) -> Result<(serde_json::Value, models::
             scene
         }
         Some(f) => {
-            let src = std::fs::read_to_string(f).map_err(|source| phong_scene::Error::Read {
-                path: f.to_path_buf(),
-                source,
-            })?;
+            let src = phong_scene::read_text(f, phong_core::limits::MAX_SCENE_BYTES, "scene file (MAX_SCENE_BYTES)")?;
             // Validate as `phong render` would (meshes from disk), then keep the meshes.
             let loaded = phong_scene::parse_scene(&src, f)?;
             for w in &loaded.warnings {
