@@ -196,6 +196,30 @@ impl Mesh {
                 around[i as usize].push(f as u32);
             }
         }
+        // At a vertex with many faces, faces of the same facet direction are one group (summed
+        // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
+        // of one triangle are one group). Vertices with few faces keep the plain loop, whose
+        // summation order the images were made with.
+        const MANY: usize = 32;
+        let groups: Vec<Option<Vec<(Vec3, Vec3)>>> = around
+            .iter()
+            .map(|fs| {
+                (fs.len() > MANY).then(|| {
+                    let mut index: HashMap<[u32; 3], usize> = HashMap::new();
+                    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+                    for &f in fs {
+                        let u = facet[f as usize].normalize_or_zero();
+                        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+                            g.push((u, Vec3::ZERO));
+                            g.len() - 1
+                        });
+                        g[k].1 += facet[f as usize];
+                    }
+                    g
+                })
+            })
+            .collect();
+        let mut memo: HashMap<(u32, [u32; 3]), Vec3> = HashMap::new();
         let mut positions = Vec::new();
         let mut normals = Vec::new();
         let mut dedup: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
@@ -203,11 +227,19 @@ impl Mesh {
         for (f, t) in w.triangles.iter().enumerate() {
             let own = facet[f].normalize_or_zero();
             let tri = t.map(|v| {
-                let n = around[v as usize]
-                    .iter()
-                    .filter(|&&g| facet[g as usize].normalize_or_zero().dot(own) >= cos_crease)
-                    .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
-                    .normalize_or_zero();
+                let n = match &groups[v as usize] {
+                    None => around[v as usize]
+                        .iter()
+                        .filter(|&&g| facet[g as usize].normalize_or_zero().dot(own) >= cos_crease)
+                        .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                        .normalize_or_zero(),
+                    Some(g) => *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
+                        g.iter()
+                            .filter(|(u, _)| u.dot(own) >= cos_crease)
+                            .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
+                            .normalize_or_zero()
+                    }),
+                };
                 let key = (v, n.to_array().map(f32::to_bits));
                 *dedup.entry(key).or_insert_with(|| {
                     positions.push(w.positions[v as usize]);
@@ -304,5 +336,51 @@ mod tests {
         assert!(Mesh::new(vec![Vec3::ZERO], vec![Vec3::Z], vec![[0, 0, 1]]).is_err());
         assert!(Mesh::new(vec![Vec3::NAN], vec![Vec3::Z], vec![]).is_err());
         assert!(Mesh::new(vec![Vec3::ZERO], vec![], vec![]).is_err());
+    }
+}
+
+#[cfg(test)]
+mod crease_tests {
+    use super::*;
+
+    #[test]
+    fn many_copies_of_one_triangle_are_one_group() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tris = vec![[0, 1, 2]; 80_000];
+        let m = Mesh::from_triangles(p, tris).expect("mesh").with_crease_normals(60.0);
+        assert_eq!(m.positions().len(), 3);
+        assert!(m.normals().iter().all(|n| (*n - Vec3::Z).length() < 1e-6));
+    }
+
+    #[test]
+    fn grouped_vertices_give_the_plain_loops_normals() {
+        // A fan of 40 triangles around the origin, tilted so that neighbours are within the
+        // crease angle and opposite sides are not: the apex has more than MANY faces.
+        let n = 40;
+        let mut p = vec![Vec3::new(0.0, 0.0, 0.3)];
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+        }
+        let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [0, 1 + i, 1 + (i + 1) % n as u32]).collect();
+        let mesh = Mesh::from_triangles(p, tris).expect("mesh");
+        let m = mesh.with_crease_normals(30.0);
+        // The plain loop, written out: for each face at the apex, the sum of facets within 30°.
+        let facets: Vec<Vec3> = (0..n)
+            .map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                (b - a).cross(c - a)
+            })
+            .collect();
+        for (f, t) in m.triangles().iter().enumerate() {
+            let own = facets[f].normalize();
+            let want = facets
+                .iter()
+                .filter(|g| g.normalize().dot(own) >= 30f32.to_radians().cos())
+                .fold(Vec3::ZERO, |a, g| a + *g)
+                .normalize();
+            let got = m.normals()[t[0] as usize];
+            assert!((got - want).length() < 1e-5, "face {f}: {got} vs {want}");
+        }
     }
 }

@@ -934,6 +934,24 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let bounds = parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+    let v = model_view(bounds);
+    if !(v.position.is_finite() && v.near.is_finite() && v.far.is_finite()) {
+        let extent = bounds.map_or(0.0, |(lo, hi)| (hi - lo).max_element());
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            col: 1,
+            key: None,
+            message: format!(
+                "the model is too large for the automatic camera (its extent is {extent:e}, past f32's range once framed); \
+                 put it in a scene file with a `scale` and a camera"
+            ),
+        });
+    }
     let json = model_scene(&name, &parts);
     let lookup = |_: &str| Ok(parts.clone());
     let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
