@@ -698,7 +698,7 @@ async fn upload(
         let u = clients.entry(client.clone()).or_default();
         u.last_used = Some(Instant::now());
         u.put(&name, bytes.to_vec())
-            .map_err(|m| ApiError::limit(StatusCode::PAYLOAD_TOO_LARGE, "SERVE_MAX_UPLOADS", m))?;
+            .map_err(|(limit, m)| ApiError::limit(StatusCode::PAYLOAD_TOO_LARGE, limit, m))?;
         u.lookup(&name)
     };
     let mut info = json!({"name": name});

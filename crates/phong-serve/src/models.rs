@@ -46,18 +46,25 @@ pub struct Uploads {
 }
 
 impl Uploads {
-    /// Stores `data` as `name`, replacing a file of that name; `Err` names the limit passed.
-    pub fn put(&mut self, name: &str, data: Vec<u8>) -> Result<(), String> {
+    /// Stores `data` as `name`, replacing a file of that name; `Err` names the limit passed
+    /// and says why.
+    pub fn put(&mut self, name: &str, data: Vec<u8>) -> Result<(), (&'static str, String)> {
         let old = self.files.get(name).map_or(0, |f| f.len());
-        if old == 0 && self.files.len() >= SERVE_MAX_UPLOADS {
-            return Err(format!(
-                "upload limit: at most {SERVE_MAX_UPLOADS} files per client (SERVE_MAX_UPLOADS); delete one first"
+        if !self.files.contains_key(name) && self.files.len() >= SERVE_MAX_UPLOADS {
+            return Err((
+                "SERVE_MAX_UPLOADS",
+                format!(
+                    "upload limit: at most {SERVE_MAX_UPLOADS} files per client (SERVE_MAX_UPLOADS); delete one first"
+                ),
             ));
         }
         if self.bytes - old + data.len() > SERVE_MAX_UPLOAD_TOTAL {
-            return Err(format!(
-                "upload limit: at most {} MiB of files per client (SERVE_MAX_UPLOAD_TOTAL)",
-                SERVE_MAX_UPLOAD_TOTAL >> 20
+            return Err((
+                "SERVE_MAX_UPLOAD_TOTAL",
+                format!(
+                    "upload limit: at most {} MiB of files per client (SERVE_MAX_UPLOAD_TOTAL)",
+                    SERVE_MAX_UPLOAD_TOTAL >> 20
+                ),
             ));
         }
         self.bytes = self.bytes - old + data.len();

@@ -608,3 +608,33 @@ async fn fit_recovers_the_material_of_a_rendered_target() {
         r.json()
     );
 }
+
+#[tokio::test]
+async fn upload_limits_per_client_and_in_all() {
+    let st = state();
+    // SERVE_MAX_UPLOAD_TOTAL: three files just under SERVE_MAX_UPLOAD pass the client's total.
+    let big = "#".repeat(phong_core::limits::SERVE_MAX_UPLOAD - 1);
+    for i in 0..2 {
+        let r = call(&st, "PUT", &format!("/api/models/big{i}.mtl"), "heavy", big.clone()).await;
+        assert_eq!(r.status, StatusCode::CREATED);
+    }
+    let r = call(&st, "PUT", "/api/models/big2.mtl", "heavy", big.clone()).await;
+    assert_eq!(refused(&r), (413, String::new(), "SERVE_MAX_UPLOAD_TOTAL".into()));
+    // Replacing a file counts its new size only.
+    let r = call(&st, "PUT", "/api/models/big1.mtl", "heavy", "newmtl x\n").await;
+    assert_eq!(r.status, StatusCode::CREATED);
+    // SERVE_MAX_CLIENTS: one more client than the store holds.
+    for i in 1..phong_core::limits::SERVE_MAX_CLIENTS {
+        let r = call(&st, "PUT", "/api/models/a.mtl", &format!("client{i}"), "newmtl a\n").await;
+        assert_eq!(r.status, StatusCode::CREATED, "client {i}");
+    }
+    let r = call(&st, "PUT", "/api/models/a.mtl", "one-too-many", "newmtl a\n").await;
+    assert_eq!(refused(&r), (503, String::new(), "SERVE_MAX_CLIENTS".into()));
+    // SERVE_MAX_FIT_BODY.
+    let body = format!(
+        "{{\"target\": \"{}\"}}",
+        "A".repeat(phong_core::limits::SERVE_MAX_FIT_BODY)
+    );
+    let r = call(&st, "POST", "/api/fit", "a", body).await;
+    assert_eq!(refused(&r), (413, String::new(), "SERVE_MAX_FIT_BODY".into()));
+}
