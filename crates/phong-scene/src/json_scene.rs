@@ -122,8 +122,26 @@ fn key(k: &str) -> String {
     if bare { k.to_string() } else { string(k) }
 }
 
+/// A TOML basic string on one line, whatever `s` holds (a multi-line string would break the
+/// one-value-a-line map of paths, and is not allowed as a key).
 fn string(s: &str) -> String {
-    toml::Value::String(s.to_string()).to_string()
+    let mut o = String::with_capacity(s.len() + 2);
+    o.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => o.push_str("\\\""),
+            '\\' => o.push_str("\\\\"),
+            '\n' => o.push_str("\\n"),
+            '\r' => o.push_str("\\r"),
+            '\t' => o.push_str("\\t"),
+            c if (c as u32) < 0x20 || c == '\u{7f}' => {
+                let _ = write!(o, "\\u{:04X}", c as u32);
+            }
+            c => o.push(c),
+        }
+    }
+    o.push('"');
+    o
 }
 
 /// A value on one line: numbers, strings, booleans, arrays and inline tables.
@@ -279,6 +297,22 @@ mod tests {
         let e = err(json!({"object": [{"mesh": "Cargo.toml"}]}));
         assert_eq!(e.path, "object[0].mesh");
         assert_eq!(e.message, "no uploaded model named \"Cargo.toml\"");
+    }
+
+    #[test]
+    fn strings_with_newlines_stay_on_their_line() {
+        // Found by the scene_json fuzz target: a key with a newline was written as a multi-line
+        // string, which TOML refuses for keys, and which moved every later line's path.
+        let e = err(json!({"image": {"\nwidth": 4}}));
+        assert_eq!(e.path, "image.\nwidth");
+        assert!(e.message.contains("unknown field"), "{e}");
+        let e = err(json!({"object": [{"shape": "sph\nere\t\"\\\u{1}"}], "light": [{"type": "point"}]}));
+        assert_eq!(e.path, "light[0].position");
+        let e = err(json!({"object": [{"shape": "sph\nere"}]}));
+        assert_eq!(e.path, "object[0].shape");
+        let t = json_to_toml(&json!({"a\"b": "x\ny", "c": {"d\re": 1}})).expect("toml");
+        assert!(t.text.parse::<toml::Table>().is_ok(), "{}", t.text);
+        assert_eq!(t.text.lines().count(), t.paths.len());
     }
 
     #[test]
