@@ -429,35 +429,7 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
         (x, rmse)
     };
     let grid: Vec<f32> = (0..=30).map(|k| 10f32.powf(4.0 * k as f32 / 30.0)).collect();
-    let results: Vec<_> = grid.iter().map(|&s| eval(s)).collect();
-    let best = (0..grid.len())
-        .min_by(|&i, &j| results[i].1.total_cmp(&results[j].1))
-        .expect("grid");
-    let (mut lo, mut hi) = (
-        grid[best.saturating_sub(1)].ln(),
-        grid[(best + 1).min(grid.len() - 1)].ln(),
-    );
-    let phi = 0.618_034_f32;
-    let (mut x1, mut x2) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
-    let (mut f1, mut f2) = (eval(x1.exp()), eval(x2.exp()));
-    for _ in 0..20 {
-        if f1.1 < f2.1 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - phi * (hi - lo);
-            f1 = eval(x1.exp());
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + phi * (hi - lo);
-            f2 = eval(x2.exp());
-        }
-    }
-    let mut cands = [(results[best], grid[best]), (f1, x1.exp()), (f2, x2.exp())];
-    cands.sort_by(|a, b| a.0.1.total_cmp(&b.0.1));
-    let ((x, rmse), s) = cands[0];
+    let ((x, rmse), s) = crate::search_exponent(&grid, 20, |s| Ok::<_, FitError>(eval(s)))?;
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
     let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
     let material = Material::new(Color::BLACK, col(0), col(1), Color::BLACK, s).expect("colours in [0, 1]");

@@ -456,40 +456,7 @@ pub fn fit_image(
     let (x, s_best) = if free.shininess && (free_c[3] || start.specular() != Color::BLACK) {
         // Grid on log s over [1, 1000], then golden section between the best's neighbours.
         let grid: Vec<f32> = (0..=24).map(|k| 10f32.powf(3.0 * k as f32 / 24.0)).collect();
-        let mut results = Vec::new();
-        for &s in &grid {
-            results.push(eval(s, &mut basis)?);
-        }
-        let best = (0..grid.len())
-            .min_by(|&i, &j| results[i].1.total_cmp(&results[j].1))
-            .expect("a grid");
-        let (mut lo, mut hi) = (
-            grid[best.saturating_sub(1)].ln(),
-            grid[(best + 1).min(grid.len() - 1)].ln(),
-        );
-        let phi = 0.618_034_f32;
-        let mut x1 = hi - phi * (hi - lo);
-        let mut x2 = lo + phi * (hi - lo);
-        let mut f1 = eval(x1.exp(), &mut basis)?;
-        let mut f2 = eval(x2.exp(), &mut basis)?;
-        for _ in 0..14 {
-            if f1.1 < f2.1 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - phi * (hi - lo);
-                f1 = eval(x1.exp(), &mut basis)?;
-            } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + phi * (hi - lo);
-                f2 = eval(x2.exp(), &mut basis)?;
-            }
-        }
-        let mut cands = vec![(results[best], grid[best]), (f1, x1.exp()), (f2, x2.exp())];
-        cands.sort_by(|a, b| a.0.1.total_cmp(&b.0.1));
-        let ((x, _), s) = cands.remove(0);
+        let ((x, _), s) = crate::search_exponent(&grid, 14, |s| eval(s, &mut basis))?;
         (x, s)
     } else {
         let (x, _) = eval(start.shininess(), &mut basis)?;
