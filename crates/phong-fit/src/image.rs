@@ -318,9 +318,15 @@ fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3]
     (x, r)
 }
 
-fn material_of(x: &[[f64; 4]; 3], s: f32) -> Material {
+/// The material of the solved colours; an error where a colour left `f32`'s range (an
+/// unclamped model with a basis term near zero can ask for that).
+fn material_of(x: &[[f64; 4]; 3], s: f32) -> Result<Material, FitError> {
     let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
-    Material::new(col(1), col(2), col(3), col(0), s).expect("colours >= 0, s >= 0")
+    Material::new(col(1), col(2), col(3), col(0), s).map_err(|e| {
+        FitError::Input(format!(
+            "the fit needs a material the renderer cannot hold ({e}): the target is far brighter than this scene's lights can make it"
+        ))
+    })
 }
 
 /// Finds the object by name (case-insensitive) or index.
@@ -463,9 +469,8 @@ pub fn fit_image(
         (x, start.shininess())
     };
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let material = material_of(&x, s_best)
-        .with_alpha(start.alpha())
-        .unwrap_or_else(|_| material_of(&x, s_best));
+    let material = material_of(&x, s_best)?;
+    let material = material.with_alpha(start.alpha()).unwrap_or(material);
     // The highlight: how much the fitted specular term adds anywhere on the fitted pixels.
     let si = basis.specular(s_best)?;
     let peak = used
