@@ -8,49 +8,9 @@
 //!
 //! The fast path (`Frame::tile_visible`) finds visibility with the same arithmetic, then
 //! shades each visible pixel once; ARCHITECTURE.md describes its steps and BENCHMARKS.md their
-//! measured effects. Measured dead ends, not kept:
-//! - shading each triangle's pixels alone in vectors, remainders included: a 1M-triangle
-//!   sphere has one or two pixels per triangle, and its shading took twice as long;
-//! - rendering every tile into a local buffer, allocated per tile, streamed into the image:
-//!   slower than writing the image directly (100k Gouraud sphere, 1 thread, 19.9 → 22.0 ms).
-//!   Kept per task and used only for tiles of several triangles it is faster (a later
-//!   session: 100k Gouraud, 2 threads, 8.6 → 8.0 ms; 1M 30.9 → 27.9 ms): the image's lines
-//!   are no longer read for ownership before being written;
-//! - the depth tests of a small triangle's rows 8 pixels at a time (AVX2, 32-bit edges,
-//!   bit-identical depths), one call per triangle: first slower (Zen 3's masked stores, then
-//!   loads stalled behind unaligned overlapping stores of neighbouring triangles), then,
-//!   with whole aligned vectors written back, within noise on the 100k sphere and slower on
-//!   the 1M one (its triangles cover two or three pixels: the call and the vector setup cost
-//!   what the tests save), with or without a minimum triangle size;
-//! - four Gouraud pixels' divisions issued together: within noise (the division's latency
-//!   was not the colour's cost, the image writes were);
-//! - software prefetch of the bin's next triangles and planes: within noise (1M Gouraud,
-//!   1 thread, 7 runs: median 56.3 → 52.4 ms in a period when single runs spread 47–72 ms);
-//! - per-light skips of zero ambient colours and unit normalisation factors in the kernel:
-//!   exact, but the fill frame went 50 → 53 ms (register allocation), reverted;
-//! - sorting the pixels of a Gouraud tile for a deferred pass instead of colouring them during
-//!   visibility: the sort cost more than the interpolation (tile CPU time 24 → 18 ms);
-//! - 8-bit frames (`Pixel`) encoded by scalar saturating casts: they did not vectorise (22%
-//!   of a 1-thread 100k Gouraud frame); the SSE2 `encode_linear` made it 5.9%. Even so
-//!   `phong bench` gained only 2–6% from writing a quarter of the bytes (every pixel is
-//!   encoded, single-triangle tiles go through the task's buffer); one-shot renders (−27%)
-//!   and memory gained more (BENCHMARKS.md);
-//! - culling a setup chunk's triangles first, branch-free (area, facing, pixel box), then
-//!   setting up only the survivors (a quarter of a 1M sphere's): slower (the setup stage 12.3
-//!   → 16.0 ms, 1 thread; LLVM kept branches for the clamps, and the survivors pay twice);
-//! - software prefetch of the vertex records of the triangle 16 ahead in the setup: within
-//!   noise, slightly slower (12.3 → 13.0 ms): the setup is not bound by load latency;
-//! - the covered pixels of a narrow row found as a mask first, then only those tested for
-//!   depth (to spare the coverage branch's mispredictions): slower, 13.4 → 13.8 ms (100k);
-//! - Gouraud planes computed as four `[r, g, b, 1/w]` lanes that the compiler vectorises
-//!   (the same bits): the planes stage unchanged (3.5 ms at 1M): it is bound by memory;
-//! - 32-pixel tiles instead of 64 (so that a tile's colours, depths and ids fit in L1):
-//!   slower, 100k Gouraud 7.0 → 7.9 ms and 1M 22 → 23.5 ms at 2 threads (more triangles
-//!   binned twice, more per-tile work);
-//! - 8-bit stores streamed past the caches: within noise, single runs slower. Not kept.
+//! measured effects. Measured dead ends are in BENCHMARKS.md ("Dead ends", R1–R14).
 //!
-//! The AVX2 Gouraud tile kernel's own dead ends (8-pixel windows, spans without divisions,
-//! masked stores, prefetching, a background filled afterwards) are in `simd/tile.rs`.
+//! The AVX2 Gouraud tile kernel's are K1–K8 there.
 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::simd::{

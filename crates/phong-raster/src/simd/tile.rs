@@ -15,37 +15,9 @@
 //! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
 //! sign bit is exactly `E − bias < 0`.
 //!
-//! Measured (1080p, 1 thread, 3 interleaved runs; `phong bench SCENE --frames 20 --threads 1`):
-//! on the 100k Gouraud sphere the scalar loop takes 13.1–13.3 ms a frame, this kernel
-//! 11.7–11.9. Per frame that sphere's tiles hold 31k triangles, 263k rows of their boxes,
-//! 458k windows of which 354k hold a covered pixel, 830k covered pixels; the 1M sphere's
-//! 249k triangles, 749k rows, 1.1M windows, 568k with a pixel (1.5 pixels of their 4, 3.3
-//! pixels a triangle), and the kernel's cost per triangle (its broadcasts) made that frame slower (39.2
-//! → 43.8 ms), hence the caller's choice per tile (`raster`'s `Frame::gouraud_kernel`).
-//! Dead ends, each against the kernel as it is:
-//! - The blend of the depth and of the pixels as a load, `blendv` and store: LLVM makes it
-//!   one masked store (`vmaskmovps`), slow on AMD and not forwarded to later loads: 14.6 ms
-//!   against the scalar loop's 13.0 with windows at any column, 16.5 ms with aligned windows
-//!   and blend masks made from the pass bits (LLVM fused those too). Loading by `lddqu`,
-//!   which LLVM does not treat as a plain load, keeps the blend (then 12.0 ms).
-//! - Every window of a row's box tested, without the covered span's three divisions: 12.5 ms.
-//!   The windows outside the span cost more than the divisions: a row's exact span makes its
-//!   first and last windows hold covered pixels, so the "any pixel covered" branch is
-//!   predictable.
-//! - Windows of 8 pixels (two `f64` vectors per edge, `f32` vectors of 8) from columns that are
-//!   multiples of 4, so that a row's span of up to 5 pixels is one window (fewer loop exits
-//!   mispredicted): 11.0 → 11.7 ms (100k), 38.8 → 39.5 ms (1M); most windows' second half is
-//!   empty, and the division and transposes of 8 lanes cost more than the loop saves.
-//! - The covered pixels counted by a scan of the tile's depths after the kernel: 3% of the
-//!   frame (the `+∞ → finite` transitions of the windows are counted instead: 10.9 → 10.8).
-//! - The "any pixel covered" branch removed (every window shaded, masked): 11.3 → 11.9 ms.
-//! - The next 8 triangles' records prefetched (`_mm_prefetch`): within noise; the records are
-//!   not the limit.
-//! - No background filled first, the pixels left at `+∞` filled after the kernel: within
-//!   noise (the tile's lines are fetched by the blends instead).
-//! - The span from `1/step` multiplications in `f64`, rounded outward (one more window at
-//!   either end now and then): 13.3 ms; the same made exact by one integer test per edge:
-//!   12.8 ms. The `i64` divisions stay.
+//! Why the caller chooses it per tile (`raster`'s `Frame::gouraud_kernel`): its cost per
+//! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
+//! K1–K8).
 
 use super::kernel::Planes;
 
