@@ -350,11 +350,17 @@ pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
 pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, Error> {
     let raw: RawScene = toml::from_str(src).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
-        let line_text = src[..offset.min(src.len())].rsplit('\n').next().unwrap_or("");
+        // The whole line the error is on (an error at a key's start, as "duplicate key", has
+        // nothing before it on the line).
+        let offset_c = offset.min(src.len());
+        let start = src[..offset_c].rfind('\n').map_or(0, |i| i + 1);
+        let end = src[offset_c..].find('\n').map_or(src.len(), |i| offset_c + i);
+        let line_text = src.get(start..end).unwrap_or("");
         let key = line_text
             .split_once('=')
             .map(|(k, _)| k.trim().to_string())
-            .filter(|k| !k.is_empty());
+            .filter(|k| !k.is_empty())
+            .map(|k| unquote_key(&k));
         let message = e
             .message()
             .trim()
@@ -377,6 +383,17 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         warnings: ctx.warnings,
         sources: ctx.sources,
     })
+}
+
+/// A quoted key (`"my key"`) as the key itself; a bare key as it is.
+fn unquote_key(k: &str) -> String {
+    if (k.starts_with('"') || k.starts_with('\''))
+        && let Ok(t) = toml::from_str::<toml::Table>(&format!("{k} = 0"))
+        && let Some(name) = t.keys().next()
+    {
+        return name.clone();
+    }
+    k.to_string()
 }
 
 fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {

@@ -145,6 +145,12 @@ fn syntax_and_type_errors_have_line_column_and_key() {
         &["scene.toml:3:1", "unknown field `colour`"],
     );
     assert_err("[camara]\n", &["scene.toml:1:", "unknown field `camara`"]);
+    // An error at a key's start names the key (it used to say only "duplicate key").
+    assert_err(
+        "[image]\nwidth = 1\nwidth = 2\n",
+        &["scene.toml:3:1", "`width`: duplicate key"],
+    );
+    assert_err("[image]\nwidht = 800\n", &["`widht`: unknown field `widht`"]);
 }
 
 #[test]
