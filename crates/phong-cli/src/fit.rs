@@ -273,30 +273,7 @@ fn fit_brdf(a: &FitArgs, spec: &str) -> Result<(Material, String)> {
     }
     print!("{table}");
     if let Some(dir) = report_dir(a)? {
-        let m = fit.material;
-        let opts = fit.options;
-        let phong = |l: [f64; 3], v: [f64; 3]| -> f64 {
-            let lighting = phong_core::Lighting::new(
-                phong_core::Color::BLACK,
-                vec![
-                    phong_core::Light::directional(
-                        -phong_core::glam::Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32),
-                        phong_core::LightColor::uniform(phong_core::Color::WHITE).expect("white"),
-                    )
-                    .expect("unit"),
-                ],
-            )
-            .expect("light");
-            let view = phong_core::View::Infinite {
-                to_viewer: phong_core::glam::Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
-            };
-            let p = phong_core::SurfacePoint {
-                position: phong_core::glam::Vec3::ZERO,
-                normal: phong_core::glam::Vec3::Z,
-            };
-            let s = phong_core::shade(&p, &view, &m, &lighting, &opts);
-            f64::from(s.diffuse.g + s.specular.g)
-        };
+        let phong = |l: [f64; 3], v: [f64; 3]| phong_fit::brdf::fitted_lobe(&fit, l, v);
         let target = |l: [f64; 3], v: [f64; 3]| brdf.eval(l, v).map(|f| f[1] * l[2]);
         phong_fit::report::write(&dir.join("lobes.png"), &phong_fit::report::lobe_plot(target, phong))?;
         phong_scene::write_file(&dir.join("errors.txt"), table.as_bytes())?;

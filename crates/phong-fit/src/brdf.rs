@@ -295,6 +295,33 @@ pub fn model_options(model: SpecularModel) -> ShadingOptions {
     }
 }
 
+/// The unit white directional light arriving from `l` (towards the light, normal +z).
+fn unit_light(l: [f64; 3]) -> Lighting {
+    let to_light = Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32);
+    let light =
+        Light::directional(-to_light, LightColor::uniform(Color::WHITE).expect("white")).expect("unit direction");
+    Lighting::new(Color::BLACK, vec![light]).expect("a light")
+}
+
+/// The Phong side at directions `l`, `v` (normal +z): `shade` of material `m` under a unit
+/// light from `l`, seen from `v`, that is `f·cos θ_l` of the Phong BRDF the options define.
+pub fn reflected(m: &Material, options: &ShadingOptions, lighting: &Lighting, v: [f64; 3]) -> phong_core::Shading {
+    let point = SurfacePoint {
+        position: Vec3::ZERO,
+        normal: Vec3::Z,
+    };
+    let view = View::Infinite {
+        to_viewer: Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
+    };
+    shade(&point, &view, m, lighting, options)
+}
+
+/// [`reflected`]'s green channel (diffuse plus specular) for the fitted material, for plots.
+pub fn fitted_lobe(fit: &BrdfFit, l: [f64; 3], v: [f64; 3]) -> f64 {
+    let s = reflected(&fit.material, &fit.options, &unit_light(l), v);
+    f64::from(s.diffuse.g + s.specular.g)
+}
+
 /// The result of a BRDF fit.
 pub struct BrdfFit {
     /// The fitted material (diffuse and specular colours, exponent; render it with `options`).
@@ -372,24 +399,7 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
             samples.len()
         )));
     }
-    let unit = |l: [f64; 3]| {
-        Lighting::new(
-            Color::BLACK,
-            vec![
-                Light::directional(
-                    -Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32),
-                    LightColor::uniform(Color::WHITE).expect("white"),
-                )
-                .expect("unit direction"),
-            ],
-        )
-        .expect("a light")
-    };
-    let lightings: Vec<Lighting> = samples.iter().map(|s| unit(s.l)).collect();
-    let point = SurfacePoint {
-        position: Vec3::ZERO,
-        normal: Vec3::Z,
-    };
+    let lightings: Vec<Lighting> = samples.iter().map(|s| unit_light(s.l)).collect();
     // Basis values at exponent s: (diffuse, specular) of shade with unit colours.
     let basis = |s: f32| -> Vec<(f64, f64)> {
         let m = Material::new(Color::BLACK, Color::WHITE, Color::WHITE, Color::BLACK, s).expect("valid");
@@ -397,10 +407,7 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
             .iter()
             .zip(&lightings)
             .map(|(smp, lighting)| {
-                let view = View::Infinite {
-                    to_viewer: Vec3::new(smp.v[0] as f32, smp.v[1] as f32, smp.v[2] as f32),
-                };
-                let sh = shade(&point, &view, &m, lighting, &options);
+                let sh = reflected(&m, &options, lighting, smp.v);
                 (f64::from(sh.diffuse.r), f64::from(sh.specular.r))
             })
             .collect()
