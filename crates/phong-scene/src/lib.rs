@@ -9,6 +9,7 @@
 
 mod error;
 mod json_scene;
+mod model;
 mod obj;
 mod png_out;
 mod read;
@@ -16,12 +17,12 @@ mod toml_scene;
 
 pub use error::Error;
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
+pub use model::{ModelView, model_scene, model_view};
 pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
 pub use toml_scene::{
-    INTERPOLATIONS, MODELS, MeshLookup, Model, ModelView, OUTPUTS, apply_model, model_scene, model_view, parse_choice,
-    parse_scene, parse_scene_with,
+    INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_with,
 };
 
 use std::path::Path;
@@ -42,7 +43,7 @@ pub struct Loaded {
 pub fn load(path: &Path) -> Result<Loaded, Error> {
     let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
-        toml_scene::scene_for_model(path)
+        model::scene_for_model(path)
     } else {
         let src = read_text(
             path,
