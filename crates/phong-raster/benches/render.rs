@@ -4,7 +4,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use phong_core::*;
-use phong_raster::simd::{LANES, Prepared, avx2_available, shade8};
+use phong_raster::internals::{Isa, LANES, Prepared, shade8};
 use phong_raster::{RenderOptions, render};
 use std::hint::black_box;
 use std::path::Path;
@@ -51,11 +51,12 @@ fn kernel(c: &mut Criterion) {
         })
     });
     c.bench_function("shade8 (baseline build)", |b| {
-        b.iter(|| black_box(shade8(false, &prep, black_box(&pos), &nrm)))
+        b.iter(|| black_box(shade8(Isa::PORTABLE, &prep, black_box(&pos), &nrm)))
     });
-    if avx2_available() {
+    let avx2 = Isa::detect(true);
+    if avx2.is_avx2() {
         c.bench_function("shade8 (AVX2 build)", |b| {
-            b.iter(|| black_box(shade8(true, &prep, black_box(&pos), &nrm)))
+            b.iter(|| black_box(shade8(avx2, &prep, black_box(&pos), &nrm)))
         });
     }
 }

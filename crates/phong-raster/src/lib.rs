@@ -2,38 +2,54 @@
 //!
 //! The CPU renderer: `render(&Scene, &RenderOptions) -> Result<Image, Error>`.
 //!
-//! ## Pipeline
+//! ## Pipeline, a module a stage
 //!
-//! 1. **Setup** (per object): vertices to clip space with `clip_from_world`;
-//!    for Gouraud, the lighting of [`phong_core::shade`] at each vertex; for
-//!    flat, at each triangle's centroid with its facet normal.
-//! 2. **Clipping** ([`clip`]): trivial reject against the view volume, then
-//!    Sutherland–Hodgman in homogeneous space against the near and far planes
-//!    and a guard band ([`GUARD_BAND`](phong_core::limits::GUARD_BAND)) in x and y, so
-//!    that screen coordinates stay bounded for the fixed-point stage.
-//! 3. **Triangle setup** ([`raster`]): viewport transform with pixel centres
-//!    at +0.5, snapping to 1/256 pixel, back-face culling (counter-clockwise in
-//!    NDC is front, as OpenGL) unless two-sided, integer edge functions with
-//!    the top-left fill rule, binning into 64×64 tiles.
-//! 4. **Tiles, in parallel** (rayon): per sample, exact integer coverage and
-//!    a `GL_LESS` depth test; per pixel and triangle, one shading at the pixel
-//!    centre (as MSAA), perspective-correct; written to the covered samples. The
-//!    reference path shades as it draws; the fast path (the default) first finds
-//!    each sample's visible triangle, then shades each visible (pixel, triangle)
-//!    once, Phong- and Gouraud-interpolated pixels 8 or 16 at a time ([`simd`]).
-//! 5. **Resolve**: the samples' average (straight alpha) into the [`Image`].
+//! 1. **Frame** (`frame`): the decisions made once per render (reference or fast path, the
+//!    instruction set, how each object is shaded, the sample pattern, the background).
+//! 2. **Vertices** (`vertex`): to clip space with `clip_from_world`, outcodes, window
+//!    positions snapped to 1/256 pixel (`fixed`); for Gouraud, the lighting of
+//!    [`phong_core::shade`] at each vertex that a drawn triangle uses.
+//! 3. **Clipping** (`clip`): trivial reject against the view volume, then Sutherland–Hodgman
+//!    in homogeneous space against the near and far planes and a guard band
+//!    ([`GUARD_BAND`](phong_core::limits::GUARD_BAND)) in x and y, so that screen coordinates
+//!    stay bounded for the fixed-point stage.
+//! 4. **Setup** (`setup`): back-face culling (counter-clockwise in NDC is front, as OpenGL)
+//!    unless two-sided, integer edge functions with the top-left fill rule, the pixel box,
+//!    plane equations; then **binning** (`binning`) into 64×64 tiles.
+//! 5. **Tiles, in parallel** (`tile`): per sample, exact integer coverage and a `GL_LESS`
+//!    depth test; per pixel and triangle, one shading at the pixel centre (as MSAA),
+//!    perspective-correct. The reference path shades as it draws; the fast path (the
+//!    default) first finds each sample's visible triangle, then shades each visible (pixel,
+//!    triangle) once, by the vector kernels (`simd`).
+//! 6. **Resolve and store** (`target`): the samples' average (straight alpha) into an `f32`
+//!    [`Image`] or an 8-bit [`Image8`].
 //!
-//! Every pixel of a tile is processed by one thread in triangle order, so the
-//! image is the same whatever the number of threads.
+//! Every pixel of a tile is processed by one thread in triangle order, so the image is the
+//! same whatever the number of threads.
 
-pub mod clip;
-pub mod raster;
-pub mod simd;
+mod binning;
+mod clip;
+mod fixed;
+mod frame;
+mod setup;
+mod simd;
+mod stats;
+mod target;
+mod tile;
+mod vertex;
 
-pub use raster::{coverage_counts, sample_pattern};
+pub use frame::coverage_counts;
+pub use phong_core::limits::sample_pattern;
+pub use stats::RenderStats;
+
+/// The kernels and the clipper, for phong-raster's own benchmarks and tests: not a stable API.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::clip::{ClipVertex, Clipped, clip_triangle};
+    pub use crate::simd::{Isa, LANES, Prepared, Shaded8, Term, avx2_available, light_vertices, shade8};
+}
 
 use phong_core::{Encoding, Image, Image8, Scene};
-use std::time::Duration;
 use thiserror::Error;
 
 /// Why a render failed.
@@ -88,30 +104,6 @@ pub struct RenderOptions<'a> {
     pub no_avx2: bool,
 }
 
-/// Counts and times of one render.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RenderStats {
-    /// Triangles in the scene.
-    pub triangles: usize,
-    /// Triangles rasterised (after culling and clipping; clipping can add some).
-    pub triangles_drawn: usize,
-    /// Shadings done: on the fast path one per visible (pixel, triangle) pair; on the
-    /// reference path one per pixel and triangle passing the depth test when drawn (overdraw
-    /// included).
-    pub pixels_shaded: u64,
-    /// Vertex transform, per-vertex lighting, clipping, triangle setup and binning.
-    pub setup: Duration,
-    /// Coverage, depth and shading in the tiles, with the resolve (wall time).
-    pub raster: Duration,
-    /// In the tiles, CPU time summed over threads: coverage and depth (the reference path
-    /// shades as it rasterises, so its shading counts here too).
-    pub tile_raster: Duration,
-    /// In the tiles, CPU time summed over threads: shading (fast path).
-    pub tile_shade: Duration,
-    /// In the tiles, CPU time summed over threads: the resolve.
-    pub tile_resolve: Duration,
-}
-
 /// Renders `scene` into a linear RGBA image.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Image, Error> {
     render_with_stats(scene, options).map(|(img, _)| img)
@@ -134,7 +126,7 @@ pub fn render_with_stats(scene: &Scene, options: &RenderOptions) -> Result<(Imag
 pub struct Renderer {
     image: Option<Image>,
     image8: Option<Image8>,
-    scratch: raster::Scratch,
+    scratch: setup::Scratch,
 }
 
 impl Renderer {
@@ -154,7 +146,7 @@ impl Renderer {
         }
         let image = self.image.as_mut().expect("set above");
         let stats = in_pool(options, || {
-            raster::render(scene, options, image.pixels_mut(), Encoding::Linear, &mut self.scratch)
+            frame::render(scene, options, image.pixels_mut(), Encoding::Linear, &mut self.scratch)
         })?;
         Ok((self.image.as_ref().expect("set above"), stats))
     }
@@ -182,7 +174,7 @@ impl Renderer {
         }
         let image = self.image8.as_mut().expect("set above");
         let stats = in_pool(options, || {
-            raster::render(scene, options, image.pixels_mut(), encoding, &mut self.scratch)
+            frame::render(scene, options, image.pixels_mut(), encoding, &mut self.scratch)
         })?;
         Ok(Some((self.image8.as_ref().expect("set above"), stats)))
     }
@@ -234,5 +226,36 @@ fn in_pool<T: Send>(options: &RenderOptions, f: impl FnOnce() -> Result<T, Error
             .build()
             .map_err(|source| Error::Threads { threads: n, source })?
             .install(f),
+    }
+}
+
+/// What phong-raster's unit tests share.
+#[cfg(test)]
+pub(crate) mod testkit {
+    use crate::simd::Isa;
+
+    /// A xorshift64 generator: the tests' reproducible random numbers.
+    pub fn xorshift(mut seed: u64) -> impl FnMut() -> u64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        }
+    }
+
+    /// The AVX2 build, or `None` (the test skips, saying so) on a CPU without it; with
+    /// `PHONG_REQUIRE_AVX2=1` a CPU without it fails the test instead.
+    pub fn avx2() -> Option<Isa> {
+        let isa = Isa::detect(true);
+        if isa.is_avx2() {
+            return Some(isa);
+        }
+        assert!(
+            std::env::var_os("PHONG_REQUIRE_AVX2").is_none_or(|v| v != "1"),
+            "PHONG_REQUIRE_AVX2=1 and this CPU has no AVX2 and FMA"
+        );
+        eprintln!("skipped: this CPU has no AVX2 and FMA");
+        None
     }
 }

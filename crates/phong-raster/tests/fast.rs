@@ -6,8 +6,7 @@ use common::Rng;
 
 use glam::Vec3;
 use phong_core::*;
-use phong_raster::clip::{ClipVertex, Clipped, clip_triangle};
-use phong_raster::simd::{LANES, Prepared, Term, avx2_available, light_vertices, shade8};
+use phong_raster::internals::{ClipVertex, Clipped, LANES, Prepared, Term, clip_triangle, light_vertices, shade8};
 use phong_raster::{RenderOptions, render};
 use std::path::Path;
 
@@ -81,11 +80,9 @@ fn kernel_matches_shade() {
                 r.v(1.0)
             }
         });
-        for avx2 in [false, true] {
-            if avx2 && !avx2_available() {
-                continue;
-            }
-            let got = shade8(avx2, &prep, &pos, &nrm);
+        for isa in common::isas() {
+            let avx2 = isa.is_avx2();
+            let got = shade8(isa, &prep, &pos, &nrm);
             // Gouraud's vertex entry (16 lanes in the AVX2 build), on the same points with a
             // 5-point tail: each term it keeps exactly as `shade8` has it, flipped normals as
             // negated.
@@ -99,7 +96,7 @@ fn kernel_matches_shade() {
                 let ps: Vec<Vec3> = (0..n).map(|i| pos[i % LANES]).collect();
                 let ns: Vec<Vec3> = (0..n).map(|i| -nrm[i % LANES]).collect();
                 let mut out = vec![Vec3::NAN; n];
-                light_vertices(avx2, &prep, term, &ps, &ns, true, &mut out);
+                light_vertices(isa, &prep, term, &ps, &ns, true, &mut out);
                 for (i, o) in out.iter().enumerate() {
                     let w = Vec3::new(want[0][i % LANES], want[1][i % LANES], want[2][i % LANES]);
                     // Lane-wise the same operations: the same bits.

@@ -21,7 +21,7 @@ pub use project::WindowVertex;
 pub(crate) use tile::covered_span;
 pub use tile::{GouraudTri, TilePixel, gouraud_tile};
 
-/// Whether the AVX2 build may be used: the CPU has AVX2 and FMA (checked once, cached by std).
+/// Whether the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
@@ -33,15 +33,29 @@ pub fn avx2_available() -> bool {
     }
 }
 
-/// Panics unless the CPU has AVX2 and FMA: every entry point checks this before calling into
-/// its AVX2 build (the callers decide `avx2` once per frame from [`avx2_available`]).
-#[cfg(target_arch = "x86_64")]
-#[inline]
-fn require_avx2() {
-    assert!(
-        avx2_available(),
-        "the AVX2 build asked for on a CPU without AVX2 and FMA"
-    );
+/// The instruction set the kernels run on, chosen once per frame. An AVX2 `Isa` is made only
+/// by [`Isa::detect`] on a CPU with AVX2 and FMA, so holding one is what the AVX2 builds'
+/// `unsafe` calls rely on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Isa {
+    avx2: bool,
+}
+
+impl Isa {
+    /// Plain Rust (`[f32; 8]` loops): any CPU.
+    pub const PORTABLE: Isa = Isa { avx2: false };
+
+    /// AVX2 and FMA where the CPU has them and `allow_avx2`, else [`Isa::PORTABLE`].
+    pub fn detect(allow_avx2: bool) -> Isa {
+        Isa {
+            avx2: allow_avx2 && avx2_available(),
+        }
+    }
+
+    /// Whether this is the AVX2 build.
+    pub fn is_avx2(self) -> bool {
+        self.avx2
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -50,17 +64,15 @@ fn shade8_avx2(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -
     kernel::shade_points::<vector::Avx2>(p, position, normal)
 }
 
-/// `phong_core::shade` on 8 points (`pow` approximated, see [`kernel`]), with the AVX2 build
-/// when `avx2` is true (the caller checked [`avx2_available`]), else the portable build.
+/// `phong_core::shade` on 8 points (`pow` approximated, see [`kernel`]), by `isa`'s build.
 #[inline]
-pub fn shade8(avx2: bool, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
+pub fn shade8(isa: Isa, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return unsafe { shade8_avx2(p, position, normal) };
     }
-    let _ = avx2;
+    let _ = isa;
     kernel::shade8(p, position, normal)
 }
 
@@ -76,23 +88,22 @@ fn shade_batch_avx2<'p>(
 }
 
 /// Interpolates and shades `n` pixels, 8 at a time: `lane(i)` gives pixel `i`'s centre and its
-/// triangle's [`Planes`], `out(i, rgb)` takes its colour. AVX2 build when `avx2` is true.
+/// triangle's [`Planes`], `out(i, rgb)` takes its colour.
 #[inline]
 pub fn shade_batch<'p>(
-    avx2: bool,
+    isa: Isa,
     batch: Batch,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes),
     out: impl FnMut(usize, [f32; 3]),
 ) {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         unsafe { shade_batch_avx2(batch, n, lane, out) };
         return;
     }
-    let _ = avx2;
+    let _ = isa;
     kernel::shade_batch::<vector::Portable>(batch, n, lane, out)
 }
 
@@ -103,10 +114,9 @@ fn light_vertices_avx2(p: &Prepared, term: Term, positions: &[Vec3], normals: &[
 }
 
 /// Gouraud's vertex lighting: `out[i]` = `term` of `phong_core::shade` at `positions[i]` with
-/// `normals[i]` (negated with `flip`), `pow` approximated as in [`kernel`]. AVX2 build (16
-/// lanes) when `avx2` is true.
+/// `normals[i]` (negated with `flip`), `pow` approximated as in [`kernel`] (AVX2: 16 lanes).
 pub fn light_vertices(
-    avx2: bool,
+    isa: Isa,
     p: &Prepared,
     term: Term,
     positions: &[Vec3],
@@ -116,22 +126,21 @@ pub fn light_vertices(
 ) {
     assert!(positions.len() == normals.len() && out.len() == positions.len());
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return unsafe { light_vertices_avx2(p, term, positions, normals, flip, out) };
     }
-    let _ = avx2;
+    let _ = isa;
     kernel::light_vertices::<vector::Portable>(p, term, positions, normals, flip, out)
 }
 
 /// The lanes of [`shade_group`]'s vectors: it shades whole vectors only.
-pub fn group_lanes(avx2: bool) -> usize {
+pub fn group_lanes(isa: Isa) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
+    if isa.is_avx2() {
         return <vector::Avx2x2 as vector::Vf32>::N;
     }
-    let _ = avx2;
+    let _ = isa;
     <vector::Portable as vector::Vf32>::N
 }
 
@@ -149,11 +158,10 @@ fn shade_group_avx2(
 
 /// Interpolates and shades the pixels of one triangle (its [`Planes`] broadcast to all lanes):
 /// `pixels` are `row << 16 | column` from `origin`, `out(pixel, rgb)` takes each colour. Whole
-/// vectors only: returns how many of `pixels` (from the start) were shaded. AVX2 build when
-/// `avx2` is true.
+/// vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline]
 pub fn shade_group(
-    avx2: bool,
+    isa: Isa,
     batch: Batch,
     planes: &Planes,
     origin: (u32, u32),
@@ -161,12 +169,11 @@ pub fn shade_group(
     out: impl FnMut(u32, [f32; 3]),
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return unsafe { shade_group_avx2(batch, planes, origin, pixels, out) };
     }
-    let _ = avx2;
+    let _ = isa;
     kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
 }
 
@@ -176,7 +183,7 @@ pub fn shade_group(
 /// vertices the vector kernel leaves and every vertex without AVX2.
 #[inline]
 pub fn project_vertices<O>(
-    avx2: bool,
+    isa: Isa,
     clip_from_world: &glam::Mat4,
     (w, h, one): (f32, f32, f32),
     positions: &[Vec3],
@@ -185,12 +192,11 @@ pub fn project_vertices<O>(
     scalar: impl Fn(Vec3) -> O,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return unsafe { project::project_avx2(clip_from_world, (w, h, one), positions, out, make, scalar) };
     }
-    let _ = (avx2, clip_from_world, w, h, one, make);
+    let _ = (isa, clip_from_world, w, h, one, make);
     for (o, &p) in out.iter_mut().zip(positions) {
         *o = scalar(p);
     }
@@ -301,7 +307,7 @@ mod tests {
             let t = (k as f32 + 0.5) / 255.0;
             values.extend([t, f32::from_bits(t.to_bits() - 1), f32::from_bits(t.to_bits() + 1)]);
         }
-        let mut next = crate::raster::tests::xorshift(7);
+        let mut next = crate::testkit::xorshift(7);
         values.extend((0..10_000).map(|_| f32::from_bits(next() as u32)));
         values.extend([
             f32::NAN,

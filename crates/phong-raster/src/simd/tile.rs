@@ -19,6 +19,7 @@
 //! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
 //! K1–K8).
 
+use super::Isa;
 use super::kernel::Planes;
 
 /// The pixels a triangle's row covers, as a range of `k` over `0..n` (pixels from the row's
@@ -47,17 +48,27 @@ pub(crate) fn covered_span(row: [i64; 3], step: [i64; 3], n: i64) -> (i64, i64) 
 
 /// A pixel [`gouraud_tile`] writes: linear `f32` RGBA, or 8-bit RGBA as
 /// `Encoding::Linear` encodes it (see `encode_linear`), alpha 255.
-pub trait TilePixel: bytemuck::Pod {
+pub trait TilePixel: bytemuck::Pod + Send {
     /// 8 bits a channel (else `f32`).
     const EIGHT: bool;
+    /// `c` as this pixel: the kernel's store of it, for the scalar loop.
+    fn from_linear(c: [f32; 4]) -> Self;
 }
 
 impl TilePixel for [f32; 4] {
     const EIGHT: bool = false;
+    #[inline(always)]
+    fn from_linear(c: [f32; 4]) -> Self {
+        c
+    }
 }
 
 impl TilePixel for [u8; 4] {
     const EIGHT: bool = true;
+    #[inline(always)]
+    fn from_linear(c: [f32; 4]) -> Self {
+        c.map(|x| phong_core::Encoding::Linear.encode(x))
+    }
 }
 
 /// A triangle as [`gouraud_tile`] draws it into a tile, in the tile's pixels.
@@ -89,11 +100,10 @@ pub struct GouraudTri<'p> {
 /// (row-major, `stride` a row; a multiple of 4 at least the tile's width is fastest) keeps
 /// the nearest depth, and each pixel that passes its depth test (`z < depth`) gets its
 /// triangle's colour in `rows` (see [`TilePixel`]); returns how many pixels
-/// of `depth` were `+∞` before and are not after. The AVX2 kernel, only with `avx2` (the
-/// caller checked [`super::avx2_available`]); returns `None` and draws nothing without it (the
-/// caller then draws with the scalar loop).
+/// of `depth` were `+∞` before and are not after. The AVX2 kernel: with a portable `isa` it
+/// returns `None` and draws nothing (the caller then draws with the scalar loop).
 pub fn gouraud_tile<'p, P: TilePixel>(
-    avx2: bool,
+    isa: Isa,
     (x0, y0): (u32, u32),
     stride: usize,
     n: usize,
@@ -102,12 +112,11 @@ pub fn gouraud_tile<'p, P: TilePixel>(
     rows: &mut [&mut [P]],
 ) -> Option<u64> {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        super::require_avx2();
-        // SAFETY: the CPU has AVX2 and FMA (`require_avx2` above).
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return Some(unsafe { gouraud_tile_avx2((x0, y0), stride, n, tri, depth, rows) });
     }
-    let _ = (avx2, x0, y0, stride, n, tri, depth, rows);
+    let _ = (isa, x0, y0, stride, n, tri, depth, rows);
     None
 }
 

@@ -29,3 +29,20 @@ impl Rng {
         Color::new(self.f(), self.f(), self.f())
     }
 }
+
+/// The kernels' builds on this CPU: portable, and AVX2 where the CPU has it. With
+/// `PHONG_REQUIRE_AVX2=1` (CI) a CPU without AVX2 and FMA fails instead of testing less.
+#[allow(dead_code)] // each test file uses part of it
+pub fn isas() -> Vec<phong_raster::internals::Isa> {
+    use phong_raster::internals::Isa;
+    let avx2 = Isa::detect(true);
+    if !avx2.is_avx2() {
+        assert!(
+            std::env::var_os("PHONG_REQUIRE_AVX2").is_none_or(|v| v != "1"),
+            "PHONG_REQUIRE_AVX2=1 and this CPU has no AVX2 and FMA"
+        );
+        eprintln!("this CPU has no AVX2 and FMA: the portable build only");
+        return vec![Isa::PORTABLE];
+    }
+    vec![Isa::PORTABLE, avx2]
+}

@@ -1,0 +1,246 @@
+//! A frame: the decisions made once per render (path, instruction set, how each object is
+//! shaded, the sample pattern, the background), the set-up and binned triangles, and the
+//! render itself (setup, then the tiles).
+
+use crate::fixed::pattern;
+use crate::setup::{Chunk, Corners, ID_INDEX_BITS, SampleSpan, Scratch, Tri};
+use crate::simd::{Batch, Isa, Planes, Prepared, Term};
+use crate::stats::{RenderStats, StageClock};
+use crate::target::{Pixel, resolve};
+use crate::{Error, RenderOptions};
+use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
+use phong_core::{Encoding, Interpolation, Output, Scene, View};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Which CPU path draws the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Path {
+    /// One `shade` per pixel and covering triangle, in drawing order.
+    Reference,
+    /// Visibility first, then each visible pixel shaded once, by the vector kernels.
+    Fast,
+}
+
+/// How the fast path shades an object's pixels.
+pub(crate) enum Mode {
+    /// Interpolated position and normal, the vector kernel; the term shown.
+    Phong(Prepared, Term),
+    /// Interpolated vertex colours.
+    Gouraud,
+    /// One pixel at a time, as the reference path (flat shading, normal and depth outputs).
+    Scalar,
+}
+
+impl Mode {
+    /// The vector kernels' batch for this mode; `None` for scalar shading.
+    pub fn batch(&self) -> Option<Batch<'_>> {
+        match self {
+            Mode::Phong(prep, term) => Some(Batch::Phong(prep, *term)),
+            Mode::Gouraud => Some(Batch::Gouraud),
+            Mode::Scalar => None,
+        }
+    }
+}
+
+/// The kernel's term for a lit output; `None` for the normal and depth outputs.
+pub(crate) fn lit_term(output: Output) -> Option<Term> {
+    match output {
+        Output::Color => Some(Term::Color),
+        Output::Ambient => Some(Term::Ambient),
+        Output::Diffuse => Some(Term::Diffuse),
+        Output::Specular => Some(Term::Specular),
+        _ => None,
+    }
+}
+
+pub(crate) struct Frame<'a> {
+    pub scene: &'a Scene,
+    pub path: Path,
+    pub isa: Isa,
+    /// Per object: how the fast path shades it.
+    pub modes: Vec<Mode>,
+    /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
+    pub gouraud_only: bool,
+    /// Per object: its view vector rule.
+    pub views: Vec<View>,
+    pub w: u32,
+    pub h: u32,
+    /// The sample offsets from a pixel's corner, in 1/256 pixel.
+    pub pattern: Vec<(i64, i64)>,
+    /// The pattern's bounds, for the triangles' bounding boxes.
+    pub span: SampleSpan,
+    /// The scene's background colour, for the resolve of partly covered pixels.
+    pub bg: [f32; 4],
+    /// An uncovered pixel: the resolve of its background samples.
+    pub background: [f32; 4],
+    /// Set-up triangles, in the chunks the parallel setup made them (not copied into one
+    /// vector); ids pack (chunk, index), see [`Frame::tri`].
+    pub tris: Vec<Chunk>,
+    pub tiles_x: u32,
+    pub bins: Vec<Vec<u32>>,
+}
+
+impl<'a> Frame<'a> {
+    /// Decides the frame's constants, then transforms, lights (Gouraud, flat), clips, sets up and
+    /// bins every triangle, in memory taken from `scratch` (given back by [`Frame::recycle`]).
+    pub fn build(scene: &'a Scene, path: Path, isa: Isa, scratch: &mut Scratch) -> Frame<'a> {
+        let (w, h) = (scene.image.width, scene.image.height);
+        let clip_from_world = scene.camera.clip_from_world(w as f32 / h as f32);
+        let views: Vec<View> = scene
+            .objects
+            .iter()
+            .map(|o| scene.camera.view(o.shading.viewer))
+            .collect();
+        let pattern = pattern(scene.image.samples);
+        let modes: Vec<Mode> = scene
+            .objects
+            .iter()
+            .zip(&views)
+            .map(|(o, &view)| {
+                let Some(term) = lit_term(o.shading.output) else {
+                    return Mode::Scalar;
+                };
+                match o.shading.interpolation {
+                    Interpolation::Phong => Mode::Phong(
+                        Prepared::new(&scene.lighting, &o.material, &o.shading.options, view),
+                        term,
+                    ),
+                    Interpolation::Gouraud => Mode::Gouraud,
+                    Interpolation::Flat => Mode::Scalar,
+                }
+            })
+            .collect();
+        let bg = scene.image.background;
+        let ns = pattern.len();
+        let tiles = (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as usize;
+        let mut frame = Frame {
+            scene,
+            path,
+            isa,
+            gouraud_only: path == Path::Fast && modes.iter().all(|m| matches!(m, Mode::Gouraud)),
+            modes,
+            views,
+            w,
+            h,
+            span: SampleSpan::of(&pattern),
+            pattern,
+            bg,
+            background: resolve(std::iter::repeat_n(bg, ns), ns, bg),
+            tris: Vec::new(),
+            tiles_x: w.div_ceil(TILE_SIZE),
+            bins: std::mem::take(&mut scratch.bins),
+        };
+        frame.bins.resize(tiles, Vec::new());
+        let spare = Mutex::new(std::mem::take(&mut scratch.chunks));
+        for (oi, obj) in scene.objects.iter().enumerate() {
+            let chunks = if path == Path::Reference || matches!(frame.modes[oi], Mode::Scalar) {
+                frame.setup_object_full(oi, obj, clip_from_world)
+            } else {
+                frame.setup_object_fast(oi, obj, clip_from_world, scratch, &spare)
+            };
+            frame.bin_chunks(chunks);
+        }
+        scratch.chunks = spare.into_inner().unwrap_or_default();
+        frame
+    }
+
+    /// Gives the frame's memory back to `scratch`, emptied, for the next frame.
+    pub fn recycle(self, scratch: &mut Scratch) {
+        for mut chunk in self.tris {
+            chunk.clear();
+            scratch.chunks.push(chunk);
+        }
+        scratch.bins = self.bins;
+        for bin in &mut scratch.bins {
+            bin.clear();
+        }
+    }
+
+    /// The triangle with packed id `id` (chunk in the high bits, index in the low ones).
+    #[inline]
+    pub fn tri(&self, id: u32) -> &Tri {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].tris[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The object of triangle `id`.
+    #[inline]
+    pub fn object(&self, id: u32) -> usize {
+        self.tris[(id >> ID_INDEX_BITS) as usize].object as usize
+    }
+
+    /// The fast path's plane equations of triangle `id`.
+    #[inline]
+    pub fn planes(&self, id: u32) -> &Planes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].planes[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The [`Corners`] of triangle `id` (kept for the reference path and scalar-shaded objects).
+    #[inline]
+    pub fn corners(&self, id: u32) -> &Corners {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].corners[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// Pixel rectangle `(x0, y0, x1, y1)` of `tile` (exclusive max).
+    pub fn tile_rect(&self, tile: u32) -> (u32, u32, u32, u32) {
+        let (tx, ty) = (tile % self.tiles_x, tile / self.tiles_x);
+        let (x0, y0) = (tx * TILE_SIZE, ty * TILE_SIZE);
+        (x0, y0, (x0 + TILE_SIZE).min(self.w), (y0 + TILE_SIZE).min(self.h))
+    }
+}
+
+/// Renders into `pixels`, the scene's size row-major (8-bit pixels encoded by `encoding`);
+/// every pixel is written.
+pub(crate) fn render<P: Pixel>(
+    scene: &Scene,
+    options: &RenderOptions,
+    pixels: &mut [P],
+    encoding: Encoding,
+    scratch: &mut Scratch,
+) -> Result<RenderStats, Error> {
+    let t0 = Instant::now();
+    let path = if options.reference { Path::Reference } else { Path::Fast };
+    let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2), scratch);
+    let setup = t0.elapsed();
+    let t1 = Instant::now();
+    let clock = StageClock::default();
+    let shaded = frame.draw_tiles(pixels, encoding, &clock, options.progress);
+    let triangles_drawn = frame.tris.iter().map(|c| c.tris.len()).sum();
+    frame.recycle(scratch);
+    let raster = t1.elapsed();
+    let (tile_raster, tile_shade, tile_resolve) = clock.into_durations();
+    Ok(RenderStats {
+        triangles: scene.triangle_count(),
+        triangles_drawn,
+        pixels_shaded: shaded,
+        setup,
+        raster,
+        tile_raster,
+        tile_shade,
+        tile_resolve,
+    })
+}
+
+/// Diagnostic for coverage tests: for each sample of each pixel (row-major,
+/// samples innermost), how many triangles cover it, depth ignored. Culling
+/// and clipping apply as in [`render`](crate::render).
+pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
+    let frame = Frame::build(scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+    let ns = frame.pattern.len();
+    let mut counts = vec![0u16; frame.w as usize * frame.h as usize * ns];
+    for t in frame.tris.iter().flat_map(|c| &c.tris) {
+        let bb = t.bbox();
+        for py in bb[1]..bb[3] {
+            for px in bb[0]..bb[2] {
+                for (s, &(ox, oy)) in frame.pattern.iter().enumerate() {
+                    let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
+                    let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
+                    if t.covers(sx, sy).is_some() {
+                        counts[(py as usize * frame.w as usize + px as usize) * ns + s] += 1;
+                    }
+                }
+            }
+        }
+    }
+    counts
+}

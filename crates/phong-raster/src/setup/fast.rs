@@ -1,0 +1,190 @@
+//! The fast path's setup of a Phong- or Gouraud-interpolated object, lean in memory traffic:
+//! per vertex a 20-byte [`FastVertex`] (and for Gouraud its lit colours), per triangle its
+//! edges and plane equations; `ClipVertex` records are made only for the triangles that need
+//! clipping.
+//!
+//! Gouraud vertices are lit after the triangles are set up, and only those of drawn triangles
+//! (a sphere's back half is culled); the triangles wait as [`Pending`] until their colours
+//! exist.
+
+use super::{Chunk, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations};
+use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
+use crate::fixed::each3;
+use crate::frame::{Frame, Mode, lit_term};
+use crate::simd::{Planes, Prepared};
+use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
+use glam::{Mat4, Vec3, Vec4};
+use phong_core::Object;
+use rayon::prelude::*;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+impl Frame<'_> {
+    /// Sets up object `oi` for the fast path, in chunks of [`SETUP_CHUNK`] input triangles,
+    /// each binned.
+    pub(crate) fn setup_object_fast(
+        &self,
+        oi: usize,
+        obj: &Object,
+        clip_from_world: Mat4,
+        scratch: &mut Scratch,
+        spare: &Mutex<Vec<Chunk>>,
+    ) -> Vec<Chunk> {
+        let two_sided = obj.shading.options.two_sided;
+        let mesh = &obj.mesh;
+        let (positions, normals) = (mesh.positions(), mesh.normals());
+        let vertices = &mut scratch.vertices;
+        // Every record is overwritten below: keep last frame's (no fill) where there are enough.
+        vertices.truncate(positions.len());
+        vertices.resize(positions.len(), FastVertex::default());
+        vertices
+            .par_chunks_mut(SETUP_CHUNK)
+            .zip(positions.par_chunks(SETUP_CHUNK))
+            .for_each(|(out, ps)| fast_vertices(self.isa, clip_from_world, (self.w, self.h), ps, out));
+        let gouraud = matches!(self.modes[oi], Mode::Gouraud);
+        let lighting = gouraud.then(|| VertexLighting {
+            isa: self.isa,
+            prepared: Prepared::new(
+                &self.scene.lighting,
+                &obj.material,
+                &obj.shading.options,
+                self.views[oi],
+            ),
+            term: lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
+            two_sided,
+        });
+        let used = &mut scratch.used;
+        if gouraud {
+            used.truncate(positions.len());
+            used.par_iter().for_each(|u| u.store(false, Ordering::Relaxed));
+            used.resize_with(positions.len(), || AtomicBool::new(false));
+        }
+        let (vertices, used) = (&*vertices, &*used);
+        let mark = |idx: [u32; 3]| {
+            for i in idx {
+                used[i as usize].store(true, Ordering::Relaxed);
+            }
+        };
+        // The planes of a set-up triangle from its input vertices' indices (Phong).
+        let phong_planes = |s: &Setup, idx: [u32; 3]| -> Planes {
+            let idx = each3(|k| idx[s.order[k]] as usize);
+            let sign = if s.front { 1.0 } else { -1.0 };
+            let attrs = [
+                [positions[idx[0]], positions[idx[1]], positions[idx[2]]],
+                [normals[idx[0]] * sign, normals[idx[1]] * sign, normals[idx[2]] * sign],
+            ];
+            plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
+        };
+        let setup_chunk = |chunk: &[[u32; 3]]| {
+            let mut out = Chunk::reuse(spare, oi, chunk.len());
+            out.planes.reserve(chunk.len());
+            for &tri in chunk {
+                let v = [
+                    vertices[tri[0] as usize],
+                    vertices[tri[1] as usize],
+                    vertices[tri[2] as usize],
+                ];
+                let c = [v[0].code, v[1].code, v[2].code];
+                if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                    continue;
+                }
+                if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    if let Some(s) = self.setup_edges([v[0].p, v[1].p, v[2].p], two_sided) {
+                        if gouraud {
+                            mark(tri);
+                            out.pending.push(Pending {
+                                slot: out.tris.len() as u32,
+                                idx: each3(|k| tri[s.order[k]]),
+                            });
+                        } else {
+                            out.planes.push(phong_planes(&s, tri));
+                        }
+                        out.tris.push(s.tri);
+                    }
+                    continue;
+                }
+                // Rare: clip, with the vertices in full (Gouraud: lit here).
+                let mut lit3 = [[Vec3::ZERO; 3]; 2];
+                if let Some(lighting) = &lighting {
+                    let ps = tri.map(|i| positions[i as usize]);
+                    let ns = tri.map(|i| normals[i as usize]);
+                    let [front, back] = &mut lit3;
+                    lighting.light(&ps, &ns, [front, back]);
+                }
+                let t = each3(|k| {
+                    let i = tri[k] as usize;
+                    ClipVertex {
+                        clip: clip_from_world * Vec4::from((positions[i], 1.0)),
+                        world: positions[i],
+                        normal: normals[i],
+                        color: lit3[0][k],
+                        color_back: lit3[1][k],
+                    }
+                });
+                let mut push = |t: [ClipVertex; 3]| {
+                    if let Some((tri, p, _)) = self.setup(t, None, None, oi as u32, false) {
+                        if gouraud {
+                            out.clipped.push((out.tris.len() as u32, p));
+                        } else {
+                            out.planes.push(p);
+                        }
+                        out.tris.push(tri);
+                    }
+                };
+                match clip_triangle(&t) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => push(t),
+                    Clipped::Polygon(p) => {
+                        for i in 1..p.len() - 1 {
+                            push([p[0], p[i], p[i + 1]]);
+                        }
+                    }
+                }
+            }
+            self.bin_entries(&mut out);
+            out
+        };
+        let mut chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
+        if let Some(lighting) = &lighting {
+            // Lit straight into the colour arrays, which keep last frame's values: only the
+            // used vertices' colours are read.
+            lighting.light_used(positions, normals, used, &mut scratch.colors);
+            let colors = &scratch.colors;
+            chunks.par_iter_mut().for_each(|chunk| {
+                let Chunk {
+                    tris,
+                    planes,
+                    pending,
+                    clipped,
+                    ..
+                } = chunk;
+                // In slot order: the pending triangles' planes made here, the clipped ones'
+                // taken (no default planes written first: 96 bytes a triangle).
+                let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
+                planes.extend((0..tris.len() as u32).map(|slot| {
+                    if let Some(p) = pending.next_if(|p| p.slot == slot) {
+                        let t = &tris[slot as usize];
+                        let v = each3(|k| vertices[p.idx[k] as usize].p);
+                        // Twice the area: the cross product of edges 2 (vertex 0 to 1) and 1
+                        // (vertex 2 to 0), as `setup_edges` computed it up to the sign.
+                        let area = (t.a(1) * t.b(2) - t.a(2) * t.b(1)).unsigned_abs();
+                        let c = each3(|k| colors[usize::from(t.back)][p.idx[k] as usize]);
+                        plane_equations(
+                            (i64::from(v[0].0), i64::from(v[0].1)),
+                            t,
+                            area,
+                            [v[0].3, v[1].3, v[2].3],
+                            [c, [Vec3::ZERO; 3]],
+                            true,
+                        )
+                    } else {
+                        let c = clipped.next();
+                        debug_assert_eq!(c.map(|c| c.0), Some(slot), "every slot is pending or clipped");
+                        c.map(|c| c.1).unwrap_or_default()
+                    }
+                }));
+            });
+        }
+        chunks
+    }
+}

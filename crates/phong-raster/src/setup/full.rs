@@ -1,0 +1,112 @@
+//! The setup of an object for the reference path, or for the fast path's scalar shading (flat,
+//! normal and depth outputs): every vertex in full, lit per vertex (Gouraud) or per triangle
+//! (flat) by `Object::shade`, [`Corners`](super::Corners) kept.
+
+use super::{Chunk, Corners, SETUP_CHUNK, Tri};
+use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
+use crate::frame::Frame;
+use crate::simd::Planes;
+use crate::vertex::Projected;
+use glam::{Mat4, Vec3, Vec4};
+use phong_core::mesh::facet_normal;
+use phong_core::{Interpolation, Object};
+use rayon::prelude::*;
+
+impl Frame<'_> {
+    /// Sets up object `oi` with [`Corners`] for scalar shading, in chunks of [`SETUP_CHUNK`]
+    /// input triangles, each binned.
+    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4) -> Vec<Chunk> {
+        let scene = self.scene;
+        let interpolation = obj.shading.interpolation;
+        let output = obj.shading.output;
+        let two_sided = obj.shading.options.two_sided;
+        let view = self.views[oi];
+        let mesh = &obj.mesh;
+        let gouraud = interpolation == Interpolation::Gouraud;
+        let verts: Vec<ClipVertex> = mesh
+            .positions()
+            .par_iter()
+            .zip(mesh.normals().par_iter())
+            .map(|(&p, &n)| ClipVertex {
+                clip: clip_from_world * Vec4::from((p, 1.0)),
+                world: p,
+                normal: n,
+                color: if gouraud {
+                    let s = obj.shade(&scene.lighting, &view, p, n);
+                    Vec3::from(output.term(&s).to_array())
+                } else {
+                    Vec3::ZERO
+                },
+                color_back: if gouraud && two_sided {
+                    let s = obj.shade(&scene.lighting, &view, p, -n);
+                    Vec3::from(output.term(&s).to_array())
+                } else {
+                    Vec3::ZERO
+                },
+            })
+            .collect();
+        // Per vertex, once: its outcode, and its projection where it is inside the clipping
+        // planes (a vertex is shared by about six triangles).
+        let codes: Vec<u16> = verts.par_iter().map(|v| outcode(v.clip)).collect();
+        let projected: Vec<Projected> = verts
+            .par_iter()
+            .zip(&codes)
+            .map(|(v, &code)| {
+                if code & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    self.project(v.clip)
+                } else {
+                    Projected::default()
+                }
+            })
+            .collect();
+        let setup_chunk = |chunk: &[[u32; 3]]| {
+            let mut out = Chunk {
+                object: oi as u32,
+                tris: Vec::with_capacity(chunk.len()),
+                ..Chunk::default()
+            };
+            let mut push = |r: Option<(Tri, Planes, Option<Corners>)>| {
+                if let Some((t, _, c)) = r {
+                    out.tris.push(t);
+                    out.corners.extend(c);
+                }
+            };
+            for tri in chunk {
+                let c = tri.map(|i| codes[i as usize]);
+                if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
+                    continue;
+                }
+                let t = tri.map(|i| verts[i as usize]);
+                // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
+                let flat = (interpolation == Interpolation::Flat).then(|| {
+                    let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
+                    let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
+                    let front = output.term(&obj.shade(&scene.lighting, &view, centroid, fnorm));
+                    let back = if two_sided {
+                        output.term(&obj.shade(&scene.lighting, &view, centroid, -fnorm))
+                    } else {
+                        front
+                    };
+                    [(front, fnorm), (back, -fnorm)]
+                });
+                if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
+                    let proj = tri.map(|i| projected[i as usize]);
+                    push(self.setup(t, Some(proj), flat, oi as u32, true));
+                    continue;
+                }
+                match clip_triangle(&t) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, true)),
+                    Clipped::Polygon(p) => {
+                        for i in 1..p.len() - 1 {
+                            push(self.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, true));
+                        }
+                    }
+                }
+            }
+            self.bin_entries(&mut out);
+            out
+        };
+        mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+    }
+}

@@ -1,0 +1,178 @@
+//! The tiles, in parallel: each 64×64 tile is planned once ([`TilePlan`]) and drawn by one
+//! `match`, by one thread, its triangles in the input's order, so the image is the same
+//! whatever the number of threads.
+//!
+//! - [`reference`]: the reference path, shading as it draws.
+//! - [`visible`]: the fast path's visibility, one sample or several a pixel.
+//! - [`shade`]: the fast path's deferred shading of the visible pixels, and the scalar shading
+//!   both paths share.
+//! - [`gouraud`]: all-Gouraud frames with one sample, coloured during visibility.
+
+mod gouraud;
+mod reference;
+mod shade;
+mod visible;
+
+use crate::frame::{Frame, Path};
+use crate::stats::StageClock;
+use crate::target::{Pixel, TileTarget};
+use phong_core::Encoding;
+use phong_core::limits::TILE_SIZE;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// How a tile is drawn, decided once per tile by [`Frame::plan_tile`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TilePlan {
+    /// No triangle: every pixel is the background.
+    Empty,
+    /// The reference path: each covering triangle shaded as it is drawn.
+    Reference,
+    /// One sample, and the tile's only triangle covers all of it: every pixel sees it.
+    Covered,
+    /// An all-Gouraud frame with one sample: pixels coloured as they pass the depth test; by
+    /// the AVX2 kernel with `kernel`.
+    Gouraud { kernel: bool },
+    /// One sample: visibility, then each visible pixel shaded once.
+    Single,
+    /// Several samples: visibility per sample, then one shading per visible (pixel, triangle).
+    Multi,
+}
+
+/// One tile: where it is, its triangles (bin), and the clock its stages are added to.
+pub(crate) struct Tile<'f> {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+    pub bin: &'f [u32],
+    pub clock: &'f StageClock,
+}
+
+impl Tile<'_> {
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        (self.x1 - self.x0) as usize
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        (self.y1 - self.y0) as usize
+    }
+}
+
+/// A tile task's working memory, reused from tile to tile: its buffer for the frame's pixels
+/// (see [`TileTarget`]), and the depth and triangle of each sample.
+#[derive(Default)]
+struct TileBuffers {
+    local: Vec<[f32; 4]>,
+    depth: Vec<f32>,
+    ids: Vec<u32>,
+}
+
+impl Frame<'_> {
+    /// The plan of `tile`.
+    pub fn plan_tile(&self, tile: &Tile) -> TilePlan {
+        let n = tile.bin.len();
+        if n == 0 {
+            TilePlan::Empty
+        } else if self.path == Path::Reference {
+            TilePlan::Reference
+        } else if self.pattern.len() > 1 {
+            TilePlan::Multi
+        } else if n == 1 && self.covers_rect(tile.bin[0], (tile.x0, tile.y0, tile.x1, tile.y1)) {
+            TilePlan::Covered
+        } else if self.gouraud_only {
+            // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop:
+            // where the tile has 8 pixels per triangle or more (BENCHMARKS.md, C4).
+            let kernel = self.isa.is_avx2() && tile.width() * tile.height() >= 8 * n;
+            TilePlan::Gouraud { kernel }
+        } else {
+            TilePlan::Single
+        }
+    }
+
+    /// Draws one tile into its rows of the frame; returns the pixel shadings done.
+    fn draw_tile<P: Pixel>(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [P]],
+        encoding: Encoding,
+        buffers: &mut TileBuffers,
+    ) -> u64 {
+        let plan = self.plan_tile(tile);
+        let mut target = TileTarget {
+            rows,
+            encoding,
+            direct: plan == TilePlan::Reference || tile.bin.len() <= 1,
+        };
+        let TileBuffers { local, depth, ids } = buffers;
+        match plan {
+            TilePlan::Empty => {
+                let marks = crate::stats::Marks::start();
+                target.fill(self.background);
+                tile.clock.add(marks);
+                0
+            }
+            TilePlan::Reference => target.draw(local, |rows, _| self.tile_reference(tile, rows)),
+            TilePlan::Covered => target.draw(local, |rows, store| self.tile_covered(tile, rows, store, ids)),
+            TilePlan::Gouraud { kernel } => {
+                if kernel && let Some(n) = target.draw_linear8(|rows| self.tile_gouraud(tile, rows, depth, true)) {
+                    n
+                } else {
+                    target.draw(local, |rows, _| self.tile_gouraud(tile, rows, depth, kernel))
+                }
+            }
+            TilePlan::Single => target.draw(local, |rows, store| self.tile_single(tile, rows, store, depth, ids)),
+            TilePlan::Multi => target.draw(local, |rows, _| self.tile_multi(tile, rows, depth, ids)),
+        }
+    }
+
+    /// Draws every tile into `pixels` (the frame, row-major), in parallel; returns the pixel
+    /// shadings done. Tasks write their tiles' rows of the frame directly (disjoint slices), a
+    /// strip of 64 rows at a time, so that nothing frame-sized exists besides the frame.
+    pub fn draw_tiles<P: Pixel>(
+        &self,
+        pixels: &mut [P],
+        encoding: Encoding,
+        clock: &StageClock,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> u64 {
+        let row_len = self.w as usize;
+        debug_assert_eq!(pixels.len(), row_len * self.h as usize);
+        let total = u64::from(self.tiles_x * self.h.div_ceil(TILE_SIZE));
+        let (done, shaded) = (AtomicU64::new(0), AtomicU64::new(0));
+        pixels
+            .par_chunks_mut(TILE_SIZE as usize * row_len)
+            .enumerate()
+            .for_each(|(ty, strip)| {
+                let mut tiles: Vec<Vec<&mut [P]>> = (0..self.tiles_x).map(|_| Vec::new()).collect();
+                for row in strip.chunks_mut(row_len) {
+                    for (tx, piece) in row.chunks_mut(TILE_SIZE as usize).enumerate() {
+                        tiles[tx].push(piece);
+                    }
+                }
+                tiles
+                    .into_par_iter()
+                    .enumerate()
+                    .for_each_init(TileBuffers::default, |buffers, (tx, mut rows)| {
+                        let index = ty as u32 * self.tiles_x + tx as u32;
+                        let (x0, y0, x1, y1) = self.tile_rect(index);
+                        let tile = Tile {
+                            x0,
+                            y0,
+                            x1,
+                            y1,
+                            bin: &self.bins[index as usize],
+                            clock,
+                        };
+                        let n = self.draw_tile(&tile, &mut rows, encoding, buffers);
+                        shaded.fetch_add(n, Ordering::Relaxed);
+                        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                        if let Some(p) = progress {
+                            p(d, total);
+                        }
+                    });
+            });
+        shaded.into_inner()
+    }
+}

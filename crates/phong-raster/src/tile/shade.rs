@@ -1,0 +1,304 @@
+//! The fast path's deferred shading of the visible pixels, and the scalar shading of one pixel
+//! that the reference path and the fast path's scalar objects share.
+//!
+//! Phong and Gouraud pixels are shaded by the vector kernels: with one sample, sorted by
+//! triangle so that each triangle's whole vectors share its plane coefficients
+//! ([`shade_group`]), the rest gathered lane by lane ([`Frame::shade_gathered`]); with
+//! several, one job per visible (pixel, triangle), gathered, then the reference's resolve.
+
+use super::Tile;
+use super::visible::FORWARD;
+use crate::clip::ClipVertex;
+use crate::fixed::{HALF, each3, map3};
+use crate::frame::Frame;
+use crate::setup::{Corners, Tri};
+use crate::simd::{Planes, group_lanes, shade_batch, shade_group};
+use crate::stats::Marks;
+use crate::target::{Store, fill, resolve};
+use glam::Vec3;
+use phong_core::limits::SUBPIXEL_BITS;
+use phong_core::{Color, Interpolation, Output, depth_color, normal_color};
+
+/// How many of `ids` from the start equal `k`: 8 compared at a time (a branch-free mask LLVM
+/// vectorises; BENCHMARKS.md, C5).
+#[inline]
+pub(super) fn run_length(ids: &[u32], k: u32) -> usize {
+    let mut chunks = ids.chunks_exact(8);
+    let mut n = 0;
+    for c in &mut chunks {
+        let mut differ = 0u32;
+        for (i, &id) in c.iter().enumerate() {
+            differ |= u32::from(id != k) << i;
+        }
+        if differ != 0 {
+            return n + differ.trailing_zeros() as usize;
+        }
+        n += 8;
+    }
+    n + chunks.remainder().iter().take_while(|&&id| id == k).count()
+}
+
+impl Frame<'_> {
+    /// Shades, by object, pixels whose triangles differ lane to lane (each lane gathers its
+    /// triangle's planes): `batches[object]` are the items, `lane(item)` gives a pixel's centre
+    /// and planes, `out(item, rgb)` takes its colour. Scalar-shaded objects are skipped.
+    fn shade_gathered<'a, T: Copy>(
+        &'a self,
+        batches: &[Vec<T>],
+        lane: impl Fn(T) -> (f32, f32, &'a Planes),
+        mut out: impl FnMut(T, [f32; 3]),
+    ) {
+        for (object, batch) in batches.iter().enumerate() {
+            let Some(kind) = self.modes[object].batch() else {
+                continue;
+            };
+            shade_batch(
+                self.isa,
+                kind,
+                batch.len(),
+                |i| lane(batch[i]),
+                |i, rgb| out(batch[i], rgb),
+            );
+        }
+    }
+
+    /// The shading of a one-sample tile after visibility: each visible pixel shaded once and
+    /// written straight into `out` (the resolve of one opaque sample is the sample itself).
+    /// `ids` is, per pixel of the tile, the index in its bin of the visible triangle (or
+    /// [`FORWARD`], or `u32::MAX`). The pixels are sorted by triangle (a counting sort over the
+    /// bin, by runs of equal ids along rows), so that each triangle's pixels are shaded together
+    /// with its plane coefficients broadcast.
+    pub(super) fn shade_single(
+        &self,
+        tile: &Tile,
+        ids: &[u32],
+        out: &mut [&mut [[f32; 4]]],
+        store: Store,
+        marks: Marks,
+    ) -> u64 {
+        let (bin, x0, y0) = (tile.bin, tile.x0, tile.y0);
+        let (tw, th) = (tile.width(), tile.height());
+        let background = resolve(std::iter::once(self.bg), 1, self.bg);
+        // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
+        // where its pixels end in `order`. Runs are `(row << 16 | first column, length, k)`.
+        let mut starts = vec![0u32; bin.len() + 1];
+        let mut shaded = 0u32;
+        let mut runs: Vec<(u32, u32, u32)> = Vec::with_capacity(tw * th / 4);
+        for (row, line) in out.iter_mut().enumerate().take(th) {
+            let ids = &ids[row * tw..(row + 1) * tw];
+            let mut col = 0;
+            while col < tw {
+                let k = ids[col];
+                let len = run_length(&ids[col..], k);
+                if k == u32::MAX {
+                    fill(&mut line[col..col + len], background, store);
+                } else if k == FORWARD {
+                    // Coloured during visibility.
+                    shaded += len as u32;
+                } else {
+                    starts[k as usize + 1] += len as u32;
+                    runs.push(((row as u32) << 16 | col as u32, len as u32, k));
+                }
+                col += len;
+            }
+        }
+        crate::simd::stream_fence();
+        for k in 0..bin.len() {
+            starts[k + 1] += starts[k];
+        }
+        let sorted = starts[bin.len()];
+        shaded += sorted;
+        let mut order = vec![0u32; sorted as usize];
+        let mut next = starts.clone();
+        for &(first, len, k) in &runs {
+            let at = next[k as usize] as usize;
+            for (i, o) in order[at..at + len as usize].iter_mut().enumerate() {
+                *o = first + i as u32;
+            }
+            next[k as usize] += len;
+        }
+        // Per object, the pixels left over from whole vectors, with their triangles.
+        let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
+        let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
+        let group = group_lanes(self.isa);
+        for (k, &id) in bin.iter().enumerate() {
+            let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
+            if pixels.is_empty() {
+                continue;
+            }
+            let object = self.object(id);
+            let Some(kind) = self.modes[object].batch() else {
+                for &p in pixels {
+                    let (r, c) = at(p);
+                    let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32);
+                    out[r][c] = resolve(std::iter::once(color), 1, self.bg);
+                }
+                continue;
+            };
+            // Fewer pixels than a vector: straight to the gathered batch (no call; a 1M-triangle
+            // tile has thousands of one-pixel triangles).
+            let done = if pixels.len() < group {
+                0
+            } else {
+                shade_group(self.isa, kind, self.planes(id), (x0, y0), pixels, |p, rgb| {
+                    let (r, c) = at(p);
+                    out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                })
+            };
+            rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
+        }
+        self.shade_gathered(
+            &rest,
+            |(p, id)| {
+                let (r, c) = at(p);
+                (
+                    (x0 + c as u32) as f32 + 0.5,
+                    (y0 + r as u32) as f32 + 0.5,
+                    self.planes(id),
+                )
+            },
+            |(p, _), rgb| {
+                let (r, c) = at(p);
+                out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+            },
+        );
+        tile.clock.add(marks);
+        u64::from(shaded)
+    }
+
+    /// The shading of a tile of several samples a pixel after visibility (`ids`: per sample,
+    /// the packed id of its visible triangle or `u32::MAX`): one job per visible (pixel,
+    /// triangle), then the reference's resolve, sample by sample.
+    pub(super) fn shade_multi(&self, tile: &Tile, ids: &[u32], rows: &mut [&mut [[f32; 4]]], mut marks: Marks) -> u64 {
+        let (x0, y0) = (tile.x0, tile.y0);
+        let (tw, th) = (tile.width(), tile.height());
+        let ns = self.pattern.len();
+        // The pixel as `row << 16 | column` in the tile (no division to find it again); a
+        // pixel's jobs are contiguous.
+        let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
+        let mut starts = Vec::with_capacity(tw * th + 1);
+        for row in 0..th {
+            for col in 0..tw {
+                let pixel = row * tw + col;
+                let packed = (row as u32) << 16 | col as u32;
+                starts.push(jobs.len());
+                let first = jobs.len();
+                for &id in &ids[pixel * ns..(pixel + 1) * ns] {
+                    if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
+                        jobs.push((packed, id));
+                    }
+                }
+            }
+        }
+        starts.push(jobs.len());
+        let at = |packed: u32| (x0 + (packed & 0xffff), y0 + (packed >> 16));
+        let mut colors = vec![[0f32; 4]; jobs.len()];
+        let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
+        for (k, &(pixel, ti)) in jobs.iter().enumerate() {
+            if self.modes[self.object(ti)].batch().is_none() {
+                let (px, py) = at(pixel);
+                colors[k] = self.shade_pixel(ti, px, py);
+            } else {
+                batches[self.object(ti)].push(k as u32);
+            }
+        }
+        self.shade_gathered(
+            &batches,
+            |k| {
+                let (pixel, ti) = jobs[k as usize];
+                let (px, py) = at(pixel);
+                (px as f32 + 0.5, py as f32 + 0.5, self.planes(ti))
+            },
+            |k, rgb| colors[k as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
+        );
+        marks.resolving();
+        let out = rows.iter_mut().flat_map(|r| r.iter_mut());
+        for (pixel, o) in out.enumerate() {
+            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+            let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
+                if id == u32::MAX {
+                    self.bg
+                } else {
+                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+                }
+            });
+            *o = resolve(samples, ns, self.bg);
+        }
+        tile.clock.add(marks);
+        jobs.len() as u64
+    }
+
+    /// Perspective-correct weights of triangle `t`'s vertices at the centre of pixel
+    /// `(px, py)`: `(λ_i / w_i) / Σ (λ_j / w_j)`.
+    #[inline]
+    fn weights(t: &Tri, corners: &Corners, px: u32, py: u32) -> [f32; 3] {
+        let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
+        let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
+        let e = each3(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area);
+        let q = each3(|i| e[i] as f32 * corners.inv_w[i]);
+        let sum = q[0] + q[1] + q[2];
+        map3(q, |x| x / sum)
+    }
+
+    /// The colour of triangle `id` at the centre of pixel `(px, py)`, perspective-correct, by
+    /// phong-core's `Object::shade` (or the vertices' or the triangle's colours it made).
+    pub(crate) fn shade_pixel(&self, id: u32, px: u32, py: u32) -> [f32; 4] {
+        let (t, corners) = (self.tri(id), self.corners(id));
+        let q = Self::weights(t, corners, px, py);
+        let v = &corners.v;
+        let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
+        let scene = self.scene;
+        let obj = &scene.objects[self.object(id)];
+        let output = obj.shading.output;
+        let c = match output {
+            Output::Normal => {
+                let n = match corners.flat {
+                    Some((_, n)) => n,
+                    None if t.back => -lerp3(|v| v.normal).normalize_or_zero(),
+                    None => lerp3(|v| v.normal).normalize_or_zero(),
+                };
+                normal_color(n)
+            }
+            Output::Depth => depth_color(&scene.camera, lerp3(|v| v.world)),
+            _ => match (corners.flat, obj.shading.interpolation) {
+                (Some((c, _)), _) => c,
+                (None, Interpolation::Gouraud) => {
+                    let c = if t.back {
+                        lerp3(|v| v.color_back)
+                    } else {
+                        lerp3(|v| v.color)
+                    };
+                    Color::new(c.x, c.y, c.z)
+                }
+                _ => {
+                    let n = lerp3(|v| v.normal);
+                    let n = if t.back { -n } else { n };
+                    let view = &self.views[self.object(id)];
+                    output.term(&obj.shade(&scene.lighting, view, lerp3(|v| v.world), n))
+                }
+            },
+        };
+        [c.r, c.g, c.b, 1.0]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::run_length;
+
+    /// `run_length` counts the leading run exactly, at every length and position around its
+    /// blocks of 8.
+    #[test]
+    fn run_length_counts_the_leading_run() {
+        for len in 0..40 {
+            for run in 0..=len {
+                let mut ids = vec![7u32; len];
+                if run < len {
+                    ids[run] = 3;
+                }
+                assert_eq!(run_length(&ids, 7), run, "length {len}");
+                assert_eq!(run_length(&ids, 3), usize::from(run == 0 && len > 0), "length {len}");
+            }
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! The fast path's visibility: per sample the nearest triangle, with the reference's
+//! coverage and depth arithmetic (exact integer edge functions stepped incrementally, the same
+//! barycentrics and depths), so the same triangle wins every sample.
+//!
+//! With one sample ([`Frame::tile_single`]) wide rows first find their covered span exactly,
+//! and Gouraud triangles colour their pixels as they pass (see [`Forward`]); with several
+//! ([`Frame::tile_multi`]) each sample is tested in turn.
+
+use super::Tile;
+use super::gouraud::ColorPlanes;
+use crate::fixed::{HALF, each3, map3};
+use crate::frame::{Frame, Mode};
+use crate::setup::Tri;
+use crate::simd::{TilePixel, covered_span};
+use crate::stats::Marks;
+use crate::target::Store;
+use phong_core::limits::SUBPIXEL_BITS;
+
+/// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
+pub(super) const FORWARD: u32 = u32::MAX - 1;
+
+/// Gouraud with one sample: colours written into the tile's rows as pixels pass the depth
+/// test, from the triangle's colour planes. Interpolating a colour costs less than sorting the
+/// pixel for a deferred pass (BENCHMARKS.md, R7), and a later, nearer triangle overwrites it.
+pub(super) struct Forward<'r, 'i, T> {
+    pub planes: ColorPlanes,
+    pub rows: &'r mut [&'i mut [T]],
+}
+
+/// A tile's rectangle as the row loop reads it: `(x0, y0, width, y1)`.
+pub(super) type Span = (u32, u32, usize, u32);
+
+/// One triangle's scan of a tile's rows with one sample a pixel: the triangle, its id, the
+/// sample's offset of its edge functions (bias subtracted), and the columns `cols.0..cols.1`.
+#[derive(Clone, Copy)]
+pub(super) struct Scan<'t> {
+    pub t: &'t Tri,
+    pub id: u32,
+    pub o: [i64; 3],
+    pub cols: (u32, u32),
+}
+
+impl<'t> Scan<'t> {
+    /// Triangle `t` (id `id`) in the tile `(x0, x1)` columns, for sample offset `(ox, oy)`.
+    #[inline(always)]
+    pub fn new(t: &'t Tri, id: u32, (ox, oy): (i64, i64), (x0, x1): (u32, u32)) -> Scan<'t> {
+        let bb = t.bbox();
+        Scan {
+            t,
+            id,
+            o: each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i)),
+            cols: (bb[0].max(x0), bb[2].min(x1)),
+        }
+    }
+}
+
+impl Frame<'_> {
+    /// Whether triangle `id` covers the centre of every pixel of the rectangle `(x0, y0, x1, y1)`
+    /// (exclusive max) by the top-left rule: the four corner pixels are covered, and the
+    /// triangle is convex.
+    pub(crate) fn covers_rect(&self, id: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> bool {
+        let t = self.tri(id);
+        let centre = |p: u32| (i64::from(p) << SUBPIXEL_BITS) + HALF;
+        [(x0, y0), (x1 - 1, y0), (x0, y1 - 1), (x1 - 1, y1 - 1)]
+            .iter()
+            .all(|&(px, py)| t.covers(centre(px), centre(py)).is_some())
+    }
+
+    /// [`TilePlan::Covered`](super::TilePlan::Covered): every pixel sees the tile's only
+    /// triangle (its depth, finite inside the clipped volume, passes against the cleared
+    /// buffer), so there is no edge, depth or sorting work.
+    pub(super) fn tile_covered(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [[f32; 4]]],
+        store: Store,
+        ids: &mut Vec<u32>,
+    ) -> u64 {
+        let mut marks = Marks::start();
+        marks.shading();
+        ids.clear();
+        ids.resize(tile.width() * tile.height(), 0);
+        self.shade_single(tile, ids, rows, store, marks)
+    }
+
+    /// [`TilePlan::Single`](super::TilePlan::Single): one sample a pixel. `ids` gets, per
+    /// pixel, the index in the bin of its visible triangle, or [`FORWARD`] where a Gouraud
+    /// triangle coloured it, or `u32::MAX` (background); then [`Frame::shade_single`].
+    pub(super) fn tile_single(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [[f32; 4]]],
+        store: Store,
+        depth: &mut Vec<f32>,
+        ids: &mut Vec<u32>,
+    ) -> u64 {
+        let mut marks = Marks::start();
+        let (tw, th) = (tile.width(), tile.height());
+        depth.clear();
+        depth.resize(tw * th, f32::INFINITY);
+        ids.clear();
+        ids.resize(tw * th, u32::MAX);
+        let span = (tile.x0, tile.y0, tw, tile.y1);
+        for (k, &ti) in tile.bin.iter().enumerate() {
+            let scan = Scan::new(self.tri(ti), k as u32, self.pattern[0], (tile.x0, tile.x1));
+            if matches!(self.modes[self.object(ti)], Mode::Gouraud) {
+                let forward = Forward {
+                    planes: ColorPlanes::new(self.planes(ti)),
+                    rows: &mut *rows,
+                };
+                visible_single::<true, _>(scan, span, depth, ids, Some(forward));
+            } else {
+                visible_single::<true, [f32; 4]>(scan, span, depth, ids, None);
+            }
+        }
+        marks.shading();
+        self.shade_single(tile, ids, rows, store, marks)
+    }
+
+    /// [`TilePlan::Multi`](super::TilePlan::Multi): several samples a pixel. `ids` gets, per
+    /// sample, the packed id of its visible triangle or `u32::MAX`; then
+    /// [`Frame::shade_multi`].
+    pub(super) fn tile_multi(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [[f32; 4]]],
+        depth: &mut Vec<f32>,
+        ids: &mut Vec<u32>,
+    ) -> u64 {
+        let mut marks = Marks::start();
+        let Tile { x0, y0, x1, y1, .. } = *tile;
+        let tw = tile.width();
+        let ns = self.pattern.len();
+        depth.clear();
+        depth.resize(tw * tile.height() * ns, f32::INFINITY);
+        ids.clear();
+        ids.resize(tw * tile.height() * ns, u32::MAX);
+        let mut offsets = [[0i64; 3]; 16];
+        for &ti in tile.bin {
+            let t = self.tri(ti);
+            // Per sample an offset from the pixel corner, per pixel a step of `a·256`: exact
+            // integer adds, the reference's values.
+            for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
+                *o = each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
+            }
+            let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
+            let bb = t.bbox();
+            let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
+            for py in bb[1].max(y0)..bb[3].min(y1) {
+                let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
+                let mut row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i]);
+                for px in bx0..bx1 {
+                    let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
+                    for (s, o) in offsets[..ns].iter().enumerate() {
+                        // e − bias >= 0 on every edge: covered (top-left rule).
+                        let eb = [row[0] + o[0], row[1] + o[1], row[2] + o[2]];
+                        if (eb[0] | eb[1] | eb[2]) < 0 {
+                            continue;
+                        }
+                        let e = each3(|i| eb[i] + t.bias(i));
+                        let l = map3(e, |x| (x as f64 * t.inv_area) as f32);
+                        let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                        if zz < depth[base + s] {
+                            depth[base + s] = zz;
+                            ids[base + s] = ti;
+                        }
+                    }
+                    for i in 0..3 {
+                        row[i] += step[i];
+                    }
+                }
+            }
+        }
+        marks.shading();
+        self.shade_multi(tile, ids, rows, marks)
+    }
+}
+
+/// Visibility of one triangle with one sample per pixel (see [`Scan`]), over its rows in the
+/// tile `span`. Wide rows first find their covered span exactly (per edge, the integer bound
+/// of `e − bias + k·step >= 0`), so the loop over pixels tests no edges; narrow ones (under 8
+/// pixels, where the three divisions cost more) test each pixel.
+///
+/// With `forward`, each pixel that passes gets its colour at once and the id [`FORWARD`].
+/// Without `IDS` (all-Gouraud tiles) no id is written and `ids` is not read.
+#[inline(always)]
+pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
+    Scan {
+        t,
+        id: ti,
+        o,
+        cols: (bx0, bx1),
+    }: Scan,
+    (x0, y0, tw, y1): Span,
+    depth: &mut [f32],
+    ids: &mut [u32],
+    mut forward: Option<Forward<T>>,
+) {
+    let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
+    let bb = t.bbox();
+    let n = i64::from(bx1 - bx0);
+    for py in bb[1].max(y0)..bb[3].min(y1) {
+        let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
+        // e − bias at the row's first pixel.
+        let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
+        let (lo, hi) = covered_span(row, step, n);
+        let line = (py - y0) as usize * tw + (bx0 - x0) as usize;
+        let mut eb = each3(|i| row[i] + step[i] * lo);
+        // Forward: the pixels of this row (at most a tile's 64) that passed.
+        let mut passed = 0u64;
+        for k in lo..hi {
+            if (eb[0] | eb[1] | eb[2]) >= 0 {
+                let e = each3(|i| eb[i] + t.bias(i));
+                let l = map3(e, |x| (x as f64 * t.inv_area) as f32);
+                let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                let at = line + k as usize;
+                if zz < depth[at] {
+                    depth[at] = zz;
+                    if forward.is_some() {
+                        if IDS {
+                            ids[at] = FORWARD;
+                        }
+                        passed |= 1 << k;
+                    } else if IDS {
+                        ids[at] = ti;
+                    }
+                }
+            }
+            for i in 0..3 {
+                eb[i] += step[i];
+            }
+        }
+        if let Some(f) = &mut forward
+            && passed != 0
+        {
+            let row = &mut f.rows[(py - y0) as usize][(bx0 - x0) as usize..(bx1 - x0) as usize];
+            let mut m = passed;
+            while m != 0 {
+                let j = m.trailing_zeros();
+                row[j as usize] = T::from_linear(f.planes.at(bx0 + j, py));
+                m &= m - 1;
+            }
+        }
+    }
+}
