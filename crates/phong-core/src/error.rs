@@ -62,6 +62,21 @@ pub enum Error {
     /// parallel to its view direction).
     #[error("{0}")]
     Degenerate(String),
+    /// An image no renderer draws: a side of 0 or past
+    /// [`MAX_IMAGE_DIMENSION`](crate::limits::MAX_IMAGE_DIMENSION), or more pixels × samples
+    /// than [`MAX_SAMPLES_TOTAL`](crate::limits::MAX_SAMPLES_TOTAL).
+    #[error(
+        "image {width}x{height} with {samples} samples per pixel cannot be rendered (each side from 1 to 16384 \
+         pixels, and at most 16384x16384x4 samples in all)"
+    )]
+    ImageSize {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Samples per pixel.
+        samples: u32,
+    },
     /// No built-in material has this name.
     #[error("unknown material {name:?}{}", suggest(.suggestions))]
     UnknownMaterial {

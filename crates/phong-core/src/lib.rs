@@ -48,7 +48,7 @@ pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, Poi
 pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;
 pub use scene::{
-    ImageSettings, Interpolation, Label, Object, Output, Scene, ShadingSettings, depth_color, normal_color,
+    ImageSettings, Interpolation, Label, Object, Output, Samples, Scene, ShadingSettings, depth_color, normal_color,
 };
 pub use shading::{
     Lighting, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, lyon,

@@ -11,9 +11,6 @@ pub const MAX_IMAGE_DIMENSION: u32 = 16384;
 /// [`MAX_SAMPLES_TOTAL`]): 16384², so a full-size image fits in memory.
 pub const MAX_SAMPLES_TOTAL: u64 = 16384 * 16384 * 4;
 
-/// Samples per pixel the renderers accept.
-pub const SAMPLE_COUNTS: [u32; 3] = [1, 4, 16];
-
 /// Sub-pixel precision of snapped vertex positions: 8 bits (1/256 pixel),
 /// as D3D11 and llvmpipe.
 pub const SUBPIXEL_BITS: u32 = 8;
@@ -44,19 +41,19 @@ pub const MAX_SEGMENTS: u32 = 4096;
 /// not an out-of-memory abort.
 pub const MAX_PRIMITIVE_TRIANGLES: u64 = 1 << 24;
 
-/// Sample positions within a pixel, in [0, 1)², for 1, 4 and 16 samples (any other count: the
-/// centre). 1: the centre. 4: the D3D/Vulkan standard rotated grid. 16: a 4×4 grid. The CPU
-/// renderer and the GPU's compute rasterizer sample here.
-pub fn sample_pattern(samples: u32) -> Vec<(f32, f32)> {
+/// Sample positions within a pixel, in [0, 1)². One: the centre. Four: the D3D/Vulkan
+/// standard rotated grid. Sixteen: a 4×4 grid. The CPU renderer and the GPU's compute
+/// rasterizer sample here.
+pub fn sample_pattern(samples: crate::Samples) -> Vec<(f32, f32)> {
     match samples {
-        4 => [(-2.0, -6.0), (6.0, -2.0), (-6.0, 2.0), (2.0, 6.0)]
+        crate::Samples::Four => [(-2.0, -6.0), (6.0, -2.0), (-6.0, 2.0), (2.0, 6.0)]
             .iter()
             .map(|&(x, y)| (0.5 + x / 16.0, 0.5 + y / 16.0))
             .collect(),
-        16 => (0..16)
+        crate::Samples::Sixteen => (0..16)
             .map(|i| ((i % 4) as f32 * 0.25 + 0.125, (i / 4) as f32 * 0.25 + 0.125))
             .collect(),
-        _ => vec![(0.5, 0.5)],
+        crate::Samples::One => vec![(0.5, 0.5)],
     }
 }
 

@@ -3,7 +3,8 @@
 //! read it.
 
 use crate::{
-    Camera, Color, Encoding, Lighting, Material, Mesh, Shading, ShadingOptions, SurfacePoint, View, Viewer, shade,
+    Camera, Color, Encoding, Error, Lighting, Material, Mesh, Shading, ShadingOptions, SurfacePoint, View, Viewer,
+    shade,
 };
 use glam::Vec3;
 
@@ -68,7 +69,52 @@ pub fn depth_color(camera: &Camera, p: Vec3) -> Color {
     Color::splat((1.0 - (d - camera.near()) / (camera.far() - camera.near())).clamp(0.0, 1.0))
 }
 
-/// The image's settings.
+/// Samples per pixel: the counts every renderer draws, so that no other can be asked for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Samples {
+    /// One sample at the pixel's centre.
+    #[default]
+    One,
+    /// The standard 4-sample rotated grid.
+    Four,
+    /// A 4×4 grid.
+    Sixteen,
+}
+
+impl Samples {
+    /// Every count, smallest first.
+    pub const ALL: [Samples; 3] = [Samples::One, Samples::Four, Samples::Sixteen];
+
+    /// How many samples.
+    pub const fn count(self) -> u32 {
+        match self {
+            Samples::One => 1,
+            Samples::Four => 4,
+            Samples::Sixteen => 16,
+        }
+    }
+
+    /// The samples of `n` per pixel: 1, 4 or 16.
+    pub fn from_count(n: u32) -> Result<Samples, Error> {
+        Samples::ALL
+            .into_iter()
+            .find(|s| s.count() == n)
+            .ok_or(Error::OutOfRange {
+                what: "antialias",
+                range: "1, 4 or 16 samples per pixel",
+                value: n as f32,
+            })
+    }
+}
+
+impl std::fmt::Display for Samples {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.count())
+    }
+}
+
+/// The image's settings. Renderers take them through [`ImageSettings::check`], the one place
+/// the size limits are decided.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageSettings {
     /// Width in pixels.
@@ -77,8 +123,8 @@ pub struct ImageSettings {
     pub height: u32,
     /// Background, linear RGBA (alpha < 1 gives an RGBA PNG).
     pub background: [f32; 4],
-    /// Samples per pixel: 1, 4 or 16.
-    pub samples: u32,
+    /// Samples per pixel.
+    pub samples: Samples,
     /// 8-bit encoding of the output.
     pub encoding: Encoding,
 }
@@ -89,9 +135,33 @@ impl Default for ImageSettings {
             width: 800,
             height: 600,
             background: [0.0, 0.0, 0.0, 1.0],
-            samples: 1,
+            samples: Samples::One,
             encoding: Encoding::Linear,
         }
+    }
+}
+
+impl ImageSettings {
+    /// The image can be rendered: each side from 1 to
+    /// [`MAX_IMAGE_DIMENSION`](crate::limits::MAX_IMAGE_DIMENSION), pixels × samples at most
+    /// [`MAX_SAMPLES_TOTAL`](crate::limits::MAX_SAMPLES_TOTAL).
+    pub fn check(&self) -> Result<(), Error> {
+        let (w, h, s) = (self.width, self.height, self.samples.count());
+        let side = 1..=crate::limits::MAX_IMAGE_DIMENSION;
+        if side.contains(&w) && side.contains(&h) && self.samples_total() <= crate::limits::MAX_SAMPLES_TOTAL {
+            Ok(())
+        } else {
+            Err(Error::ImageSize {
+                width: w,
+                height: h,
+                samples: s,
+            })
+        }
+    }
+
+    /// Pixels × samples per pixel.
+    pub fn samples_total(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height) * u64::from(self.samples.count())
     }
 }
 

@@ -64,6 +64,13 @@ pub enum FitError {
     Render(String),
 }
 
+impl FitError {
+    /// Whether the error is in what the user gave.
+    pub fn is_input(&self) -> bool {
+        matches!(self, FitError::Input(_))
+    }
+}
+
 fn num(x: f32) -> String {
     let r = (f64::from(x) * 1e6).round() / 1e6;
     format!("{r}")

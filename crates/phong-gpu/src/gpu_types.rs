@@ -1,4 +1,5 @@
-//! `#[repr(C)]` mirrors of the WGSL structs in `shade.wgsl`, `frame.wgsl`, `raster.wgsl` and `compute.wgsl`,
+//! `#[repr(C)]` mirrors of the WGSL structs in `shade.wgsl`, `frame.wgsl`, `raster.wgsl` and `shade_cases.wgsl`
+//! (under `shaders/`),
 //! all made of 16-byte vectors so that Rust and WGSL layouts agree without padding rules.
 
 use bytemuck::{Pod, Zeroable};

@@ -84,7 +84,7 @@ mod tests {
         let (w, h) = (4 * TILE_SIZE, 4 * TILE_SIZE);
         let mut bits = xorshift(0x2545_f491_4f6c_dd1du64);
         let mut next = |range: i64| (bits() % range as u64) as i64;
-        let patterns: Vec<Vec<(i64, i64)>> = [1, 4, 16].iter().map(|&n| pattern(n)).collect();
+        let patterns: Vec<Vec<(i64, i64)>> = phong_core::Samples::ALL.iter().map(|&n| pattern(n)).collect();
         let all = SampleSpan::of(&patterns.concat());
         let mut rejected = 0;
         for _ in 0..400 {

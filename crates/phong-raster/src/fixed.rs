@@ -1,6 +1,7 @@
 //! The fixed-point grid (1/256 pixel, [`SUBPIXEL_BITS`]) and the small always-inlined
 //! helpers of the per-triangle and per-pixel loops.
 
+use phong_core::Samples;
 use phong_core::limits::{SUBPIXEL_BITS, sample_pattern};
 
 /// One pixel in grid units.
@@ -9,7 +10,7 @@ pub(crate) const ONE: f32 = (1u32 << SUBPIXEL_BITS) as f32;
 pub(crate) const HALF: i64 = 1 << (SUBPIXEL_BITS - 1);
 
 /// The sample pattern of `samples` per pixel in grid units, from the pixel's corner.
-pub(crate) fn pattern(samples: u32) -> Vec<(i64, i64)> {
+pub(crate) fn pattern(samples: Samples) -> Vec<(i64, i64)> {
     sample_pattern(samples)
         .into_iter()
         .map(|(x, y)| ((x * ONE).round() as i64, (y * ONE).round() as i64))

@@ -56,22 +56,6 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// Samples per pixel other than 1, 4 or 16.
-    #[error("antialias must be 1, 4 or 16 samples per pixel, got {0}")]
-    Samples(u32),
-    /// The image (times its samples) is larger than the renderer accepts.
-    #[error(
-        "image {width}x{height} with {samples} samples per pixel is too large (limits: 16384 pixels on a side, \
-         and 16384x16384x4 samples in all)"
-    )]
-    TooLarge {
-        /// Width.
-        width: u32,
-        /// Height.
-        height: u32,
-        /// Samples per pixel.
-        samples: u32,
-    },
     /// More threads than [`MAX_THREADS`](phong_core::limits::MAX_THREADS), or none.
     #[error("threads must be from 1 to {max}, got {0}", max = phong_core::limits::MAX_THREADS)]
     ThreadCount(usize),
@@ -86,6 +70,14 @@ pub enum Error {
     /// An invalid image (from the core crate).
     #[error(transparent)]
     Core(#[from] phong_core::Error),
+}
+
+impl Error {
+    /// Whether the error is in what the caller asked for (the scene or the options), not in
+    /// the machine.
+    pub fn is_input(&self) -> bool {
+        matches!(self, Error::ThreadCount(_) | Error::Core(_))
+    }
 }
 
 /// How to render (what the scene does not say).
@@ -188,27 +180,37 @@ impl Renderer {
     pub fn into_image8(self) -> Option<Image8> {
         self.image8
     }
+
+    /// Renders `scene` into the target its PNG needs: 8 bits where they give the bytes of the
+    /// `f32` image ([`Renderer::render_8bit`]), else `f32` ([`Renderer::render`]). The one place
+    /// that choice is made.
+    pub fn render_for_png(
+        &mut self,
+        scene: &Scene,
+        options: &RenderOptions,
+    ) -> Result<(Rendered<'_>, RenderStats), Error> {
+        check(scene, options)?;
+        if Image8::exact_for_background(scene.image.background[3]) {
+            let (image, stats) = self.render_8bit(scene, options)?.expect("8 bits are exact here");
+            return Ok((Rendered::Eight(image), stats));
+        }
+        let (image, stats) = self.render(scene, options)?;
+        Ok((Rendered::Linear(image), stats))
+    }
+}
+
+/// A frame as [`Renderer::render_for_png`] drew it.
+#[derive(Clone, Copy, Debug)]
+pub enum Rendered<'a> {
+    /// Linear `f32` RGBA.
+    Linear(&'a Image),
+    /// 8 bits, in the scene's encoding.
+    Eight(&'a Image8),
 }
 
 /// The scene's and options' checks shared by both targets.
 fn check(scene: &Scene, options: &RenderOptions) -> Result<(), Error> {
-    let s = scene.image.samples;
-    if !phong_core::limits::SAMPLE_COUNTS.contains(&s) {
-        return Err(Error::Samples(s));
-    }
-    let (w, h) = (scene.image.width, scene.image.height);
-    if w == 0
-        || h == 0
-        || w > phong_core::limits::MAX_IMAGE_DIMENSION
-        || h > phong_core::limits::MAX_IMAGE_DIMENSION
-        || u64::from(w) * u64::from(h) * u64::from(s) > phong_core::limits::MAX_SAMPLES_TOTAL
-    {
-        return Err(Error::TooLarge {
-            width: w,
-            height: h,
-            samples: s,
-        });
-    }
+    scene.image.check()?;
     if let Some(n) = options.threads
         && !(1..=phong_core::limits::MAX_THREADS).contains(&n)
     {

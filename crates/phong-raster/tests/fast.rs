@@ -424,7 +424,7 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
     scene.image.width = 80;
     scene.image.height = 60;
     for alpha in [0.0, 0.5, 1.0] {
-        for samples in [1, 4, 16] {
+        for samples in phong_core::Samples::ALL {
             scene.image.background = [0.2, 0.4, 0.6, alpha];
             scene.image.samples = samples;
             let options = RenderOptions::default();

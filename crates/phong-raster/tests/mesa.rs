@@ -139,7 +139,7 @@ fn scene_with(
             width: 160,
             height: 120,
             background: [0.0, 0.0, 0.0, 1.0],
-            samples: 1,
+            samples: phong_core::Samples::One,
             encoding: Encoding::Linear,
         },
         camera,

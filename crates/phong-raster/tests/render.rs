@@ -22,7 +22,7 @@ fn scene(w: u32, h: u32, camera: Camera, objects: Vec<Object>, lighting: Lightin
             width: w,
             height: h,
             background: [0.0, 0.0, 0.0, 1.0],
-            samples: 1,
+            samples: Samples::One,
             encoding: Encoding::Linear,
         },
         shading: ShadingSettings {
@@ -210,7 +210,7 @@ fn jittered_grid(cells: u32, extent: f32, seed: u64) -> Mesh {
 #[test]
 fn mesh_covering_the_screen_covers_each_sample_once() {
     for (cells, seed) in [(1, 1), (5, 2), (20, 3)] {
-        for samples in [1, 4, 16] {
+        for samples in Samples::ALL {
             let mut s = scene(
                 37,
                 29,
@@ -496,7 +496,10 @@ fn interpolation_modes_against_core() {
 /// (x offsets 0.375, 0.875, 0.125, 0.625) left of it in pixel 10: half white.
 #[test]
 fn antialiasing_averages_samples() {
-    assert_eq!(sample_pattern(4).iter().filter(|(x, _)| *x < 0.5).count(), 2);
+    assert_eq!(
+        sample_pattern(Samples::Four).iter().filter(|(x, _)| *x < 0.5).count(),
+        2
+    );
     let (x0, x1) = (-8.0, 10.5 - 8.0);
     let quad = rect(x0, -8.0, x1, 8.0, 0.0);
     let mut s = scene(
@@ -507,7 +510,7 @@ fn antialiasing_averages_samples() {
         Lighting::default(),
         Interpolation::Phong,
     );
-    s.image.samples = 4;
+    s.image.samples = Samples::Four;
     let img = render(&s, &RenderOptions::default()).unwrap();
     assert_eq!(px(&img, 9, 5), Vec3::ONE);
     assert!(
@@ -580,16 +583,23 @@ fn rejects_bad_settings() {
         Lighting::default(),
         Interpolation::Phong,
     );
-    s.image.samples = 3;
-    assert!(
-        render(&s, &RenderOptions::default())
-            .unwrap_err()
-            .to_string()
-            .contains("1, 4 or 16")
-    );
-    s.image.samples = 1;
-    s.image.width = 1_000_000;
-    assert!(render(&s, &RenderOptions::default()).is_err());
+    // Sample counts other than 1, 4 and 16 cannot be asked for (`Samples`); sizes past the
+    // limits are refused, as the core crate's check says.
+    assert!(Samples::from_count(3).unwrap_err().to_string().contains("1, 4 or 16"));
+    for (w, h, samples) in [
+        (1_000_000, 8, Samples::One),
+        (0, 8, Samples::One),
+        (16384, 16384, Samples::Sixteen),
+    ] {
+        s.image.width = w;
+        s.image.height = h;
+        s.image.samples = samples;
+        let e = render(&s, &RenderOptions::default()).unwrap_err();
+        assert!(
+            e.is_input() && e.to_string().contains("cannot be rendered"),
+            "{w}x{h}: {e}"
+        );
+    }
 }
 
 /// OpenGL's two-sided lighting decides by polygon facing, not by the sign of N·V: a back-facing

@@ -11,6 +11,7 @@ mod error;
 mod json_scene;
 mod model;
 mod obj;
+mod overrides;
 mod png_out;
 mod read;
 mod toml_scene;
@@ -19,6 +20,7 @@ pub use error::Error;
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
 pub use model::{ModelView, model_scene, model_view};
 pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
+pub use overrides::Overrides;
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
 pub use toml_scene::{

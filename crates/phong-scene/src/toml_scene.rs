@@ -4,13 +4,14 @@
 //! with the span toml gives; values that need checking are read as
 //! `Spanned` so that a bad one is reported at its own line and column.
 
+use crate::overrides::Overrides;
 use crate::{Error, Loaded, ObjPart, load_obj_sources};
 use glam::{EulerRot, Mat4, Quat, Vec3};
-use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS, SAMPLE_COUNTS};
+use phong_core::limits::{MAX_IMAGE_DIMENSION, MAX_LIGHTS, MAX_SEGMENTS};
 use phong_core::{
     Attenuation, Camera, Color, Encoding, ImageSettings, Interpolation, Label, Light, LightColor, Lighting, LyonLambda,
-    Material, Mesh, Normalization, Object, Output, Projection, Scene, ShadingOptions, ShadingSettings, SpecularModel,
-    Viewer, nearest_names, normalize_name, primitives,
+    Material, Mesh, Normalization, Object, Output, Projection, Samples, Scene, ShadingOptions, ShadingSettings,
+    SpecularModel, Viewer, nearest_names, normalize_name, primitives,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -426,23 +427,22 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
         let mat = material(ctx, m.get_ref(), &key, &named)?;
         named.insert(normalize_name(name), mat);
     }
-    let lyon = match shading.options.specular {
-        SpecularModel::Lyon { squarings, lambda } => (squarings, lambda),
-        _ => (3, LyonLambda::Dot),
-    };
     let mut objects = Vec::new();
     for o in &raw.object {
-        let mut sh = shading;
         let r = o.get_ref();
-        if let Some(m) = &r.model {
-            apply_model(&mut sh.options, ctx.choice(m, "model", MODELS)?, lyon);
-        }
-        if let Some(i) = &r.interpolation {
-            sh.interpolation = ctx.choice(i, "interpolation", INTERPOLATIONS)?;
-        }
-        if let Some(out) = &r.output {
-            sh.output = ctx.choice(out, "output", OUTPUTS)?;
-        }
+        let overrides = Overrides {
+            model: r.model.as_ref().map(|m| ctx.choice(m, "model", MODELS)).transpose()?,
+            interpolation: (r.interpolation.as_ref())
+                .map(|i| ctx.choice(i, "interpolation", INTERPOLATIONS))
+                .transpose()?,
+            output: r
+                .output
+                .as_ref()
+                .map(|o| ctx.choice(o, "output", OUTPUTS))
+                .transpose()?,
+        };
+        let mut sh = shading;
+        overrides.apply(&mut sh);
         objects.extend(object(ctx, o, &named, sh)?);
     }
     let mut labels = Vec::new();
@@ -491,14 +491,15 @@ fn image_settings(ctx: &Ctx, r: RawImage) -> Result<ImageSettings, Error> {
     }
     if let Some(a) = &r.antialias {
         let v = *a.get_ref();
-        if !SAMPLE_COUNTS.iter().any(|&c| i64::from(c) == v) {
+        let samples = u32::try_from(v).ok().and_then(|n| Samples::from_count(n).ok());
+        let Some(samples) = samples else {
             return ctx.err(
                 &a.span(),
                 "antialias",
                 format!("must be 1, 4 or 16 samples per pixel, got {v}"),
             );
-        }
-        s.samples = v as u32;
+        };
+        s.samples = samples;
     }
     if let Some(e) = &r.encoding {
         s.encoding = ctx.choice(e, "encoding", ENCODINGS)?;

@@ -26,7 +26,7 @@ fn assert_err(src: &str, want: &[&str]) {
 #[test]
 fn empty_scene_has_opengl_defaults() {
     let s = parse("").unwrap();
-    assert_eq!((s.image.width, s.image.height, s.image.samples), (800, 600, 1));
+    assert_eq!((s.image.width, s.image.height, s.image.samples), (800, 600, Samples::One));
     assert_eq!(s.lighting.ambient(), Color::splat(0.2));
     // No light: one white directional light from the camera (travelling along its view direction).
     assert_eq!(s.lighting.lights().len(), 1);

@@ -323,7 +323,7 @@ fn scene_from_json(state: &AppState, client: &str, value: &Value) -> Result<Scen
     let (w, h, s) = (
         u64::from(scene.image.width),
         u64::from(scene.image.height),
-        u64::from(scene.image.samples),
+        u64::from(scene.image.samples.count()),
     );
     if w * h > SERVE_MAX_PIXELS {
         return Err(ApiError {

@@ -37,6 +37,13 @@ pub enum StartError {
     System(String),
 }
 
+impl StartError {
+    /// Whether the error is in what the user gave (the file, the address).
+    pub fn is_input(&self) -> bool {
+        matches!(self, StartError::Input(_) | StartError::Usage(_))
+    }
+}
+
 /// The initial scene for `file` (a scene `.toml`, a model `.obj`, or the default scene), as
 /// JSON, and the models it names, loaded from disk by the operator's command (requests never
 /// name files).

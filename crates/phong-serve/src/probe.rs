@@ -218,7 +218,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     let encoding = scene.image.encoding;
     let bg = scene.image.background;
     let mut notes = Vec::new();
-    if scene.image.samples > 1 {
+    if scene.image.samples != phong_core::Samples::One {
         notes.push(format!(
             "antialias {}: the pixel averages {} samples; the probe is the surface at the pixel's centre",
             scene.image.samples, scene.image.samples

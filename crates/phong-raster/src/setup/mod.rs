@@ -368,7 +368,7 @@ mod tests {
         let mut bits = xorshift(0x9e37_79b9_7f4a_7c15u64);
         let mut next = |range: i64| (bits() % range as u64) as i64;
         let (mut culled, mut tight) = (0, 0usize);
-        for n in [1, 4, 16] {
+        for n in phong_core::Samples::ALL {
             let pattern = pattern(n);
             for k in 0..3000 {
                 // Half of them within about two pixels, the rest up to 12 pixels across.

@@ -1,0 +1,197 @@
+//! The arguments `render` and `bench` share, resolved once: the flags checked, the scene
+//! loaded with its warnings printed, and the overrides applied.
+
+use crate::InputError;
+use anyhow::{Context, Result, bail};
+use phong_raster::RenderOptions;
+use phong_scene::{INTERPOLATIONS, MODELS, OUTPUTS, Overrides, parse_choice};
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    /// The multi-core CPU rasteriser.
+    Cpu,
+    /// The wgpu renderer (an error when no adapter is found).
+    Gpu,
+    /// The GPU when an adapter is found, else the CPU.
+    Auto,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum GpuPathArg {
+    /// On a GPU the compute rasterizer where it can draw the frame, else the pipeline; on a
+    /// CPU adapter (lavapipe) the pipeline.
+    Auto,
+    /// The GPU's render pipeline (its own rasterizer).
+    Pipeline,
+    /// The compute rasterizer (an error where it cannot draw the frame).
+    Compute,
+}
+
+/// What `render` and `bench` share: the input, its overrides and how to render it.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// Scene file (.toml) or model (.obj).
+    pub input: PathBuf,
+    /// Image width in pixels (overrides the scene).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (overrides the scene).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Rendering threads for the CPU backend (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub backend: Backend,
+    /// GPU: how frames are drawn.
+    #[arg(long, value_enum, default_value_t = GpuPathArg::Auto)]
+    pub gpu_path: GpuPathArg,
+    /// CPU: the scalar reference path instead of the fast path.
+    #[arg(long)]
+    pub reference: bool,
+    /// Print counts, the backend and the time of each stage.
+    #[arg(short, long)]
+    pub verbose: bool,
+}
+
+/// The shading overrides `render` takes (as an object's keys override the scene's
+/// `[shading]`).
+#[derive(clap::Args)]
+pub struct ShadingArgs {
+    /// Samples per pixel: 1, 4 or 16 (overrides the scene).
+    #[arg(long)]
+    pub antialias: Option<u32>,
+    /// Shading model: lambert, phong, blinn-phong, phong-lyon, opengl.
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Interpolation: flat, gouraud, phong.
+    #[arg(long)]
+    pub interpolation: Option<String>,
+    /// What to show: color, ambient, diffuse, specular, normal, depth.
+    #[arg(long = "output", value_name = "TERM")]
+    pub term: Option<String>,
+}
+
+/// A run's arguments resolved: the scene as it will be rendered, every file it read, and the
+/// renderer's settings.
+pub struct Job {
+    pub scene: phong_core::Scene,
+    pub sources: Vec<PathBuf>,
+    pub input: PathBuf,
+    pub threads: Option<usize>,
+    pub backend: Backend,
+    pub gpu_path: GpuPathArg,
+    pub reference: bool,
+    pub verbose: bool,
+}
+
+impl RunArgs {
+    /// Checks the flags, loads the scene (printing its warnings), and applies the size and
+    /// `shading` overrides.
+    pub fn resolve(self, shading: Option<&ShadingArgs>) -> Result<Job> {
+        let max = phong_core::limits::MAX_IMAGE_DIMENSION;
+        for (flag, v) in [("--width", self.width), ("--height", self.height)] {
+            if let Some(v) = v
+                && !(1..=max).contains(&v)
+            {
+                bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
+            }
+        }
+        if let Some(t) = self.threads
+            && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
+        {
+            bail!(InputError(format!(
+                "--threads must be from 1 to {}, got {t}",
+                phong_core::limits::MAX_THREADS
+            )));
+        }
+        let overrides = shading.map(ShadingArgs::overrides).transpose()?.unwrap_or_default();
+        let samples = match shading.and_then(|s| s.antialias) {
+            Some(n) => Some(
+                phong_core::Samples::from_count(n)
+                    .map_err(|_| InputError(format!("--antialias must be 1, 4 or 16, got {n}")))?,
+            ),
+            None => None,
+        };
+        let loaded = phong_scene::load(&self.input)?;
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        let mut scene = loaded.scene;
+        if let Some(w) = self.width {
+            scene.image.width = w;
+        }
+        if let Some(h) = self.height {
+            scene.image.height = h;
+        }
+        if let Some(s) = samples {
+            scene.image.samples = s;
+        }
+        overrides.apply_to_scene(&mut scene);
+        Ok(Job {
+            scene,
+            sources: loaded.sources,
+            input: self.input,
+            threads: self.threads,
+            backend: self.backend,
+            gpu_path: self.gpu_path,
+            reference: self.reference,
+            verbose: self.verbose,
+        })
+    }
+}
+
+impl ShadingArgs {
+    /// The flags as scene overrides (each checked against its names).
+    fn overrides(&self) -> Result<Overrides> {
+        Ok(Overrides {
+            model: choice("--model", &self.model, MODELS)?,
+            interpolation: choice("--interpolation", &self.interpolation, INTERPOLATIONS)?,
+            output: choice("--output", &self.term, OUTPUTS)?,
+        })
+    }
+}
+
+/// `value` of `flag` looked up in `table`, if given.
+fn choice<T: Copy>(flag: &str, value: &Option<String>, table: &[(&str, T)]) -> Result<Option<T>> {
+    Ok(value
+        .as_deref()
+        .map(|v| parse_choice(flag, v, table).map_err(InputError))
+        .transpose()?)
+}
+
+impl Job {
+    /// The CPU renderer's options.
+    pub fn options<'a>(&self, progress: Option<&'a (dyn Fn(u64, u64) + Sync)>) -> RenderOptions<'a> {
+        RenderOptions {
+            threads: self.threads,
+            progress,
+            reference: self.reference,
+            no_avx2: false,
+        }
+    }
+
+    /// The GPU when asked for (an error if there is none), or for `auto` when one is found.
+    pub fn open_gpu(&self) -> Result<Option<phong_gpu::Gpu>> {
+        open_gpu(self.backend, self.gpu_path)
+    }
+}
+
+/// The GPU when asked for (an error if there is none), or for `auto` when one is found.
+pub fn open_gpu(backend: Backend, path: GpuPathArg) -> Result<Option<phong_gpu::Gpu>> {
+    let mut gpu = match backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(phong_gpu::Gpu::new().context("--backend gpu")?),
+        Backend::Auto => phong_gpu::Gpu::new().ok(),
+    };
+    if let Some(g) = &mut gpu {
+        g.set_path(match path {
+            GpuPathArg::Auto => phong_gpu::GpuPath::Auto,
+            GpuPathArg::Pipeline => phong_gpu::GpuPath::Pipeline,
+            GpuPathArg::Compute => phong_gpu::GpuPath::Compute,
+        });
+    }
+    Ok(gpu)
+}
