@@ -236,8 +236,6 @@ pub struct Scene {
     pub camera: Camera,
     /// Ambient light and lights.
     pub lighting: Lighting,
-    /// Shading settings.
-    pub shading: ShadingSettings,
     /// The objects.
     pub objects: Vec<Object>,
     /// Text over the image.

@@ -49,7 +49,6 @@ fn scene(lights: Vec<Light>, options: ShadingOptions, material: Material, interp
         },
         camera,
         lighting: Lighting::new(Color::splat(0.2), lights).expect("lights"),
-        shading,
         objects: vec![Object {
             name: "sphere".into(),
             mesh: primitives::sphere(96),

@@ -144,7 +144,6 @@ fn scene_with(
         },
         camera,
         lighting: Lighting::new(ambient, lights).unwrap(),
-        shading,
         objects: vec![Object {
             name: "test".into(),
             mesh,

@@ -16,7 +16,12 @@ fn ortho_camera(height: f32) -> Camera {
     .unwrap()
 }
 
-fn scene(w: u32, h: u32, camera: Camera, objects: Vec<Object>, lighting: Lighting, interp: Interpolation) -> Scene {
+/// A scene of `objects`, each shaded with `interp` and the camera's default viewer.
+fn scene(w: u32, h: u32, camera: Camera, mut objects: Vec<Object>, lighting: Lighting, interp: Interpolation) -> Scene {
+    for o in &mut objects {
+        o.shading.interpolation = interp;
+        o.shading.viewer = camera.default_viewer();
+    }
     Scene {
         image: ImageSettings {
             width: w,
@@ -24,12 +29,6 @@ fn scene(w: u32, h: u32, camera: Camera, objects: Vec<Object>, lighting: Lightin
             background: [0.0, 0.0, 0.0, 1.0],
             samples: Samples::One,
             encoding: Encoding::Linear,
-        },
-        shading: ShadingSettings {
-            options: ShadingOptions::default(),
-            interpolation: interp,
-            viewer: camera.default_viewer(),
-            output: Output::Color,
         },
         camera,
         lighting,
@@ -52,13 +51,15 @@ fn obj(mesh: Mesh, material: Material) -> Object {
     }
 }
 
-/// Renders with the scene's shading settings given to every object (the tests set `s.shading`).
 fn render(s: &Scene, o: &RenderOptions) -> Result<Image, phong_raster::Error> {
-    let mut s = s.clone();
-    for ob in &mut s.objects {
-        ob.shading = s.shading;
+    phong_raster::render(s, o)
+}
+
+/// Changes every object's shading settings.
+fn each(s: &mut Scene, f: impl Fn(&mut ShadingSettings)) {
+    for o in &mut s.objects {
+        f(&mut o.shading);
     }
-    phong_raster::render(&s, o)
 }
 
 fn one_light(dir: Vec3) -> Lighting {
@@ -117,7 +118,7 @@ fn orthographic_sphere_matches_closed_form() {
                     &view,
                     &m,
                     &s.lighting,
-                    &s.shading.options,
+                    &s.objects[0].shading.options,
                 );
                 let want = Vec3::from(sh.color.to_array());
                 worst = worst.max((got - want).abs().max_element());
@@ -305,7 +306,7 @@ fn perspective_correct_interpolation_and_near_clipping() {
         one_light(-Vec3::Y),
         Interpolation::Phong,
     );
-    s.shading.output = Output::Depth;
+    each(&mut s, |sh| sh.output = Output::Depth);
     let img = render(&s, &RenderOptions::default()).unwrap();
     let t = (30f32).to_radians().tan();
     let aspect = w as f32 / h as f32;
@@ -465,8 +466,8 @@ fn interpolation_modes_against_core() {
                 lighting.clone(),
                 interp,
             );
-            s.shading.options.specular = model;
-            s.shading.viewer = Viewer::Local; // per-point V, to exercise positions too
+            each(&mut s, |sh| sh.options.specular = model);
+            each(&mut s, |sh| sh.viewer = Viewer::Local); // per-point V, to exercise positions too
             let img = render(&s, &RenderOptions::default()).unwrap();
             let view = s.camera.view(Viewer::Local);
             let sh = |p: Vec3, nrm: Vec3| {
@@ -478,7 +479,7 @@ fn interpolation_modes_against_core() {
                     &view,
                     &m,
                     &lighting,
-                    &s.shading.options,
+                    &s.objects[0].shading.options,
                 );
                 Vec3::from(r.color.to_array())
             };
@@ -539,7 +540,7 @@ fn back_face_culling() {
         Interpolation::Phong,
     );
     assert_eq!(px(&render(&s, &RenderOptions::default()).unwrap(), 4, 4), Vec3::ZERO);
-    s.shading.options.two_sided = true;
+    each(&mut s, |sh| sh.options.two_sided = true);
     assert_eq!(px(&render(&s, &RenderOptions::default()).unwrap(), 4, 4), Vec3::ONE);
 }
 
@@ -635,7 +636,7 @@ fn two_sided_lighting_follows_polygon_facing() {
             lighting.clone(),
             interp,
         );
-        s.shading.options.two_sided = true;
+        each(&mut s, |sh| sh.options.two_sided = true);
         let img = render(&s, &RenderOptions::default()).unwrap();
         let view = s.camera.view(Viewer::Infinite);
         let one_sided = ShadingOptions::default();

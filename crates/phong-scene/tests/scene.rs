@@ -26,14 +26,19 @@ fn assert_err(src: &str, want: &[&str]) {
 #[test]
 fn empty_scene_has_opengl_defaults() {
     let s = parse("").unwrap();
-    assert_eq!((s.image.width, s.image.height, s.image.samples), (800, 600, Samples::One));
+    assert_eq!(
+        (s.image.width, s.image.height, s.image.samples),
+        (800, 600, Samples::One)
+    );
     assert_eq!(s.lighting.ambient(), Color::splat(0.2));
     // No light: one white directional light from the camera (travelling along its view direction).
     assert_eq!(s.lighting.lights().len(), 1);
     assert_eq!(s.lighting.lights()[0].to_light(), Some(-s.camera.forward()));
-    assert_eq!(s.shading.options, ShadingOptions::default());
-    assert_eq!(s.shading.viewer, Viewer::Local);
     assert!(s.objects.is_empty());
+    // An object without `[shading]`: the default options, a local viewer.
+    let s = parse("[[object]]\nshape = \"cube\"\n").unwrap();
+    assert_eq!(s.objects[0].shading.options, ShadingOptions::default());
+    assert_eq!(s.objects[0].shading.viewer, Viewer::Local);
 }
 
 #[test]
@@ -67,7 +72,7 @@ material = "Shiny"
 "#,
     )
     .unwrap();
-    assert_eq!(s.shading.viewer, Viewer::Infinite);
+    assert!(s.objects.iter().all(|o| o.shading.viewer == Viewer::Infinite));
     let clay = s.objects[0].material;
     assert_eq!(clay.ambient(), Color::new(0.8, 0.5, 0.3));
     assert_eq!(clay.specular(), Color::WHITE);
@@ -89,20 +94,22 @@ material = "Shiny"
 
 #[test]
 fn models_and_options() {
+    // The `[shading]` section, as the scene's one object gets it.
+    let parse = |src: &str| parse(&format!("{src}[[object]]\nshape = \"cube\"\n")).map(|s| s.objects[0].shading);
     let s = parse("[shading]\nmodel = \"phong-lyon\"\nlyon_squarings = 4\nlyon_lambda = \"difference\"\n").unwrap();
     assert_eq!(
-        s.shading.options.specular,
+        s.options.specular,
         SpecularModel::Lyon {
             squarings: 4,
             lambda: LyonLambda::Difference
         }
     );
     let s = parse("[shading]\nmodel = \"opengl\"\ntwo_sided = true\n").unwrap();
-    assert_eq!(s.shading.options, ShadingOptions::opengl(true));
+    assert_eq!(s.options, ShadingOptions::opengl(true));
     let s = parse("[shading]\nmodel = \"lambert\"\nnormalization = \"blinn-phong-exact\"\nclamp = false\n").unwrap();
-    assert_eq!(s.shading.options.specular, SpecularModel::None);
-    assert_eq!(s.shading.options.normalization, Normalization::BlinnPhongExact);
-    assert!(!s.shading.options.clamp);
+    assert_eq!(s.options.specular, SpecularModel::None);
+    assert_eq!(s.options.normalization, Normalization::BlinnPhongExact);
+    assert!(!s.options.clamp);
 }
 
 #[test]

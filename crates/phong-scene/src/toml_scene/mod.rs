@@ -1,0 +1,159 @@
+//! The TOML scene format (see README.md for every key), a module a section.
+//!
+//! serde with `deny_unknown_fields` rejects unknown keys and wrong types with the span toml
+//! gives (`raw`); values that need checking are read as `Spanned` so that a bad one is
+//! reported at its own line and column (`ctx`).
+
+mod camera;
+mod choices;
+mod ctx;
+mod image;
+mod light;
+mod material;
+mod object;
+mod raw;
+mod shading;
+
+pub use choices::{INTERPOLATIONS, MODELS, Model, OUTPUTS, apply_model, parse_choice};
+pub use ctx::MeshLookup;
+
+use crate::overrides::Overrides;
+use crate::{Error, Loaded};
+use camera::camera;
+use ctx::Ctx;
+use image::image_settings;
+use light::light;
+use material::material;
+use object::object;
+use phong_core::limits::MAX_LIGHTS;
+use phong_core::{Color, Label, Light, LightColor, Lighting, Scene, normalize_name};
+use raw::RawScene;
+use shading::shading;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Parses a scene file's text; `path` names it in errors and anchors relative mesh paths.
+pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
+    parse_scene_with(src, path, None)
+}
+
+/// [`parse_scene`] with meshes from `meshes` instead of the file system (when given).
+pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, Error> {
+    let raw: RawScene = toml::from_str(src).map_err(|e| {
+        let offset = e.span().map_or(0, |s| s.start);
+        // The whole line the error is on (an error at a key's start, as "duplicate key", has
+        // nothing before it on the line).
+        let offset_c = offset.min(src.len());
+        let start = src[..offset_c].rfind('\n').map_or(0, |i| i + 1);
+        let end = src[offset_c..].find('\n').map_or(src.len(), |i| offset_c + i);
+        let line_text = src.get(start..end).unwrap_or("");
+        let key = line_text
+            .split_once('=')
+            .map(|(k, _)| k.trim().to_string())
+            .filter(|k| !k.is_empty())
+            .map(|k| unquote_key(&k));
+        let message = e
+            .message()
+            .trim()
+            .replace("expected i64", "expected an integer")
+            .replace("expected f32", "expected a number")
+            .replace("expected a sequence", "expected an array");
+        Error::at(path, src, offset, key.as_deref(), message)
+    })?;
+    let mut ctx = Ctx {
+        path,
+        src,
+        warnings: Vec::new(),
+        sources: Vec::new(),
+        triangles: std::cell::Cell::new(0),
+        meshes,
+    };
+    let scene = build(&mut ctx, raw)?;
+    Ok(Loaded {
+        scene,
+        warnings: ctx.warnings,
+        sources: ctx.sources,
+    })
+}
+
+/// A quoted key (`"my key"`) as the key itself; a bare key as it is.
+fn unquote_key(k: &str) -> String {
+    if (k.starts_with('"') || k.starts_with('\''))
+        && let Ok(t) = toml::from_str::<toml::Table>(&format!("{k} = 0"))
+        && let Some(name) = t.keys().next()
+    {
+        return name.clone();
+    }
+    k.to_string()
+}
+
+fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
+    let image = image_settings(ctx, raw.image.unwrap_or_default())?;
+    let camera = camera(ctx, raw.camera.unwrap_or_default())?;
+    let shading = shading(ctx, raw.shading.as_ref(), &camera)?;
+    let ambient = match raw.shading.as_ref().and_then(|s| s.ambient.as_ref()) {
+        Some(a) => ctx.color(a, "ambient")?,
+        None => Color::splat(0.2),
+    };
+    if raw.light.len() > MAX_LIGHTS {
+        return ctx.err(
+            &raw.light[MAX_LIGHTS].span(),
+            "light",
+            format!("at most {MAX_LIGHTS} lights"),
+        );
+    }
+    let mut lights = Vec::new();
+    for l in &raw.light {
+        lights.push(light(ctx, l)?);
+    }
+    if raw.light.is_empty() {
+        // OpenGL's light 0 in eye space, (0, 0, 1, 0): white, from the camera.
+        lights.push(Light::directional(camera.forward(), LightColor::default()).expect("unit direction"));
+    }
+    let lighting = Lighting::new(ambient, lights).expect("checked colour");
+    let mut named = BTreeMap::new();
+    for (name, m) in &raw.materials {
+        let key = format!("materials.{name}");
+        let mat = material(ctx, m.get_ref(), &key, &named)?;
+        named.insert(normalize_name(name), mat);
+    }
+    let mut objects = Vec::new();
+    for o in &raw.object {
+        let r = o.get_ref();
+        let overrides = Overrides {
+            model: r.model.as_ref().map(|m| ctx.choice(m, "model", MODELS)).transpose()?,
+            interpolation: (r.interpolation.as_ref())
+                .map(|i| ctx.choice(i, "interpolation", INTERPOLATIONS))
+                .transpose()?,
+            output: r
+                .output
+                .as_ref()
+                .map(|o| ctx.choice(o, "output", OUTPUTS))
+                .transpose()?,
+        };
+        let mut sh = shading;
+        overrides.apply(&mut sh);
+        objects.extend(object(ctx, o, &named, sh)?);
+    }
+    let mut labels = Vec::new();
+    for l in &raw.label {
+        let l = l.get_ref();
+        let size = match &l.size {
+            Some(sz) => ctx.int(sz, "size", 1, 64)? as u32,
+            None => 2,
+        };
+        labels.push(Label {
+            text: l.text.get_ref().clone(),
+            position: ctx.vec3(&l.position, "position")?,
+            color: ctx.opt_color(&l.color, "color")?.unwrap_or(Color::WHITE),
+            size,
+        });
+    }
+    Ok(Scene {
+        image,
+        camera,
+        lighting,
+        objects,
+        labels,
+    })
+}

@@ -1,0 +1,210 @@
+//! `[[object]]`: a shape or a mesh file, its transform, material and shading.
+
+use super::choices::SHAPES;
+use super::ctx::{Ctx, S};
+use super::material::{lookup_material, material};
+use super::raw::{MaterialRef, RawMaterial, RawObject, Scale};
+use crate::Error;
+use crate::load_obj_sources;
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use phong_core::limits::MAX_SEGMENTS;
+use phong_core::{Material, Mesh, Object, ShadingSettings, primitives};
+use std::collections::BTreeMap;
+use std::path::Path;
+use toml::Spanned;
+
+pub(super) fn object(
+    ctx: &mut Ctx,
+    o: &S<RawObject>,
+    named: &BTreeMap<String, Material>,
+    shading: ShadingSettings,
+) -> Result<Vec<Object>, Error> {
+    let span = o.span();
+    let o = o.get_ref();
+    let material = match &o.material {
+        None => None,
+        Some(m) => Some(match m.get_ref() {
+            MaterialRef::Name(n) => lookup_material(ctx, &Spanned::new(m.span(), n.clone()), named)?,
+            MaterialRef::Inline(p) => {
+                let sp = |v: &Option<Vec<f32>>| v.clone().map(|v| Spanned::new(m.span(), v));
+                let spf = |v: Option<f32>| v.map(|v| Spanned::new(m.span(), v));
+                let raw = RawMaterial {
+                    base: p.base.clone().map(|b| Spanned::new(m.span(), b)),
+                    paint: sp(&p.paint),
+                    ambient: sp(&p.ambient),
+                    diffuse: sp(&p.diffuse),
+                    specular: sp(&p.specular),
+                    emission: sp(&p.emission),
+                    shininess: spf(p.shininess),
+                    alpha: spf(p.alpha),
+                };
+                material(ctx, &raw, "material", named)?
+            }
+        }),
+    };
+    let world_from_object = transform(ctx, o)?;
+    let normals_choice = o.normals.as_ref();
+    let crease = match &o.crease {
+        Some(c) => ctx.num(c, "crease", |x| (0.0..=180.0).contains(&x), "in [0, 180] degrees")?,
+        None => 60.0,
+    };
+    let apply_normals = |mesh: Mesh, default: &str, allowed: &[&str]| -> Result<Mesh, Error> {
+        let choice = match normals_choice {
+            Some(n) => ctx.name(n, "normals", allowed)?,
+            None => default,
+        };
+        Ok(match choice {
+            "flat" => mesh.with_flat_normals(),
+            "smooth" => mesh.with_smooth_normals(),
+            "angle" => mesh.with_crease_normals(crease),
+            _ => mesh,
+        })
+    };
+    match (&o.shape, &o.mesh) {
+        (Some(_), Some(m)) | (None, Some(m)) if o.shape.is_some() => {
+            ctx.err(&m.span(), "mesh", "an object has either `shape` or `mesh`, not both")
+        }
+        (Some(shape), None) => {
+            let kind = ctx.name(shape, "shape", SHAPES)?;
+            let default_segments = match kind {
+                "plane" => 1,
+                "teapot" => 10,
+                _ => 64,
+            };
+            let min = if matches!(kind, "plane" | "teapot") { 1 } else { 3 };
+            let segments = match &o.segments {
+                Some(s) => ctx.int(s, "segments", min, i64::from(MAX_SEGMENTS))? as u32,
+                None => default_segments,
+            };
+            let n = u64::from(segments);
+            let triangles = match kind {
+                "teapot" => 64 * n * n,
+                "plane" => 2 * n * n,
+                "cube" => 12,
+                _ => n * n + 4 * n,
+            };
+            if triangles > phong_core::limits::MAX_PRIMITIVE_TRIANGLES {
+                let span = o.segments.as_ref().map_or(span.clone(), |s| s.span());
+                return ctx.err(
+                    &span,
+                    "segments",
+                    format!(
+                        "a {kind} with {segments} segments has about {triangles} triangles; the limit is {}",
+                        phong_core::limits::MAX_PRIMITIVE_TRIANGLES
+                    ),
+                );
+            }
+            ctx.add_triangles(
+                triangles,
+                &o.segments.as_ref().map_or(span.clone(), |s| s.span()),
+                "segments",
+            )?;
+            if kind != "torus" {
+                for (v, key) in [(&o.radius, "radius"), (&o.tube, "tube")] {
+                    if let Some(v) = v {
+                        return ctx.err(&v.span(), key, format!("only a torus has `{key}`; use `scale`"));
+                    }
+                }
+            }
+            let mesh = match kind {
+                "sphere" => primitives::sphere(segments),
+                "torus" => {
+                    let r = match &o.radius {
+                        Some(r) => ctx.num(r, "radius", |x| x > 0.0, "> 0")?,
+                        None => 1.0,
+                    };
+                    let t = match &o.tube {
+                        Some(t) => ctx.num(t, "tube", |x| x > 0.0, "> 0")?,
+                        None => 0.25,
+                    };
+                    primitives::torus(segments, r, t)
+                }
+                "cylinder" => primitives::cylinder(segments),
+                "cone" => primitives::cone(segments),
+                "cube" => primitives::cube(),
+                "plane" => primitives::plane(segments),
+                _ => primitives::teapot(segments),
+            };
+            let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
+            Ok(vec![Object {
+                name: kind.to_string(),
+                mesh: mesh.transformed(&world_from_object),
+                material: material.unwrap_or_default(),
+                shading,
+            }])
+        }
+        (None, Some(m)) => {
+            if let Some(s) = &o.segments {
+                return ctx.err(&s.span(), "segments", "a mesh has no `segments`");
+            }
+            let mut warnings = Vec::new();
+            let mut sources = Vec::new();
+            let parts = match ctx.meshes {
+                Some(lookup) => match lookup(m.get_ref()) {
+                    Ok(parts) => parts,
+                    Err(msg) => return ctx.err(&m.span(), "mesh", msg),
+                },
+                None => {
+                    let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
+                    if !file.exists() {
+                        return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
+                    }
+                    let ext_ok = file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+                    if !ext_ok {
+                        return ctx.err(&m.span(), "mesh", "only Wavefront .obj meshes are supported");
+                    }
+                    load_obj_sources(&file, &mut warnings, &mut sources)?
+                }
+            };
+            let mut out = Vec::new();
+            for p in parts {
+                let default = if p.has_normals { "file" } else { "angle" };
+                let mesh = apply_normals(p.mesh, default, &["file", "flat", "smooth", "angle"])?;
+                out.push(Object {
+                    name: p.name,
+                    mesh: mesh.transformed(&world_from_object),
+                    material: material.or(p.material).unwrap_or_default(),
+                    shading,
+                });
+            }
+            let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();
+            ctx.warnings.extend(warnings);
+            ctx.sources.extend(sources);
+            ctx.add_triangles(tris, &m.span(), "mesh")?;
+            Ok(out)
+        }
+        _ => ctx.err(
+            &span,
+            "object",
+            "an object needs `shape` (sphere, torus, ...) or `mesh` (a file)",
+        ),
+    }
+}
+
+/// `world_from_object = T · Rz · Ry · Rx · S`: scale, then rotate about x, y, z (degrees), then move.
+pub(super) fn transform(ctx: &Ctx, o: &RawObject) -> Result<Mat4, Error> {
+    let t = o
+        .position
+        .as_ref()
+        .map_or(Ok(Vec3::ZERO), |p| ctx.vec3(p, "position"))?;
+    let r = o
+        .rotation
+        .as_ref()
+        .map_or(Ok(Vec3::ZERO), |p| ctx.vec3(p, "rotation"))?;
+    let s = match &o.scale {
+        None => Vec3::ONE,
+        Some(sc) => {
+            let v = match sc.get_ref() {
+                Scale::Uniform(k) => Vec3::splat(*k),
+                Scale::Axes(v) if v.len() == 3 => Vec3::new(v[0], v[1], v[2]),
+                Scale::Axes(_) => return ctx.err(&sc.span(), "scale", "expected a number or [x, y, z]"),
+            };
+            if !v.is_finite() || v.cmpeq(Vec3::ZERO).any() {
+                return ctx.err(&sc.span(), "scale", "must be finite and non-zero");
+            }
+            v
+        }
+    };
+    let q = Quat::from_euler(EulerRot::ZYX, r.z.to_radians(), r.y.to_radians(), r.x.to_radians());
+    Ok(Mat4::from_scale_rotation_translation(s, q, t))
+}
