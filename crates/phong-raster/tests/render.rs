@@ -1,5 +1,7 @@
 //! The rasteriser against closed-form images and the core crate's `shade`.
 
+mod common;
+
 use glam::{Mat4, Vec3};
 use phong_core::*;
 use phong_raster::{RenderOptions, coverage_counts, sample_pattern};
@@ -100,35 +102,38 @@ fn orthographic_sphere_matches_closed_form() {
         one_light(light),
         Interpolation::Phong,
     );
-    let img = render(&s, &RenderOptions::default()).unwrap();
-    let view = s.camera.view(Viewer::Infinite);
-    let mut worst = 0.0f32;
-    let mut inside = 0;
-    for y in 0..n {
-        for x in 0..n {
-            let (wx, wy) = ortho_world(x, y, n, height);
-            let r2 = wx * wx + wy * wy;
-            let got = px(&img, x, y);
-            if r2 > 1.02 * 1.02 {
-                assert_eq!(got, Vec3::ZERO, "background at ({x}, {y})");
-            } else if r2 < 0.98 * 0.98 {
-                let p = Vec3::new(wx, wy, (1.0 - r2).sqrt());
-                let sh = shade(
-                    &SurfacePoint { position: p, normal: p },
-                    &view,
-                    &m,
-                    &s.lighting,
-                    &s.objects[0].shading.options,
-                );
-                let want = Vec3::from(sh.color.to_array());
-                worst = worst.max((got - want).abs().max_element());
-                inside += 1;
+    for path in common::paths() {
+        let img = path.render(&s);
+        eprintln!("{}", path.name);
+        let view = s.camera.view(Viewer::Infinite);
+        let mut worst = 0.0f32;
+        let mut inside = 0;
+        for y in 0..n {
+            for x in 0..n {
+                let (wx, wy) = ortho_world(x, y, n, height);
+                let r2 = wx * wx + wy * wy;
+                let got = px(&img, x, y);
+                if r2 > 1.02 * 1.02 {
+                    assert_eq!(got, Vec3::ZERO, "background at ({x}, {y})");
+                } else if r2 < 0.98 * 0.98 {
+                    let p = Vec3::new(wx, wy, (1.0 - r2).sqrt());
+                    let sh = shade(
+                        &SurfacePoint { position: p, normal: p },
+                        &view,
+                        &m,
+                        &s.lighting,
+                        &s.objects[0].shading.options,
+                    );
+                    let want = Vec3::from(sh.color.to_array());
+                    worst = worst.max((got - want).abs().max_element());
+                    inside += 1;
+                }
             }
         }
+        eprintln!("sphere: largest error {worst} over {inside} pixels");
+        assert!(inside > 20000);
+        assert!(worst < 0.001, "largest error {worst}");
     }
-    eprintln!("sphere: largest error {worst} over {inside} pixels");
-    assert!(inside > 20000);
-    assert!(worst < 0.001, "largest error {worst}");
 }
 
 /// A plane facing a directional light along its normal: N·L = 1, so every pixel is exactly
@@ -154,24 +159,28 @@ fn lit_plane_is_exactly_ka_ia_plus_kd_i() {
             one_light(-Vec3::Z),
             interp,
         );
-        let img = render(&s, &RenderOptions::default()).unwrap();
-        for y in 0..64 {
-            for x in 0..64 {
-                let d = (px(&img, x, y) - want).abs().max_element();
-                assert!(d < 1e-6, "{interp:?} ({x},{y}): {:?}", px(&img, x, y));
+        for path in common::paths() {
+            let img = path.render(&s);
+            eprintln!("{}", path.name);
+            for y in 0..64 {
+                for x in 0..64 {
+                    let d = (px(&img, x, y) - want).abs().max_element();
+                    assert!(d < 1e-6, "{interp:?} ({x},{y}): {:?}", px(&img, x, y));
+                }
             }
         }
     }
 }
 
-fn lcg(seed: &mut u64) -> f32 {
-    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-    (*seed >> 40) as f32 / (1u64 << 24) as f32
-}
-
 /// A grid of jittered triangles covering more than the screen, in the z = 0 plane.
 fn jittered_grid(cells: u32, extent: f32, seed: u64) -> Mesh {
-    let mut s = seed;
+    grid(cells, extent, seed, 0.8)
+}
+
+/// A grid of triangles over [−extent, extent]² in the z = 0 plane, its inner vertices moved
+/// by up to ±`jitter`/2 of a cell (below about 0.5 no triangle folds over another).
+fn grid(cells: u32, extent: f32, seed: u64, jitter: f32) -> Mesh {
+    let mut rng = common::Rng(seed);
     let mut positions = Vec::new();
     for i in 0..=cells {
         for j in 0..=cells {
@@ -179,12 +188,12 @@ fn jittered_grid(cells: u32, extent: f32, seed: u64) -> Mesh {
             let (jx, jy) = if border {
                 (0.0, 0.0)
             } else {
-                (lcg(&mut s) - 0.5, lcg(&mut s) - 0.5)
+                (rng.f() - 0.5, rng.f() - 0.5)
             };
             let step = 2.0 * extent / cells as f32;
             positions.push(Vec3::new(
-                -extent + (j as f32 + 0.8 * jx) * step,
-                -extent + (i as f32 + 0.8 * jy) * step,
+                -extent + (j as f32 + jitter * jx) * step,
+                -extent + (i as f32 + jitter * jy) * step,
                 0.0,
             ));
         }
@@ -204,6 +213,72 @@ fn jittered_grid(cells: u32, extent: f32, seed: u64) -> Mesh {
         }
     }
     Mesh::new(positions.clone(), vec![Vec3::Z; positions.len()], tris).unwrap()
+}
+
+/// The fast path's visibility is exact: a grid of 1800 small jittered triangles (about 2
+/// pixels each), each its own object in a distinct emissive colour, over a background border,
+/// gives on every CPU path and in every interpolation exactly the image that the triangles'
+/// coverage predicts (each pixel centre's one covering triangle, by `coverage_counts` of the
+/// triangle alone), with zero tolerance on the fast path.
+#[test]
+fn fast_path_coverage_is_exact() {
+    let (w, h, cells) = (96u32, 72u32, 30u32);
+    let grid = grid(cells, 1.0, 7, 0.4);
+    let color = |k: usize| Color::new((k % 61) as f32 / 60.0, (k / 61 % 31) as f32 / 30.0, 0.5);
+    let objects: Vec<Object> = grid
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            let positions: Vec<Vec3> = t.iter().map(|&i| grid.positions()[i as usize]).collect();
+            let mesh = Mesh::new(positions, vec![Vec3::Z; 3], vec![[0, 1, 2]]).unwrap();
+            obj(mesh, emissive(color(k)))
+        })
+        .collect();
+    let lighting = Lighting::new(Color::BLACK, Vec::new()).unwrap();
+    let base = scene(w, h, ortho_camera(2.4), objects, lighting, Interpolation::Phong);
+    // The expected image: each object alone, its covered pixel centres.
+    let mut want = vec![None; (w * h) as usize];
+    for (k, o) in base.objects.iter().enumerate() {
+        let alone = Scene {
+            objects: vec![o.clone()],
+            ..base.clone()
+        };
+        for (p, &c) in coverage_counts(&alone).iter().enumerate() {
+            if c > 0 {
+                assert!(want[p].is_none(), "pixel {p} covered twice: {:?} and {k}", want[p]);
+                want[p] = Some(k);
+            }
+        }
+    }
+    let covered = want.iter().filter(|k| k.is_some()).count();
+    assert!(covered > 3000 && covered < (w * h) as usize, "{covered} pixels covered");
+    for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
+        let mut s = base.clone();
+        each(&mut s, |sh| sh.interpolation = interp);
+        for path in common::paths() {
+            let img = path.render(&s);
+            for (p, k) in want.iter().enumerate() {
+                let (x, y) = (p as u32 % w, p as u32 / w);
+                let expect = k.map_or(Vec3::ZERO, |k| Vec3::from(color(k).to_array()));
+                // The reference interpolates Gouraud colours with perspective weights that sum
+                // to 1 within rounding: its colour is the triangle's within 1e-6 (the palette's
+                // colours are 1/60 apart, so the triangle is still unambiguous); all else exact.
+                let tol = if path.options.reference && interp == Interpolation::Gouraud {
+                    1e-6
+                } else {
+                    0.0
+                };
+                let d = (px(&img, x, y) - expect).abs().max_element();
+                assert!(
+                    d <= tol,
+                    "{}, {interp:?}: pixel ({x}, {y}) {} vs {expect}",
+                    path.name,
+                    px(&img, x, y)
+                );
+            }
+        }
+    }
 }
 
 /// Shared edges cover each sample exactly once: no hole, no overlap (top-left rule), at every
@@ -307,32 +382,35 @@ fn perspective_correct_interpolation_and_near_clipping() {
         Interpolation::Phong,
     );
     each(&mut s, |sh| sh.output = Output::Depth);
-    let img = render(&s, &RenderOptions::default()).unwrap();
-    let t = (30f32).to_radians().tan();
-    let aspect = w as f32 / h as f32;
-    let mut checked = 0;
-    for y in 0..h {
-        for x in 0..w {
-            // Ray through the pixel centre in view space: (ndc_x·t·aspect, ndc_y·t, −1).
-            let ndc_x = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
-            let ndc_y = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
-            let dir = Vec3::new(ndc_x * t * aspect, ndc_y * t, -1.0);
-            let got = img.get(x, y)[0];
-            if dir.y >= -1e-3 {
-                assert_eq!(got, 0.0, "above the horizon ({x},{y})"); // background
-                continue;
+    for path in common::paths() {
+        let img = path.render(&s);
+        eprintln!("{}", path.name);
+        let t = (30f32).to_radians().tan();
+        let aspect = w as f32 / h as f32;
+        let mut checked = 0;
+        for y in 0..h {
+            for x in 0..w {
+                // Ray through the pixel centre in view space: (ndc_x·t·aspect, ndc_y·t, −1).
+                let ndc_x = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
+                let ndc_y = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
+                let dir = Vec3::new(ndc_x * t * aspect, ndc_y * t, -1.0);
+                let got = img.get(x, y)[0];
+                if dir.y >= -1e-3 {
+                    assert_eq!(got, 0.0, "above the horizon ({x},{y})"); // background
+                    continue;
+                }
+                let depth = 1.0 / -dir.y; // camera height 1, forward component of dir is 1
+                let hit = Vec3::new(0.0, 1.0, 0.0) + dir * depth;
+                if hit.z < -40.0 || hit.x.abs() > 40.0 || depth > 50.0 {
+                    continue;
+                }
+                let want = 1.0 - (depth - 0.1) / (50.0 - 0.1);
+                assert!((got - want).abs() < 2e-4, "({x},{y}): {got} vs {want}");
+                checked += 1;
             }
-            let depth = 1.0 / -dir.y; // camera height 1, forward component of dir is 1
-            let hit = Vec3::new(0.0, 1.0, 0.0) + dir * depth;
-            if hit.z < -40.0 || hit.x.abs() > 40.0 || depth > 50.0 {
-                continue;
-            }
-            let want = 1.0 - (depth - 0.1) / (50.0 - 0.1);
-            assert!((got - want).abs() < 2e-4, "({x},{y}): {got} vs {want}");
-            checked += 1;
         }
+        assert!(checked > 1000, "{checked}");
     }
-    assert!(checked > 1000, "{checked}");
 }
 
 /// The rectangle [x0, x1] × [y0, y1] in the plane z, two triangles counter-clockwise seen from +z.
@@ -372,9 +450,12 @@ fn depth_order() {
             Lighting::default(),
             Interpolation::Phong,
         );
-        let img = render(&s, &RenderOptions::default()).unwrap();
-        assert_eq!(px(&img, 16, 16), Vec3::new(1.0, 0.0, 0.0));
-        assert_eq!(px(&img, 16, 6), Vec3::new(0.0, 0.0, 1.0));
+        for path in common::paths() {
+            let img = path.render(&s);
+            eprintln!("{}", path.name);
+            assert_eq!(px(&img, 16, 16), Vec3::new(1.0, 0.0, 0.0));
+            assert_eq!(px(&img, 16, 6), Vec3::new(0.0, 0.0, 1.0));
+        }
     }
 }
 
@@ -468,27 +549,30 @@ fn interpolation_modes_against_core() {
             );
             each(&mut s, |sh| sh.options.specular = model);
             each(&mut s, |sh| sh.viewer = Viewer::Local); // per-point V, to exercise positions too
-            let img = render(&s, &RenderOptions::default()).unwrap();
-            let view = s.camera.view(Viewer::Local);
-            let sh = |p: Vec3, nrm: Vec3| {
-                let r = shade(
-                    &SurfacePoint {
-                        position: p,
-                        normal: nrm,
-                    },
-                    &view,
-                    &m,
-                    &lighting,
-                    &s.objects[0].shading.options,
-                );
-                Vec3::from(r.color.to_array())
-            };
-            let label = format!("{model:?} {interp:?}");
-            check_interior(&img, n, (a, b, c), 2e-5, &label, |l, p| match interp {
-                Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
-                Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
-                Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),
-            });
+            for path in common::paths() {
+                let img = path.render(&s);
+                eprintln!("{}", path.name);
+                let view = s.camera.view(Viewer::Local);
+                let sh = |p: Vec3, nrm: Vec3| {
+                    let r = shade(
+                        &SurfacePoint {
+                            position: p,
+                            normal: nrm,
+                        },
+                        &view,
+                        &m,
+                        &lighting,
+                        &s.objects[0].shading.options,
+                    );
+                    Vec3::from(r.color.to_array())
+                };
+                let label = format!("{model:?} {interp:?}");
+                check_interior(&img, n, (a, b, c), 2e-5, &label, |l, p| match interp {
+                    Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+                    Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
+                    Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),
+                });
+            }
         }
     }
 }
@@ -512,19 +596,25 @@ fn antialiasing_averages_samples() {
         Interpolation::Phong,
     );
     s.image.samples = Samples::Four;
-    let img = render(&s, &RenderOptions::default()).unwrap();
-    assert_eq!(px(&img, 9, 5), Vec3::ONE);
-    assert!(
-        (px(&img, 10, 5) - Vec3::splat(0.5)).abs().max_element() < 1e-6,
-        "{}",
-        px(&img, 10, 5)
-    );
-    assert_eq!(px(&img, 11, 5), Vec3::ZERO);
+    for path in common::paths() {
+        let img = path.render(&s);
+        eprintln!("{}", path.name);
+        assert_eq!(px(&img, 9, 5), Vec3::ONE);
+        assert!(
+            (px(&img, 10, 5) - Vec3::splat(0.5)).abs().max_element() < 1e-6,
+            "{}",
+            px(&img, 10, 5)
+        );
+        assert_eq!(px(&img, 11, 5), Vec3::ZERO);
+    }
     // A transparent background gives partial alpha with the covered colour (straight alpha).
     s.image.background = [0.0, 0.0, 0.0, 0.0];
-    let img = render(&s, &RenderOptions::default()).unwrap();
-    assert_eq!(img.get(10, 5), [1.0, 1.0, 1.0, 0.5]);
-    assert_eq!(img.get(12, 5)[3], 0.0);
+    for path in common::paths() {
+        let img = path.render(&s);
+        eprintln!("{}", path.name);
+        assert_eq!(img.get(10, 5), [1.0, 1.0, 1.0, 0.5]);
+        assert_eq!(img.get(12, 5)[3], 0.0);
+    }
 }
 
 /// Back faces are culled unless two-sided lighting is on.
@@ -637,35 +727,38 @@ fn two_sided_lighting_follows_polygon_facing() {
             interp,
         );
         each(&mut s, |sh| sh.options.two_sided = true);
-        let img = render(&s, &RenderOptions::default()).unwrap();
-        let view = s.camera.view(Viewer::Infinite);
-        let one_sided = ShadingOptions::default();
-        let sh = |p: Vec3, nrm: Vec3| {
-            let r = shade(
-                &SurfacePoint {
-                    position: p,
-                    normal: nrm,
-                },
-                &view,
-                &m,
-                &lighting,
-                &one_sided,
-            );
-            Vec3::from(r.color.to_array())
-        };
-        // The back face's facet normal (a, c, b winding) points away; flipped, towards +z.
-        check_interior(&img, n, (a, b, c), 2e-5, &format!("{interp:?}"), |l, p| match interp {
-            Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
-            Interpolation::Gouraud => sh(a, -na) * l[0] + sh(b, -nb) * l[1] + sh(c, -nc) * l[2],
-            Interpolation::Phong => sh(p, -(na * l[0] + nb * l[1] + nc * l[2])),
-        });
-        // Gouraud and Phong with flipped normals see only the ambient light: 0.3 · a_m (= 0).
-        if interp != Interpolation::Flat {
-            assert!(
-                px(&img, 24, 24).max_element() < 0.05,
-                "{interp:?}: {}",
-                px(&img, 24, 24)
-            );
+        for path in common::paths() {
+            let img = path.render(&s);
+            eprintln!("{}", path.name);
+            let view = s.camera.view(Viewer::Infinite);
+            let one_sided = ShadingOptions::default();
+            let sh = |p: Vec3, nrm: Vec3| {
+                let r = shade(
+                    &SurfacePoint {
+                        position: p,
+                        normal: nrm,
+                    },
+                    &view,
+                    &m,
+                    &lighting,
+                    &one_sided,
+                );
+                Vec3::from(r.color.to_array())
+            };
+            // The back face's facet normal (a, c, b winding) points away; flipped, towards +z.
+            check_interior(&img, n, (a, b, c), 2e-5, &format!("{interp:?}"), |l, p| match interp {
+                Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
+                Interpolation::Gouraud => sh(a, -na) * l[0] + sh(b, -nb) * l[1] + sh(c, -nc) * l[2],
+                Interpolation::Phong => sh(p, -(na * l[0] + nb * l[1] + nc * l[2])),
+            });
+            // Gouraud and Phong with flipped normals see only the ambient light: 0.3 · a_m (= 0).
+            if interp != Interpolation::Flat {
+                assert!(
+                    px(&img, 24, 24).max_element() < 0.05,
+                    "{interp:?}: {}",
+                    px(&img, 24, 24)
+                );
+            }
         }
     }
 }

@@ -46,3 +46,57 @@ pub fn isas() -> Vec<phong_raster::internals::Isa> {
     }
     vec![Isa::PORTABLE, avx2]
 }
+
+/// One CPU path: the reference, or the fast path in one build of the kernels.
+#[allow(dead_code)] // each test file uses part of it
+pub struct CpuPath {
+    pub name: &'static str,
+    pub options: phong_raster::RenderOptions<'static>,
+}
+
+#[allow(dead_code)]
+impl CpuPath {
+    /// `scene` on this path into the `f32` target; where 8 bits are exact for the scene, the
+    /// 8-bit target is rendered too and must be the `f32` image's bytes.
+    pub fn render(&self, scene: &phong_core::Scene) -> phong_core::Image {
+        let image = phong_raster::render(scene, &self.options).unwrap_or_else(|e| panic!("{}: {e}", self.name));
+        let mut renderer = phong_raster::Renderer::new();
+        if let Some((eight, _)) = renderer.render_8bit(scene, &self.options).unwrap() {
+            assert!(
+                eight.to_bytes(true) == image.to_bytes(scene.image.encoding, true),
+                "{}: the 8-bit target differs from the f32 one",
+                self.name
+            );
+        }
+        image
+    }
+}
+
+/// Every CPU path: the reference, the fast path's portable build and (on a CPU with it) its
+/// AVX2 build, the last with 3 threads (images do not depend on the thread count).
+#[allow(dead_code)]
+pub fn paths() -> Vec<CpuPath> {
+    let options = |reference, no_avx2, threads| phong_raster::RenderOptions {
+        reference,
+        no_avx2,
+        threads: Some(threads),
+        progress: None,
+    };
+    let mut v = vec![
+        CpuPath {
+            name: "reference",
+            options: options(true, false, 1),
+        },
+        CpuPath {
+            name: "fast, portable",
+            options: options(false, true, 1),
+        },
+    ];
+    if isas().len() > 1 {
+        v.push(CpuPath {
+            name: "fast, AVX2",
+            options: options(false, false, 3),
+        });
+    }
+    v
+}
