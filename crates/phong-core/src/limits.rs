@@ -63,7 +63,7 @@ pub fn sample_pattern(samples: crate::Samples) -> Vec<(f32, f32)> {
 pub const SERVE_MAX_BODY: usize = 1 << 20;
 
 /// `phong serve`: most pixels of one rendered image. 3840 × 2160 (a 4K screen) is more than
-/// any browser viewport; frames stay within about 40 ms of CPU time a few at a time.
+/// any browser viewport, and keeps a frame's CPU time within an interactive budget.
 pub const SERVE_MAX_PIXELS: u64 = 3840 * 2160;
 
 /// `phong serve`: most samples (pixels times antialias samples) of one image: 4K at 4

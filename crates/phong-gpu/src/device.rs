@@ -1,5 +1,5 @@
 //! The device: opening the adapter, its limits and features, and how GPU errors become
-//! [`Error`]s (error scopes around each piece of work, a sink for uncaptured errors and device
+//! [`Error`](enum@Error)s (error scopes around each piece of work, a sink for uncaptured errors and device
 //! loss).
 
 use crate::{Error, Gpu, GpuPath, ITEM_CAPACITY, RENDER_WGSL};
@@ -163,7 +163,7 @@ impl Gpu {
             .min(self.limits.max_storage_buffer_binding_size)
     }
 
-    /// Whether renders time their pass on the GPU ([`GpuStats::gpu_pass`]): the adapter has
+    /// Whether renders time their pass on the GPU ([`GpuStats::gpu_pass`](crate::GpuStats::gpu_pass)): the adapter has
     /// timestamp queries.
     pub fn has_timestamps(&self) -> bool {
         self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY)

@@ -14,8 +14,8 @@ impl Gpu {
     }
 
     /// [`Gpu::draw`], the compute rasterizer's kernels each in its own timed pass
-    /// ([`Drawn::stages`]). The passes' boundaries cost time of their own (about 0.08 ms of a
-    /// 4K frame on an H100), so frames are timed whole by [`Gpu::draw`].
+    /// ([`Drawn::stages`]). The passes' boundaries cost time of their own, so frames are timed
+    /// whole by [`Gpu::draw`].
     pub fn draw_stages(&self, p: &Prepared) -> Result<Drawn, Error> {
         self.draw_timed(p, true)
     }

@@ -88,10 +88,8 @@ impl Gpu {
         );
         self.queue.submit([enc.finish()]);
         // Row by row from the mapping: each row's halves converted by `half` (F16C where the
-        // processor has it) into a small buffer, then made straight alpha into the image. On
-        // the H100 machine (4K frame) the whole-frame copies this replaces (66 MB of halves,
-        // 133 MB of floats, both freshly allocated) took 175–194 ms beside a 44–58 ms copy
-        // out of the mapping.
+        // processor has it) into a small buffer, then made straight alpha into the image, not
+        // whole-frame copies (BENCHMARKS.md, G1).
         let bg = p.background;
         let stride = padded as usize;
         let pixels = self.read_mapped(&out, scopes, "reading the image back", |data| {

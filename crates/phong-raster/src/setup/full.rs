@@ -1,6 +1,6 @@
 //! The setup of an object for the reference path, or for the fast path's scalar shading (flat,
 //! normal and depth outputs): every vertex in full, lit per vertex (Gouraud) or per triangle
-//! (flat) by `Object::shade`, [`Corners`](super::Corners) kept.
+//! (flat) by `Object::shade`, [`Corners`] kept.
 
 use super::{Chunk, Corners, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};

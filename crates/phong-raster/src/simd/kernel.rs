@@ -20,7 +20,7 @@ use super::vector::Vf32;
 use glam::Vec3;
 use phong_core::{Color, Light, Lighting, LyonLambda, Material, Normalization, ShadingOptions, SpecularModel, View};
 
-/// Lanes of [`shade8`].
+/// Lanes of `shade8`.
 pub const LANES: usize = 8;
 /// The most lanes of any `Vf32` implementation.
 const MAX_LANES: usize = 16;
@@ -170,7 +170,7 @@ struct PreparedLight {
     spe: Color,
 }
 
-/// What [`shade8`] needs of one object, computed once per render.
+/// What `shade8` needs of one object, computed once per render.
 pub struct Prepared {
     view: View,
     options: ShadingOptions,
@@ -574,8 +574,7 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
 /// `row << 16 | column` relative to `(x0, y0)`, the pixel whose centre is `(x0 + ½, y0 + ½)`;
 /// `out(pixel, rgb)` receives each colour. Only whole vectors are shaded: returns how many
 /// pixels were (a multiple of `V::N`); the caller batches the rest with other triangles'
-/// (a 1M-triangle sphere has one or two pixels per triangle: shading those alone in 16 lanes
-/// made its shading 2× slower). Same arithmetic per pixel as [`shade_batch`].
+/// (BENCHMARKS.md, R1). Same arithmetic per pixel as [`shade_batch`].
 #[inline(always)]
 pub(crate) fn shade_group<V: Vf32>(
     batch: Batch,

@@ -64,7 +64,7 @@ fn shade8_avx2(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -
     kernel::shade_points::<vector::Avx2>(p, position, normal)
 }
 
-/// `phong_core::shade` on 8 points (`pow` approximated, see [`kernel`]), by `isa`'s build.
+/// `phong_core::shade` on 8 points (`pow` approximated, see `kernel.rs`), by `isa`'s build.
 #[inline]
 pub fn shade8(isa: Isa, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     #[cfg(target_arch = "x86_64")]
@@ -114,7 +114,7 @@ fn light_vertices_avx2(p: &Prepared, term: Term, positions: &[Vec3], normals: &[
 }
 
 /// Gouraud's vertex lighting: `out[i]` = `term` of `phong_core::shade` at `positions[i]` with
-/// `normals[i]` (negated with `flip`), `pow` approximated as in [`kernel`] (AVX2: 16 lanes).
+/// `normals[i]` (negated with `flip`), `pow` approximated as in `kernel.rs` (AVX2: 16 lanes).
 pub fn light_vertices(
     isa: Isa,
     p: &Prepared,
@@ -224,8 +224,7 @@ pub fn stream_fill(dst: &mut [[f32; 4]], value: [f32; 4]) {
 
 /// Copies `src` into `dst` (the same length) by non-temporal stores where `dst` is 16-byte
 /// aligned (on x86-64), else by plain stores: a tile drawn in a cache-resident buffer reaches
-/// the image without its cache lines being fetched first (1080p, 2 threads, 5 interleaved
-/// runs: 100k Gouraud sphere 8.6 → 8.0 ms, 1M 30.9 → 27.9 ms, medians). Call
+/// the image without its cache lines being fetched first (BENCHMARKS.md, R2). Call
 /// [`stream_fence`] before the image is read.
 pub fn stream_copy(dst: &mut [[f32; 4]], src: &[[f32; 4]]) {
     assert_eq!(dst.len(), src.len());

@@ -1,11 +1,7 @@
 //! The fast setup's vertex stage, 8 vertices at a time (AVX2): clip-space transform, outcode
 //! and window projection, with the scalar code's operations in its order (no fused
-//! multiply-adds, exact divisions), so the same bits (tested against `raster`'s scalar loop,
-//! edge cases included).
-//!
-//! Measured: the scalar loop took 6.8 ms of a 1M-triangle frame's 27 ms setup (500k vertices,
-//! 1 thread): a division, two `f32 → f64 → i64` roundings with their range checks, and the
-//! outcode's twelve compares, each vertex alone.
+//! multiply-adds, exact divisions), so the same bits (tested against `vertex`'s scalar loop,
+//! edge cases included). Why it exists: BENCHMARKS.md, C8.
 
 use crate::clip::{NOT_FINITE, OUTSIDE_CLIP};
 use glam::{Mat4, Vec3};

@@ -1,5 +1,5 @@
 //! The Gouraud tile kernel (AVX2): visibility and colour of a tile's triangles, four pixels of
-//! a row at a time, bit for bit the scalar loop's (`raster`'s `visible_single` with its
+//! a row at a time, bit for bit the scalar loop's (`tile::visible`'s `visible_single` with its
 //! colour planes), which stays as the twin on CPUs without AVX2 and is tested against it.
 //!
 //! Per four pixels of a row: the three edge functions as exact integers in `f64` lanes (an
@@ -15,7 +15,7 @@
 //! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
 //! sign bit is exactly `E − bias < 0`.
 //!
-//! Why the caller chooses it per tile (`raster`'s `Frame::gouraud_kernel`): its cost per
+//! Why the caller chooses it per tile (`Frame::plan_tile`, BENCHMARKS.md C4): its cost per
 //! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
 //! K1–K8).
 
@@ -200,7 +200,7 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
                             // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend
                             // and a store of the same address are otherwise turned into a masked
                             // store (`vmaskmovps`), slow on AMD and not forwarded to later loads
-                            // (100k sphere, 1 thread: 13.0 → 14.6 ms with it).
+                            // (BENCHMARKS.md, K1).
                             // SAFETY: `d4` is 4 readable f32.
                             let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
                             let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;

@@ -1,5 +1,5 @@
 //! All-Gouraud frames with one sample ([`TilePlan::Gouraud`](super::TilePlan::Gouraud)): every
-//! visible pixel is coloured during visibility (see [`Forward`](super::visible::Forward)), so
+//! visible pixel is coloured during visibility (see `visible::Forward`), so
 //! the tile starts as background and needs no ids, no scan and no deferred shading. By the
 //! AVX2 kernel ([`gouraud_tile`]) or the scalar loop (`visible_single`), the same bits, into
 //! `f32` rows or straight into an 8-bit frame's.

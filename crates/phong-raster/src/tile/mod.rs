@@ -2,7 +2,7 @@
 //! `match`, by one thread, its triangles in the input's order, so the image is the same
 //! whatever the number of threads.
 //!
-//! - [`reference`]: the reference path, shading as it draws.
+//! - [`mod@reference`]: the reference path, shading as it draws.
 //! - [`visible`]: the fast path's visibility, one sample or several a pixel.
 //! - [`shade`]: the fast path's deferred shading of the visible pixels, and the scalar shading
 //!   both paths share.
@@ -60,13 +60,26 @@ impl Tile<'_> {
     }
 }
 
-/// A tile task's working memory, reused from tile to tile: its buffer for the frame's pixels
-/// (see [`TileTarget`]), and the depth and triangle of each sample.
+/// A tile task's working memory, reused from tile to tile (not allocated and zeroed per
+/// tile: fresh buffers' page faults were a measurable part of a frame): its buffer for the
+/// frame's pixels (see [`TileTarget`]), and the multi-sample path's lists.
 #[derive(Default)]
 struct TileBuffers {
     local: Vec<[f32; 4]>,
-    depth: Vec<f32>,
-    ids: Vec<u32>,
+    multi: Multi,
+}
+
+/// The depth and triangle of each sample, and (several samples) the shading jobs.
+#[derive(Default)]
+pub(crate) struct Multi {
+    pub depth: Vec<f32>,
+    pub ids: Vec<u32>,
+    /// `(pixel, triangle)` per visible pair; a pixel's jobs are contiguous.
+    pub jobs: Vec<(u32, u32)>,
+    /// Where each pixel's jobs start in `jobs`.
+    pub starts: Vec<usize>,
+    /// Each job's colour.
+    pub colors: Vec<[f32; 4]>,
 }
 
 impl Frame<'_> {
@@ -105,7 +118,8 @@ impl Frame<'_> {
             encoding,
             direct: plan == TilePlan::Reference || tile.bin.len() <= 1,
         };
-        let TileBuffers { local, depth, ids } = buffers;
+        let TileBuffers { local, multi } = buffers;
+        let Multi { depth, ids, .. } = multi;
         match plan {
             TilePlan::Empty => {
                 let marks = crate::stats::Marks::start();
@@ -123,7 +137,7 @@ impl Frame<'_> {
                 }
             }
             TilePlan::Single => target.draw(local, |rows, store| self.tile_single(tile, rows, store, depth, ids)),
-            TilePlan::Multi => target.draw(local, |rows, _| self.tile_multi(tile, rows, depth, ids)),
+            TilePlan::Multi => target.draw(local, |rows, _| self.tile_multi(tile, rows, multi)),
         }
     }
 

@@ -6,11 +6,11 @@
 //! ([`shade_group`]), the rest gathered lane by lane ([`Frame::shade_gathered`]); with
 //! several, one job per visible (pixel, triangle), gathered, then the reference's resolve.
 
-use super::Tile;
 use super::visible::FORWARD;
+use super::{Multi, Tile};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
-use crate::frame::Frame;
+use crate::frame::{Frame, Mode};
 use crate::setup::{Corners, Tri};
 use crate::simd::{Planes, group_lanes, shade_batch, shade_group};
 use crate::stats::Marks;
@@ -169,14 +169,27 @@ impl Frame<'_> {
     /// The shading of a tile of several samples a pixel after visibility (`ids`: per sample,
     /// the packed id of its visible triangle or `u32::MAX`): one job per visible (pixel,
     /// triangle), then the reference's resolve, sample by sample.
-    pub(super) fn shade_multi(&self, tile: &Tile, ids: &[u32], rows: &mut [&mut [[f32; 4]]], mut marks: Marks) -> u64 {
+    pub(super) fn shade_multi(
+        &self,
+        tile: &Tile,
+        work: &mut Multi,
+        rows: &mut [&mut [[f32; 4]]],
+        mut marks: Marks,
+    ) -> u64 {
+        let Multi {
+            ids,
+            jobs,
+            starts,
+            colors,
+            ..
+        } = work;
         let (x0, y0) = (tile.x0, tile.y0);
         let (tw, th) = (tile.width(), tile.height());
         let ns = self.pattern.len();
         // The pixel as `row << 16 | column` in the tile (no division to find it again); a
         // pixel's jobs are contiguous.
-        let mut jobs: Vec<(u32, u32)> = Vec::with_capacity(tw * th);
-        let mut starts = Vec::with_capacity(tw * th + 1);
+        jobs.clear();
+        starts.clear();
         for row in 0..th {
             for col in 0..tw {
                 let pixel = row * tw + col;
@@ -192,10 +205,11 @@ impl Frame<'_> {
         }
         starts.push(jobs.len());
         let at = |packed: u32| (x0 + (packed & 0xffff), y0 + (packed >> 16));
-        let mut colors = vec![[0f32; 4]; jobs.len()];
+        colors.clear();
+        colors.resize(jobs.len(), [0.0; 4]);
         let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
-            if self.modes[self.object(ti)].batch().is_none() {
+            if matches!(self.modes[self.object(ti)], Mode::Scalar) {
                 let (px, py) = at(pixel);
                 colors[k] = self.shade_pixel(ti, px, py);
             } else {

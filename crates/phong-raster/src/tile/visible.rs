@@ -6,8 +6,8 @@
 //! and Gouraud triangles colour their pixels as they pass (see [`Forward`]); with several
 //! ([`Frame::tile_multi`]) each sample is tested in turn.
 
-use super::Tile;
 use super::gouraud::ColorPlanes;
+use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode};
 use crate::setup::Tri;
@@ -120,13 +120,8 @@ impl Frame<'_> {
     /// [`TilePlan::Multi`](super::TilePlan::Multi): several samples a pixel. `ids` gets, per
     /// sample, the packed id of its visible triangle or `u32::MAX`; then
     /// [`Frame::shade_multi`].
-    pub(super) fn tile_multi(
-        &self,
-        tile: &Tile,
-        rows: &mut [&mut [[f32; 4]]],
-        depth: &mut Vec<f32>,
-        ids: &mut Vec<u32>,
-    ) -> u64 {
+    pub(super) fn tile_multi(&self, tile: &Tile, rows: &mut [&mut [[f32; 4]]], work: &mut Multi) -> u64 {
+        let Multi { depth, ids, .. } = work;
         let mut marks = Marks::start();
         let Tile { x0, y0, x1, y1, .. } = *tile;
         let tw = tile.width();
@@ -172,7 +167,7 @@ impl Frame<'_> {
             }
         }
         marks.shading();
-        self.shade_multi(tile, ids, rows, marks)
+        self.shade_multi(tile, work, rows, marks)
     }
 }
 
