@@ -129,6 +129,12 @@ impl RunArgs {
         if let Some(s) = samples {
             scene.image.samples = s;
         }
+        if self.width.is_some() || self.height.is_some() || samples.is_some() {
+            scene
+                .image
+                .check()
+                .map_err(|e| InputError(format!("--width, --height, --antialias: {e}")))?;
+        }
         overrides.apply_to_scene(&mut scene);
         Ok(Job {
             scene,

@@ -203,6 +203,27 @@ fn bad_input_exits_2_with_location() {
         "8",
     ]);
     assert_eq!(o.status.code(), Some(2));
+    // Each flag within its range, together past the core's limit of pixels × samples: refused
+    // before rendering, naming the flags, and the previous file left as it was.
+    let o = phong(&[
+        "render",
+        "examples/scenes/tour.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "16384",
+        "--height",
+        "16384",
+        "--antialias",
+        "16",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--antialias") && stderr(&o).contains("cannot be rendered"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
 }
 
 #[test]

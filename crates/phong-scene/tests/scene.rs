@@ -171,6 +171,18 @@ fn value_errors_have_line_column_and_key() {
         "[image]\nantialias = 3\n",
         &["scene.toml:2:13", "`antialias`", "1, 4 or 16"],
     );
+    // Each side within its range, the whole past the core's limit of pixels × samples
+    // (16384² × 4): reported at the key that made it so, with the core's rule.
+    assert_err(
+        "[image]\nwidth = 16384\nheight = 16384\nantialias = 16\n",
+        &[
+            "scene.toml:4:13",
+            "`antialias`",
+            "16384x16384 with 16 samples",
+            "cannot be rendered",
+        ],
+    );
+    assert!(parse("[image]\nwidth = 16384\nheight = 16384\nantialias = 4\n").is_ok());
     assert_err("[image]\nbackground = [1, 2]\n", &["scene.toml:2:14", "`background`"]);
     assert_err("[camera]\nfov = 200\n", &["scene.toml:2:7", "`fov`", "(0, 180)"]);
     assert_err("[camera]\nnear = -1\n", &["scene.toml:2:8", "`near`"]);

@@ -2,7 +2,7 @@
 //! renderer's own thread pool or on the GPU, never on the async threads.
 
 use phong_core::Scene;
-use phong_raster::{RenderOptions, Renderer};
+use phong_raster::{RenderOptions, Rendered, Renderer};
 use std::sync::Mutex;
 
 /// Which renderer draws the frames.
@@ -51,17 +51,16 @@ impl Backend {
                 let mut renderer = renderers.lock().ok().and_then(|mut r| r.pop()).unwrap_or_default();
                 let options = RenderOptions::default();
                 let out = pool.install(|| -> Result<Vec<u8>, String> {
-                    // 8 bits where that is exact, as `phong render` does; else f32.
-                    let eight = renderer.render_8bit(scene, &options).map_err(|e| fail(&e))?;
-                    match eight {
-                        Some((image, _)) if scene.labels.is_empty() => encode8(image, raw),
-                        Some((image, _)) => {
+                    // The target `phong render` writes (the renderer chooses it).
+                    let (image, _) = renderer.render_for_png(scene, &options).map_err(|e| fail(&e))?;
+                    match image {
+                        Rendered::Eight(image) if scene.labels.is_empty() => encode8(image, raw),
+                        Rendered::Eight(image) => {
                             let mut image = image.clone();
                             phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
                             encode8(&image, raw)
                         }
-                        None => {
-                            let (image, _) = renderer.render(scene, &options).map_err(|e| fail(&e))?;
+                        Rendered::Linear(image) => {
                             let mut image = image.clone();
                             phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
                             encode(&image, scene.image.encoding, raw)

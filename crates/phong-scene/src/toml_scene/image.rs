@@ -42,5 +42,15 @@ pub(super) fn image_settings(ctx: &Ctx, r: RawImage) -> Result<ImageSettings, Er
     if let Some(e) = &r.encoding {
         s.encoding = ctx.choice(e, "encoding", ENCODINGS)?;
     }
+    // The core's check of the whole (pixels × samples), at the key that made it too large.
+    if let Err(e) = s.check() {
+        let (span, key) = match (&r.antialias, &r.width, &r.height) {
+            (Some(a), ..) => (a.span(), "antialias"),
+            (None, Some(w), _) => (w.span(), "width"),
+            (None, None, Some(h)) => (h.span(), "height"),
+            (None, None, None) => (0..0, "image"),
+        };
+        return ctx.err(&span, key, e.to_string());
+    }
     Ok(s)
 }
