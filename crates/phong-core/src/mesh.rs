@@ -179,7 +179,19 @@ impl Mesh {
     /// `crease_deg` degrees; vertices are split at harder edges. Each corner's
     /// normal is the area-weighted sum of the facet normals of the faces
     /// around its vertex that are within the crease angle of its own face.
+    ///
+    /// Where a vertex has more than 64 face directions (a cone's apex, a fan), its faces are
+    /// grouped instead across the edges they share at the vertex, where those faces meet within
+    /// the crease angle (as Blender's auto smooth), so that the work stays linear in the faces:
+    /// faces joined by a chain of soft edges share one normal there, even where the first and
+    /// the last of the chain are further apart than the crease angle.
     pub fn with_crease_normals(&self, crease_deg: f32) -> Mesh {
+        self.crease_normals(crease_deg).0
+    }
+
+    /// [`Mesh::with_crease_normals`], and the work it did (facet comparisons), for the test
+    /// that it is linear.
+    fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
         let w = self.welded();
         let cos_crease = crease_deg.to_radians().cos();
         let facet: Vec<Vec3> = w
@@ -190,33 +202,52 @@ impl Mesh {
                 (b - a).cross(c - a)
             })
             .collect();
+        let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
         let mut around: Vec<Vec<u32>> = vec![Vec::new(); w.positions.len()];
         for (f, t) in w.triangles.iter().enumerate() {
             for &i in t {
                 around[i as usize].push(f as u32);
             }
         }
+        let mut work = 0u64;
         // At a vertex with many faces, faces of the same facet direction are one group (summed
         // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
-        // of one triangle are one group). Vertices with few faces keep the plain loop, whose
-        // summation order the images were made with.
+        // of one triangle are one group); past MANY_GROUPS directions, the edge rule above.
+        // Vertices with few faces keep the plain loop, whose summation order the images were
+        // made with.
         const MANY: usize = 32;
-        let groups: Vec<Option<Vec<(Vec3, Vec3)>>> = around
+        const MANY_GROUPS: usize = 64;
+        let vertex_rule: Vec<Rule> = around
             .iter()
-            .map(|fs| {
-                (fs.len() > MANY).then(|| {
-                    let mut index: HashMap<[u32; 3], usize> = HashMap::new();
-                    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
-                    for &f in fs {
-                        let u = facet[f as usize].normalize_or_zero();
-                        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
-                            g.push((u, Vec3::ZERO));
-                            g.len() - 1
-                        });
-                        g[k].1 += facet[f as usize];
-                    }
-                    g
-                })
+            .enumerate()
+            .map(|(v, fs)| {
+                if fs.len() <= MANY {
+                    return Rule::Plain;
+                }
+                let mut index: HashMap<[u32; 3], usize> = HashMap::new();
+                let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+                for &f in fs {
+                    work += 1;
+                    let u = unit[f as usize];
+                    let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+                        g.push((u, Vec3::ZERO));
+                        g.len() - 1
+                    });
+                    g[k].1 += facet[f as usize];
+                }
+                if g.len() <= MANY_GROUPS {
+                    Rule::Directions(g)
+                } else {
+                    Rule::Edges(edge_groups(
+                        v as u32,
+                        fs,
+                        &w.triangles,
+                        &facet,
+                        &unit,
+                        cos_crease,
+                        &mut work,
+                    ))
+                }
             })
             .collect();
         let mut memo: HashMap<(u32, [u32; 3]), Vec3> = HashMap::new();
@@ -225,20 +256,25 @@ impl Mesh {
         let mut dedup: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
-            let own = facet[f].normalize_or_zero();
+            let own = unit[f];
             let tri = t.map(|v| {
-                let n = match &groups[v as usize] {
-                    None => around[v as usize]
+                let n = match &vertex_rule[v as usize] {
+                    Rule::Plain => around[v as usize]
                         .iter()
-                        .filter(|&&g| facet[g as usize].normalize_or_zero().dot(own) >= cos_crease)
+                        .filter(|&&g| {
+                            work += 1;
+                            facet[g as usize].normalize_or_zero().dot(own) >= cos_crease
+                        })
                         .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
                         .normalize_or_zero(),
-                    Some(g) => *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
+                    Rule::Directions(g) => *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
+                        work += g.len() as u64;
                         g.iter()
                             .filter(|(u, _)| u.dot(own) >= cos_crease)
                             .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
                             .normalize_or_zero()
                     }),
+                    Rule::Edges(groups) => groups[&(f as u32)],
                 };
                 let key = (v, n.to_array().map(f32::to_bits));
                 *dedup.entry(key).or_insert_with(|| {
@@ -249,12 +285,73 @@ impl Mesh {
             });
             triangles.push(tri);
         }
-        Mesh {
+        let mesh = Mesh {
             positions,
             normals,
             triangles,
+        };
+        (mesh, work)
+    }
+}
+
+/// How a vertex's corners get their crease normals (see [`Mesh::with_crease_normals`]).
+enum Rule {
+    /// Every face around the vertex compared with the corner's own.
+    Plain,
+    /// The vertex's face directions, each with its facets' sum.
+    Directions(Vec<(Vec3, Vec3)>),
+    /// Each face's normal at the vertex, from the faces joined to it across shared edges.
+    Edges(HashMap<u32, Vec3>),
+}
+
+/// The normal at vertex `v` of each face of `faces` (the faces around it): faces that share
+/// an edge at `v` and meet within the crease angle are joined (union-find; on an edge with more
+/// than two faces, each to the next), and each face gets its group's summed facets. Linear in
+/// `faces` (`work` counts the comparisons).
+fn edge_groups(
+    v: u32,
+    faces: &[u32],
+    triangles: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    cos_crease: f32,
+    work: &mut u64,
+) -> HashMap<u32, Vec3> {
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    // The last face seen on each edge (v, other vertex).
+    let mut last_on_edge: HashMap<u32, usize> = HashMap::new();
+    for (k, &f) in faces.iter().enumerate() {
+        for &other in triangles[f as usize].iter().filter(|&&o| o != v) {
+            if let Some(&j) = last_on_edge.get(&other) {
+                *work += 1;
+                if unit[faces[j] as usize].dot(unit[f as usize]) >= cos_crease {
+                    let (a, b) = (find(&mut parent, j), find(&mut parent, k));
+                    parent[a] = b;
+                }
+            }
+            last_on_edge.insert(other, k);
         }
     }
+    let mut sums = vec![Vec3::ZERO; faces.len()];
+    for (k, &f) in faces.iter().enumerate() {
+        let r = find(&mut parent, k);
+        sums[r] += facet[f as usize];
+    }
+    faces
+        .iter()
+        .enumerate()
+        .map(|(k, &f)| {
+            let r = find(&mut parent, k);
+            (f, sums[r].normalize_or_zero())
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -342,6 +439,38 @@ mod tests {
 #[cfg(test)]
 mod crease_tests {
     use super::*;
+
+    /// A fan of 100 000 faces around one apex, every one in its own direction (a cone's tip):
+    /// the work grows linearly with the faces (counted, not timed); neighbours meet at a soft
+    /// edge, so the apex has one normal, the normalised sum of every facet (here +z).
+    #[test]
+    fn many_directions_at_a_vertex_cost_linear_work() {
+        let fan = |n: usize| {
+            let mut p = vec![Vec3::new(0.0, 0.0, 1.0)];
+            for i in 0..n {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+            }
+            let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [0, 1 + i, 1 + (i + 1) % n as u32]).collect();
+            Mesh::from_triangles(p, tris).expect("mesh")
+        };
+        let (_, work_small) = fan(10_000).crease_normals(30.0);
+        let (large, work_large) = fan(100_000).crease_normals(30.0);
+        assert!(
+            work_large < 12 * work_small,
+            "work {work_small} -> {work_large} for 10x the faces"
+        );
+        assert!(work_large < 20 * 100_000, "{work_large}");
+        let apex: Vec<Vec3> = large
+            .positions()
+            .iter()
+            .zip(large.normals())
+            .filter(|(p, _)| p.z == 1.0)
+            .map(|(_, n)| *n)
+            .collect();
+        assert_eq!(apex.len(), 1, "one apex vertex");
+        assert!((apex[0] - Vec3::Z).length() < 1e-3, "{}", apex[0]);
+    }
 
     #[test]
     fn many_copies_of_one_triangle_are_one_group() {

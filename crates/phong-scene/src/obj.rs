@@ -100,7 +100,14 @@ fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
                         format!("needs {need} numbers, found {}", rest.len()),
                     ));
                 }
-                for (i, f) in rest.iter().enumerate().take(3) {
+                // `v x y z [w | r g b]`, `vn x y z`, `vt u [v [w]]`: every number finite (those
+                // beyond the ones used are checked too, so tobj never meets a bad one).
+                let used = match kw {
+                    "v" => rest.len().min(6),
+                    "vn" => 3,
+                    _ => rest.len().min(3),
+                };
+                for (i, f) in rest.iter().enumerate().take(used) {
                     match f.parse::<f32>() {
                         Ok(x) if x.is_finite() => {}
                         _ => return Err(c.err(start, line, i + 1, kw, format!("{f:?} is not a finite number"))),
@@ -162,6 +169,34 @@ fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// The OBJ text as tobj reads it, line for line (so that the pre-check's lines stay right):
+/// comments after a statement removed (tobj reads them as values), `v` records cut to
+/// `x y z` (a `w`, which the format gives no meaning for polygon vertices and tobj divides
+/// by, is dropped; so are vertex colours, which phong does not use yet and which tobj refuses
+/// unless every vertex has them), and `vt u` given its `v` of 0.
+fn normalize_obj(src: &str) -> String {
+    let mut out = String::with_capacity(src.len() + 64);
+    for line in src.split_inclusive('\n') {
+        let content = line.split('#').next().unwrap_or("");
+        let words: Vec<&str> = content.split_whitespace().collect();
+        match words.as_slice() {
+            ["v", rest @ ..] if rest.len() >= 3 => {
+                out.push_str("v ");
+                out.push_str(&rest[..3].join(" "));
+                out.push('\n');
+            }
+            ["vt", u] => out.push_str(&format!("vt {u} 0\n")),
+            [] if line.trim_start().starts_with('#') => out.push('\n'),
+            _ if content.len() < line.trim_end_matches(['\n', '\r']).len() => {
+                out.push_str(content.trim_end());
+                out.push('\n');
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
 }
 
 /// The MTL text as tobj can read it: a colour given as one number (`Kd 0.5`, which the format
@@ -320,14 +355,18 @@ pub fn load_obj_text(
         ignore_points: true,
         ignore_lines: true,
     };
-    let loaded = tobj::load_obj_buf(&mut BufReader::new(src.as_bytes()), &opts, |mtl: &Path| {
+    let normalized = normalize_obj(src);
+    let loaded = tobj::load_obj_buf(&mut BufReader::new(normalized.as_bytes()), &opts, |mtl: &Path| {
         let p: PathBuf = dir.join(mtl);
         let text = match read_mtl(mtl) {
             Ok(t) => t,
             Err(e) => {
-                // Locate the mtllib line for the message.
+                // Locate the name on its `mtllib` line (not in a comment or another statement).
                 let name = mtl.to_string_lossy();
-                let at = src.find(&*name).unwrap_or(0);
+                let at = lines(src)
+                    .filter(|(_, l)| l.split('#').next().unwrap_or("").trim_start().starts_with("mtllib"))
+                    .find_map(|(start, l)| l.split('#').next().unwrap_or("").find(&*name).map(|i| start + i))
+                    .unwrap_or(0);
                 let msg = format!("material library {} cannot be read: {e}", p.display());
                 *mtl_error.borrow_mut() = Some(Error::at(path, src, at, Some("mtllib"), msg));
                 return Err(tobj::LoadError::OpenFileFailed);
@@ -343,7 +382,29 @@ pub fn load_obj_text(
         return Err(e);
     }
     warnings.extend(mtl_warnings.into_inner());
-    let (models, materials) = loaded.map_err(|e| Error::at(path, src, 0, None, format!("malformed OBJ: {e}")))?;
+    let (models, materials) = loaded.map_err(|e| {
+        // tobj names no line: point at the first statement of the kind it could not read.
+        let kw = match e {
+            tobj::LoadError::PositionParseError
+            | tobj::LoadError::ScalingByZeroError
+            | tobj::LoadError::ColorParseError => "v",
+            tobj::LoadError::NormalParseError => "vn",
+            tobj::LoadError::TexcoordParseError => "vt",
+            tobj::LoadError::MaterialParseError => "usemtl",
+            tobj::LoadError::InvalidObjectName => "o",
+            _ => "f",
+        };
+        let at = lines(src)
+            .find(|(_, l)| l.split_whitespace().next() == Some(kw))
+            .map_or(0, |(start, _)| start);
+        Error::at(
+            path,
+            src,
+            at,
+            Some(kw),
+            format!("malformed OBJ: {e} (tobj does not say where; the first `{kw}` statement is shown)"),
+        )
+    })?;
     let materials: Vec<tobj::Material> = materials.unwrap_or_default();
     let materials: Vec<Material> = materials.iter().map(to_material).collect();
     let file = path
@@ -464,6 +525,31 @@ mod tests {
         let _ = std::fs::remove_dir_all(d);
     }
 
+    /// What tobj reads differently from the format, or fails on without a line, is given to it
+    /// normalised: trailing comments, `w` (dropped: the format gives polygon vertices none),
+    /// colours on some vertices only, `vt u`; the model loads with the positions as written.
+    #[test]
+    fn tobj_gets_what_it_can_read() {
+        let d = tmpdir("wild");
+        let obj = write(
+            &d,
+            "wild.obj",
+            "# a model\nv 0 0 0 # origin\nv 2 0 0 0.5\nv 0 1 0 1 0.5 0.25\nvt 0.5\nvt 1 0\nvt 0 1\n\
+             f 1/1 2/2 3/3 # the face\n",
+        );
+        let parts = load_obj(&obj, &mut Vec::new()).unwrap();
+        let p = parts[0].mesh.positions();
+        assert_eq!(p.len(), 3);
+        assert!(
+            p.contains(&Vec3::new(2.0, 0.0, 0.0)) && p.contains(&Vec3::new(0.0, 1.0, 0.0)),
+            "{p:?}"
+        );
+        let obj = write(&d, "nan.obj", "v 0 0 0\nv 1 0 0 nan\nv 0 1 0\nf 1 2 3\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("nan.obj:2:9: `v`"), "{e}");
+        let _ = std::fs::remove_dir_all(d);
+    }
+
     #[test]
     fn malformed_obj_names_line_and_column() {
         let d = tmpdir("bad");
@@ -486,6 +572,10 @@ mod tests {
                 .to_string()
                 .contains("short.obj:1:1")
         );
+        // An `mtllib` name also in a comment: the statement's line is named.
+        let obj = write(&d, "comment.obj", "# see nope.mtl\nmtllib nope.mtl\nv 0 0 0\n");
+        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("comment.obj:2:8: `mtllib`"), "{e}");
         let obj = write(&d, "mtl.obj", "mtllib nope.mtl\nv 0 0 0\n");
         let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
         assert!(e.contains("mtl.obj:1:8: `mtllib`") && e.contains("nope.mtl"), "{e}");

@@ -184,6 +184,17 @@ fn value_errors_have_line_column_and_key() {
     );
     assert!(parse("[image]\nwidth = 16384\nheight = 16384\nantialias = 4\n").is_ok());
     assert_err("[image]\nbackground = [1, 2]\n", &["scene.toml:2:14", "`background`"]);
+    // Integers past 64 bits, in words; a duplicate key inside an inline table named itself.
+    for n in ["99999999999999999999999", "9223372036854775808"] {
+        assert_err(
+            &format!("[image]\nwidth = {n}\n"),
+            &["scene.toml:2:9", "`width`", &format!("{n} is too large")],
+        );
+    }
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nmaterial = { diffuse = [1, 1, 1], diffuse = [0, 0, 0] }\n",
+        &["scene.toml:3:35", "`diffuse`: duplicate key"],
+    );
     assert_err("[camera]\nfov = 200\n", &["scene.toml:2:7", "`fov`", "(0, 180)"]);
     assert_err("[camera]\nnear = -1\n", &["scene.toml:2:8", "`near`"]);
     assert_err("[camera]\nnear = 5\nfar = 1\n", &["scene.toml:3:7", "`far`"]);

@@ -47,18 +47,24 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         let start = src[..offset_c].rfind('\n').map_or(0, |i| i + 1);
         let end = src[offset_c..].find('\n').map_or(src.len(), |i| offset_c + i);
         let line_text = src.get(start..end).unwrap_or("");
-        let key = line_text
+        let line_key = line_text
             .split_once('=')
             .map(|(k, _)| k.trim().to_string())
             .filter(|k| !k.is_empty())
             .map(|k| unquote_key(&k));
-        let message = e
-            .message()
-            .trim()
+        let message = integer_message(e.message().trim())
             .replace("expected i64", "expected an integer")
             .replace("expected f32", "expected a number")
             .replace("expected a sequence", "expected an array");
-        Error::at(path, src, offset, key.as_deref(), message)
+        // An error at a key itself ("duplicate key", also inside an inline table) names that
+        // key; others the line's.
+        let at_key = src
+            .get(offset_c..end)
+            .and_then(|t| t.split_once('='))
+            .map(|(k, _)| k.trim())
+            .filter(|k| message.starts_with("duplicate key") && !k.is_empty() && !k.contains([',', '{', '[']))
+            .map(unquote_key);
+        Error::at(path, src, offset, at_key.or(line_key).as_deref(), message)
     })?;
     let mut ctx = Ctx {
         path,
@@ -74,6 +80,20 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         warnings: ctx.warnings,
         sources: ctx.sources,
     })
+}
+
+/// toml's messages for integers past `i64` ("invalid type: integer `N` as i128", "invalid
+/// value: integer `N`"), in words; other messages as they are.
+fn integer_message(m: &str) -> String {
+    let number = m
+        .strip_prefix("invalid type: integer `")
+        .or_else(|| m.strip_prefix("invalid value: integer `"))
+        .and_then(|r| r.split_once('`'))
+        .map(|(n, _)| n);
+    match number {
+        Some(n) => format!("{n} is too large: integers here are at most {}", i64::MAX),
+        None => m.to_string(),
+    }
 }
 
 /// A quoted key (`"my key"`) as the key itself; a bare key as it is.
