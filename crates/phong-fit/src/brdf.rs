@@ -137,7 +137,8 @@ impl Merl {
     }
 
     /// The BRDF for unit `l`, `v` in the frame whose normal is +z (MERL's lookup: half and
-    /// difference angles, nearest bin); `None` where unmeasured (negative).
+    /// difference angles, nearest bin); `None` where unmeasured (negative), or where the file
+    /// holds a value no measurement has (not finite, or above 10⁶).
     pub fn eval(&self, l: [f64; 3], v: [f64; 3]) -> Option<[f64; 3]> {
         let (th, td, pd) = half_diff(l, v);
         let ih = if th <= 0.0 {
@@ -151,7 +152,7 @@ impl Merl {
         let i = ip + id * PD + ih * PD * TD;
         let n = TH * TD * PD;
         let out = [0, 1, 2].map(|c| self.data[i + c * n] * SCALE[c]);
-        out.iter().all(|x| *x >= 0.0).then_some(out)
+        out.iter().all(|x| (0.0..=1e6).contains(x)).then_some(out)
     }
 }
 
@@ -439,7 +440,8 @@ pub fn fit_brdf(brdf: &Brdf, model: SpecularModel) -> Result<BrdfFit, FitError> 
     let ((x, rmse), s) = crate::search_exponent(&grid, 20, |s| Ok::<_, FitError>(eval(s)))?;
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
     let col = |k: usize| Color::new(x[0][k] as f32, x[1][k] as f32, x[2][k] as f32);
-    let material = Material::new(Color::BLACK, col(0), col(1), Color::BLACK, s).expect("colours in [0, 1]");
+    let material = Material::new(Color::BLACK, col(0), col(1), Color::BLACK, s)
+        .map_err(|e| FitError::Input(format!("the BRDF gives no Phong material ({e})")))?;
     // The error table: weighted RMS residual by incident angle.
     let b = basis(s);
     let mut bins = [(0.0f64, 0.0f64, 0usize); 6];
