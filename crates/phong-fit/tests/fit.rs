@@ -382,7 +382,7 @@ fn a_merl_file_written_from_known_parameters_is_fitted_back() {
         );
         let mixed = Merl::encode(|th, td, pd| {
             let (l, v) = from_half_diff(th, td, pd);
-            if (th * 1000.0) as u64 % 7 == 0 {
+            if ((th * 1000.0) as u64).is_multiple_of(7) {
                 [bad; 3]
             } else {
                 f(l, v)
