@@ -497,3 +497,59 @@ fn bench_line_format() {
         "{e}"
     );
 }
+
+/// A PLY model renders from the command line as an OBJ does (framed, lit), a binary STL named
+/// in a scene's `mesh` too; a file of no format phong reads is exit 2 naming the formats.
+#[test]
+fn ply_and_stl_models_render() {
+    let ply = tmp("tetra.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 4\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+    )
+    .unwrap();
+    let out = tmp("tetra.png");
+    let o = phong(&[
+        "render",
+        ply.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "48",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (w, h, _, px) = read_png(&out);
+    assert_eq!((w, h), (64, 48));
+    assert!(px.iter().any(|&b| b > 40), "the model is drawn");
+    // A binary STL of one triangle in a scene, beside it.
+    let stl = tmp("tri.stl");
+    let mut b = b"binary".to_vec();
+    b.resize(80, 0);
+    b.extend(1u32.to_le_bytes());
+    for c in [0f32, 0.0, 1.0, -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 0.0] {
+        b.extend(c.to_le_bytes());
+    }
+    b.extend([0, 0]);
+    std::fs::write(&stl, &b).unwrap();
+    let scene = tmp("s.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[image]\nwidth = 32\nheight = 32\n[[object]]\nmesh = \"{}\"\nmaterial = \"gold\"\n",
+            stl.display()
+        ),
+    )
+    .unwrap();
+    let out2 = tmp("s.png");
+    let o = phong(&["render", scene.to_str().unwrap(), "-o", out2.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let other = tmp("cloud.xyz");
+    std::fs::write(&other, "ply\nnot really\n").unwrap();
+    let o = phong(&["render", other.to_str().unwrap(), "-o", out2.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cloud.xyz"), "{}", stderr(&o));
+}

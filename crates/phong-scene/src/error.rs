@@ -29,6 +29,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A model file that is not in a format phong reads, or that its format's reader refused
+    /// (PLY and STL readers name no line).
+    #[error("{}: {message}", .path.display())]
+    Model {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// The output could not be written.
     #[error("cannot write {}", .path.display())]
     Write {
@@ -50,6 +59,7 @@ impl Error {
         match self {
             Error::Read { .. } => true,
             Error::Parse { .. } => true,
+            Error::Model { .. } => true,
             Error::Write { .. } => false,
         }
     }

@@ -8,6 +8,7 @@
 //! column and key (`scene.toml:12:13: \`shininess\`: must be >= 0, got -1`).
 
 mod error;
+mod formats;
 mod json_scene;
 mod model;
 mod obj;
@@ -17,6 +18,7 @@ mod read;
 mod toml_scene;
 
 pub use error::Error;
+pub use formats::{ModelFormat, load_model, load_model_sources, model_format, parse_mesh_bytes};
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
 pub use model::{ModelView, model_scene, model_view};
 pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
@@ -41,10 +43,17 @@ pub struct Loaded {
     pub sources: Vec<std::path::PathBuf>,
 }
 
-/// Loads a scene file (`.toml`) or a model (`.obj`, framed by a default camera and lights).
+/// Loads a scene file (`.toml`) or a model (`.obj`, `.ply`, `.stl`, framed by a default camera
+/// and lights). A file of another extension is a model where its content says so (a PLY or
+/// STL), else a scene file.
 pub fn load(path: &Path) -> Result<Loaded, Error> {
-    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if is_obj {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let model = match ext.as_deref() {
+        Some("toml") => false,
+        Some("obj" | "ply" | "stl" | "gltf" | "glb") => true,
+        _ => sniff_model(path),
+    };
+    if model {
         model::scene_for_model(path)
     } else {
         let src = read_text(
@@ -56,4 +65,20 @@ pub fn load(path: &Path) -> Result<Loaded, Error> {
         loaded.sources.insert(0, path.to_path_buf());
         Ok(loaded)
     }
+}
+
+/// Whether the file at `path` begins as a PLY, STL or glTF model does (the first bytes of a
+/// regular file; anything unreadable is left to the scene reader's message).
+fn sniff_model(path: &Path) -> bool {
+    use std::io::Read;
+    if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+        return false;
+    }
+    let mut head = Vec::new();
+    let read = std::fs::File::open(path).and_then(|f| f.take(1024).read_to_end(&mut head));
+    read.is_ok()
+        && (head.starts_with(b"ply\n")
+            || head.starts_with(b"ply\r\n")
+            || head.starts_with(b"glTF")
+            || String::from_utf8_lossy(&head).trim_start().starts_with("solid"))
 }

@@ -1,7 +1,7 @@
 //! A model alone as a scene: the camera that frames it, its lights and background, the model
 //! as the only object. `phong render MODEL.obj` and `phong serve MODEL.obj` both read it.
 
-use crate::{Error, Loaded, ObjPart, load_obj_sources};
+use crate::{Error, Loaded, ObjPart, load_model_sources};
 use glam::Vec3;
 use std::path::Path;
 
@@ -9,7 +9,7 @@ use std::path::Path;
 /// as its mesh (so that `phong render MODEL.obj` and `phong serve MODEL.obj` draw the same).
 pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
     let (mut warnings, mut sources) = (Vec::new(), Vec::new());
-    let parts = load_obj_sources(path, &mut warnings, &mut sources)?;
+    let parts = load_model_sources(path, &mut warnings, &mut sources)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

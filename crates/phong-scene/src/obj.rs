@@ -313,11 +313,22 @@ pub fn load_obj_sources(
 ) -> Result<Vec<ObjPart>, Error> {
     let src = read(path)?;
     sources.push(path.to_path_buf());
+    obj_from_text(path, &src, warnings, sources)
+}
+
+/// An OBJ's text `src` (of `path`) with its MTL libraries read beside it, each added to
+/// `sources`.
+pub(crate) fn obj_from_text(
+    path: &Path,
+    src: &str,
+    warnings: &mut Vec<String>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Vec<ObjPart>, Error> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_mtl = std::cell::RefCell::new(Vec::new());
     let out = load_obj_text(
         path,
-        &src,
+        src,
         &|mtl| {
             let p = dir.join(mtl);
             read_mtl.borrow_mut().push(p.clone());

@@ -46,7 +46,11 @@ pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Erro
 
 /// [`read_bounded`] as UTF-8 text; the error names the first line that is not.
 pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, Error> {
-    let bytes = read_bounded(path, limit, what)?;
+    text_of(path, read_bounded(path, limit, what)?, what)
+}
+
+/// `bytes` (of `path`) as UTF-8 text; the error names the first line that is not.
+pub(crate) fn text_of(path: &Path, bytes: Vec<u8>, what: &str) -> Result<String, Error> {
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let bytes = e.as_bytes();

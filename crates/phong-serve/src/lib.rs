@@ -54,7 +54,7 @@ pub fn initial_scene(file: Option<&Path>) -> Result<(serde_json::Value, models::
         None => toml_to_json(DEFAULT_SCENE, Path::new("default.toml"))?,
         Some(f) if is_obj => {
             let mut warnings = Vec::new();
-            let parts = phong_scene::load_obj(f, &mut warnings)?;
+            let parts = phong_scene::load_model(f, &mut warnings)?;
             for w in warnings {
                 eprintln!("warning: {w}");
             }
@@ -78,7 +78,7 @@ pub fn initial_scene(file: Option<&Path>) -> Result<(serde_json::Value, models::
             for o in json.get("object").and_then(|o| o.as_array()).into_iter().flatten() {
                 if let Some(m) = o.get("mesh").and_then(|m| m.as_str()) {
                     let mut warnings = Vec::new();
-                    let parts = phong_scene::load_obj(&dir.join(m), &mut warnings)?;
+                    let parts = phong_scene::load_model(&dir.join(m), &mut warnings)?;
                     library.insert(m.to_string(), parts);
                 }
             }

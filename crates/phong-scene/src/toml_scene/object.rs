@@ -5,7 +5,7 @@ use super::ctx::{Ctx, S};
 use super::material::{lookup_material, material};
 use super::raw::{MaterialRef, RawMaterial, RawObject, Scale};
 use crate::Error;
-use crate::load_obj_sources;
+use crate::load_model_sources;
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::MAX_SEGMENTS;
 use phong_core::{Material, Mesh, Object, ShadingSettings, primitives};
@@ -149,11 +149,11 @@ pub(super) fn object(
                     if !file.exists() {
                         return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
                     }
-                    let ext_ok = file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-                    if !ext_ok {
-                        return ctx.err(&m.span(), "mesh", "only Wavefront .obj meshes are supported");
+                    // A file in no format phong reads is reported at the scene's `mesh` key.
+                    match load_model_sources(&file, &mut warnings, &mut sources) {
+                        Err(e @ Error::Model { .. }) => return ctx.err(&m.span(), "mesh", e.to_string()),
+                        r => r?,
                     }
-                    load_obj_sources(&file, &mut warnings, &mut sources)?
                 }
             };
             let mut out = Vec::new();

@@ -1,0 +1,307 @@
+//! Model files by format: OBJ with its MTL libraries (`obj.rs`), PLY (ply-rs) and STL
+//! (stl_io). The format is told by the content where the content tells it (PLY's `ply` line,
+//! glTF's magic, a binary STL's size, an ASCII STL's `solid`), else by the extension; anything
+//! else is an error naming the formats phong reads.
+
+use crate::obj::obj_from_text;
+use crate::read::text_of;
+use crate::{Error, ObjPart, read_bounded};
+use glam::Vec3;
+use phong_core::Mesh;
+use phong_core::limits::MAX_MODEL_BYTES;
+use ply_rs::parser::Parser;
+use ply_rs::ply::{Property, PropertyAccess};
+use std::path::{Path, PathBuf};
+
+const WHAT: &str = "model (MAX_MODEL_BYTES)";
+
+/// The model formats phong reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelFormat {
+    /// Wavefront OBJ (with MTL libraries).
+    Obj,
+    /// Stanford PLY, ASCII or binary.
+    Ply,
+    /// STL, ASCII or binary.
+    Stl,
+}
+
+/// The format of model `path` whose bytes are `bytes`; an error for glTF (not read yet) and
+/// for what is none of them.
+pub fn model_format(path: &Path, bytes: &[u8]) -> Result<ModelFormat, Error> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let fail = |message: String| Error::Model {
+        path: path.to_path_buf(),
+        message,
+    };
+    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+        return Ok(ModelFormat::Ply);
+    }
+    if bytes.starts_with(b"glTF") || ext == "gltf" || ext == "glb" {
+        return Err(fail(
+            "glTF files are not read yet; export the model as OBJ, PLY or STL".into(),
+        ));
+    }
+    // A binary STL: an 80-byte header, a triangle count, 50 bytes a triangle (its header may
+    // begin with "solid" too, so the size decides first).
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]);
+        if 84 + 50 * u64::from(n) == bytes.len() as u64 {
+            return Ok(ModelFormat::Stl);
+        }
+    }
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(1024)]);
+    if head.trim_start().starts_with("solid") && head.contains("facet") {
+        return Ok(ModelFormat::Stl);
+    }
+    match ext.as_str() {
+        "obj" => Ok(ModelFormat::Obj),
+        "ply" => Ok(ModelFormat::Ply),
+        "stl" => Ok(ModelFormat::Stl),
+        _ => Err(fail(format!(
+            "not a model phong reads (OBJ .obj, PLY .ply, STL .stl){}",
+            if ext.is_empty() {
+                String::new()
+            } else {
+                format!("; .{ext} is not one of them")
+            }
+        ))),
+    }
+}
+
+/// Reads the model at `path` in whichever format it is, adding every file read to `sources`
+/// (the model and its MTL libraries).
+pub fn load_model_sources(
+    path: &Path,
+    warnings: &mut Vec<String>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Vec<ObjPart>, Error> {
+    let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
+    sources.push(path.to_path_buf());
+    match model_format(path, &bytes)? {
+        ModelFormat::Obj => obj_from_text(path, &text_of(path, bytes, WHAT)?, warnings, sources),
+        ModelFormat::Ply => read_ply(path, &bytes),
+        ModelFormat::Stl => read_stl(path, &bytes),
+    }
+}
+
+/// A PLY or STL model from its bytes (`path` names it and tells the format as
+/// [`model_format`] does); an OBJ is refused here (its MTL libraries are files: use
+/// [`load_model_sources`] or [`load_obj_text`](crate::load_obj_text)).
+pub fn parse_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+    match model_format(path, bytes)? {
+        ModelFormat::Ply => read_ply(path, bytes),
+        ModelFormat::Stl => read_stl(path, bytes),
+        ModelFormat::Obj => Err(model_error(
+            path,
+            "an OBJ is read with its MTL libraries, not here".into(),
+        )),
+    }
+}
+
+/// [`load_model_sources`] without the list of files read.
+pub fn load_model(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
+    load_model_sources(path, warnings, &mut Vec::new())
+}
+
+/// The name of a model's one part: its file name.
+fn part_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn model_error(path: &Path, message: String) -> Error {
+    Error::Model {
+        path: path.to_path_buf(),
+        message,
+    }
+}
+
+/// A PLY vertex: position and, where the file has all three, a normal.
+#[derive(Default)]
+struct PlyVertex {
+    p: [Option<f64>; 3],
+    n: [Option<f64>; 3],
+}
+
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(v) => f64::from(v),
+        Property::UChar(v) => f64::from(v),
+        Property::Short(v) => f64::from(v),
+        Property::UShort(v) => f64::from(v),
+        Property::Int(v) => f64::from(v),
+        Property::UInt(v) => f64::from(v),
+        Property::Float(v) => f64::from(v),
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+impl PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        PlyVertex::default()
+    }
+    fn set_property(&mut self, name: String, property: Property) {
+        let slot = match name.as_str() {
+            "x" => &mut self.p[0],
+            "y" => &mut self.p[1],
+            "z" => &mut self.p[2],
+            "nx" => &mut self.n[0],
+            "ny" => &mut self.n[1],
+            "nz" => &mut self.n[2],
+            _ => return,
+        };
+        *slot = scalar(&property);
+    }
+}
+
+/// A PLY face: its vertex indices (`vertex_indices` or `vertex_index`).
+#[derive(Default)]
+struct PlyFace(Option<Vec<i64>>);
+
+impl PropertyAccess for PlyFace {
+    fn new() -> Self {
+        PlyFace::default()
+    }
+    fn set_property(&mut self, name: String, property: Property) {
+        if name != "vertex_indices" && name != "vertex_index" {
+            return;
+        }
+        self.0 = match property {
+            Property::ListChar(v) => Some(v.into_iter().map(i64::from).collect()),
+            Property::ListUChar(v) => Some(v.into_iter().map(i64::from).collect()),
+            Property::ListShort(v) => Some(v.into_iter().map(i64::from).collect()),
+            Property::ListUShort(v) => Some(v.into_iter().map(i64::from).collect()),
+            Property::ListInt(v) => Some(v.into_iter().map(i64::from).collect()),
+            Property::ListUInt(v) => Some(v.into_iter().map(i64::from).collect()),
+            _ => None,
+        };
+    }
+}
+
+/// What ply-rs's header grammar panics on instead of refusing: a number in a header line past
+/// `u64` (its `uint` rule unwraps the parse). The header is the text up to `end_header`.
+fn check_ply_header(bytes: &[u8]) -> Result<(), String> {
+    let end = bytes
+        .windows(10)
+        .position(|w| w == b"end_header")
+        .unwrap_or(bytes.len().min(1 << 16));
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    for (i, line) in header.lines().enumerate() {
+        for run in line.split(|c: char| !c.is_ascii_digit()).filter(|r| !r.is_empty()) {
+            if run.parse::<u64>().is_err() {
+                return Err(format!("header line {}: the number {run} is too large", i + 1));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A PLY file's `vertex` and `face` elements as one part (polygons as fans; other elements
+/// skipped).
+fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+    let fail = |m: String| model_error(path, format!("malformed PLY: {m}"));
+    check_ply_header(bytes).map_err(fail)?;
+    let mut reader = std::io::BufReader::new(bytes);
+    let header = Parser::<PlyVertex>::new()
+        .read_header(&mut reader)
+        .map_err(|e| fail(e.to_string()))?;
+    let (mut vertices, mut faces) = (Vec::new(), Vec::new());
+    for (name, element) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                vertices = Parser::<PlyVertex>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| fail(format!("element vertex: {e}")))?;
+            }
+            "face" => {
+                faces = Parser::<PlyFace>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| fail(format!("element face: {e}")))?;
+            }
+            other => {
+                // Read past it (edges, materials, a scanner's extras).
+                Parser::<ply_rs::ply::DefaultElement>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| fail(format!("element {other}: {e}")))?;
+            }
+        }
+    }
+    let mut positions = Vec::with_capacity(vertices.len());
+    let mut normals = Vec::with_capacity(vertices.len());
+    let mut has_normals = !vertices.is_empty();
+    for (i, v) in vertices.iter().enumerate() {
+        let [Some(x), Some(y), Some(z)] = v.p else {
+            return Err(fail(format!("vertex {i} has no x, y and z")));
+        };
+        let p = Vec3::new(x as f32, y as f32, z as f32);
+        if !p.is_finite() {
+            return Err(fail(format!("vertex {i} is not finite: {p}")));
+        }
+        positions.push(p);
+        match v.n {
+            [Some(x), Some(y), Some(z)] => normals.push(Vec3::new(x as f32, y as f32, z as f32).normalize_or_zero()),
+            _ => {
+                has_normals = false;
+                normals.push(Vec3::ZERO);
+            }
+        }
+    }
+    let n = positions.len() as i64;
+    let mut triangles = Vec::new();
+    for (k, f) in faces.iter().enumerate() {
+        let idx =
+            f.0.as_deref()
+                .ok_or_else(|| fail(format!("face {k} has no vertex_indices")))?;
+        if let Some(bad) = idx.iter().find(|&&i| i < 0 || i >= n) {
+            return Err(fail(format!(
+                "face {k}: vertex index {bad} is out of range ({n} vertices)"
+            )));
+        }
+        for j in 1..idx.len().saturating_sub(1) {
+            triangles.push([idx[0] as u32, idx[j] as u32, idx[j + 1] as u32]);
+        }
+    }
+    if triangles.is_empty() {
+        return Err(fail("no faces: nothing to render (a point cloud?)".into()));
+    }
+    if !has_normals {
+        normals = vec![Vec3::ZERO; positions.len()];
+    }
+    let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
+    Ok(vec![ObjPart {
+        name: part_name(path),
+        mesh,
+        material: None,
+        has_normals,
+    }])
+}
+
+/// An STL file (ASCII or binary) as one part, its vertices shared where they are equal
+/// (stl_io's indexing); the facets' normals are not used (the scene's `normals` choice makes
+/// them).
+fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+    let fail = |m: String| model_error(path, format!("malformed STL: {m}"));
+    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| fail(e.to_string()))?;
+    let positions: Vec<Vec3> = mesh.vertices.iter().map(|v| Vec3::from_array(v.0)).collect();
+    if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+        return Err(fail(format!("vertex {i} is not finite: {p}")));
+    }
+    let triangles: Vec<[u32; 3]> = mesh.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
+    if triangles.is_empty() {
+        return Err(fail("no facets: nothing to render".into()));
+    }
+    let normals = vec![Vec3::ZERO; positions.len()];
+    let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
+    Ok(vec![ObjPart {
+        name: part_name(path),
+        mesh,
+        material: None,
+        has_normals: false,
+    }])
+}

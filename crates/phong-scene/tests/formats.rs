@@ -1,0 +1,260 @@
+//! PLY and STL models, and how a model's format is told: files written here byte by byte, so
+//! that what they hold is known independently of the readers.
+
+use glam::Vec3;
+use phong_scene::{Error, ModelFormat, load, load_model, model_format};
+use std::path::{Path, PathBuf};
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("phong-formats-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(d: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = d.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// The unit cube's 8 corners and its 6 faces as quads, counter-clockwise from outside.
+const CUBE_V: [[f32; 3]; 8] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 0.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [0.0, 1.0, 1.0],
+];
+const CUBE_F: [[u32; 4]; 6] = [
+    [0, 3, 2, 1],
+    [4, 5, 6, 7],
+    [0, 1, 5, 4],
+    [1, 2, 6, 5],
+    [2, 3, 7, 6],
+    [3, 0, 4, 7],
+];
+
+fn ascii_ply_cube() -> String {
+    let mut s = String::from(
+        "ply\nformat ascii 1.0\ncomment a cube\nelement vertex 8\nproperty float x\nproperty float y\n\
+         property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 6\n\
+         property list uchar int vertex_indices\nelement edge 1\nproperty int vertex1\nproperty int vertex2\n\
+         end_header\n",
+    );
+    for v in CUBE_V {
+        s += &format!("{} {} {} 255 0 0\n", v[0], v[1], v[2]);
+    }
+    for f in CUBE_F {
+        s += &format!("4 {} {} {} {}\n", f[0], f[1], f[2], f[3]);
+    }
+    s += "0 1\n";
+    s
+}
+
+/// A binary PLY of the cube with normals, in either byte order.
+fn binary_ply_cube(big: bool) -> Vec<u8> {
+    let order = if big {
+        "binary_big_endian"
+    } else {
+        "binary_little_endian"
+    };
+    let mut b = format!(
+        "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\nelement face 6\n\
+         property list uchar uint vertex_index\nend_header\n"
+    )
+    .into_bytes();
+    let f32b = |x: f32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
+    let u32b = |x: u32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
+    for v in CUBE_V {
+        let n = (Vec3::from_array(v) - 0.5).normalize();
+        for c in v.into_iter().chain(n.to_array()) {
+            b.extend(f32b(c));
+        }
+    }
+    for f in CUBE_F {
+        b.push(4);
+        for i in f {
+            b.extend(u32b(i));
+        }
+    }
+    b
+}
+
+/// A binary STL of `tris`, its header beginning with "solid" as some exporters write it.
+fn binary_stl(tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut b = b"solid exported by a tool that writes binary STL".to_vec();
+    b.resize(80, b' ');
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        for c in [0.0f32; 3].into_iter().chain(t.iter().flatten().copied()) {
+            b.extend(c.to_le_bytes());
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
+fn cube_triangles() -> Vec<[[f32; 3]; 3]> {
+    CUBE_F
+        .iter()
+        .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
+        .map(|t| t.map(|i| CUBE_V[i as usize]))
+        .collect()
+}
+
+/// Each of the mesh's triangles as its three corners.
+fn corners(m: &phong_core::Mesh) -> Vec<[[f32; 3]; 3]> {
+    m.triangles()
+        .iter()
+        .map(|t| t.map(|i| m.positions()[i as usize].to_array()))
+        .collect()
+}
+
+#[test]
+fn ply_ascii_and_binary_in_both_byte_orders() {
+    let d = dir("ply");
+    let want = cube_triangles();
+    for (name, bytes) in [
+        ("ascii.ply", ascii_ply_cube().into_bytes()),
+        ("little.ply", binary_ply_cube(false)),
+        ("big.ply", binary_ply_cube(true)),
+    ] {
+        let p = write(&d, name, &bytes);
+        assert_eq!(model_format(&p, &bytes).unwrap(), ModelFormat::Ply);
+        let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(parts.len(), 1);
+        let m = &parts[0].mesh;
+        // Quads as two triangles each, the same corners in the same order as written.
+        assert_eq!(corners(m), want, "{name}");
+        assert_eq!(parts[0].has_normals, name != "ascii.ply", "{name}");
+        if parts[0].has_normals {
+            for (p, n) in m.positions().iter().zip(m.normals()) {
+                assert!((*n - (*p - 0.5).normalize()).length() < 1e-6, "{name}: {p} {n}");
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
+
+#[test]
+fn stl_binary_and_ascii() {
+    let d = dir("stl");
+    let tris = cube_triangles();
+    let bin = binary_stl(&tris);
+    let mut ascii = String::from("solid cube\n");
+    for t in &tris {
+        ascii += "facet normal 0 0 0\nouter loop\n";
+        for v in t {
+            ascii += &format!("vertex {} {} {}\n", v[0], v[1], v[2]);
+        }
+        ascii += "endloop\nendfacet\n";
+    }
+    ascii += "endsolid cube\n";
+    for (name, bytes) in [("bin.stl", bin), ("ascii.stl", ascii.into_bytes())] {
+        let p = write(&d, name, &bytes);
+        assert_eq!(model_format(&p, &bytes).unwrap(), ModelFormat::Stl, "{name}");
+        let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let m = &parts[0].mesh;
+        assert_eq!(corners(m), tris, "{name}");
+        // Equal corners share a vertex: the cube's 8.
+        assert_eq!(m.positions().len(), 8, "{name}");
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
+
+#[test]
+fn the_format_is_told_by_content_then_extension() {
+    let d = dir("sniff");
+    // A PLY named .stl is a PLY; an STL named .dat is an STL and `load` frames it as a model.
+    let ply = write(&d, "misnamed.stl", ascii_ply_cube().as_bytes());
+    assert_eq!(load_model(&ply, &mut Vec::new()).unwrap()[0].mesh.triangles().len(), 12);
+    let stl = write(&d, "cube.dat", &binary_stl(&cube_triangles()));
+    let scene = load(&stl).unwrap().scene;
+    assert_eq!(scene.triangle_count(), 12);
+    // glTF, and what is none of the formats: errors naming the file and the formats.
+    let gltf = write(&d, "box.glb", b"glTF\x02\x00\x00\x00");
+    let e = load_model(&gltf, &mut Vec::new()).unwrap_err();
+    assert!(
+        e.is_input() && e.to_string().contains("box.glb: glTF files are not read yet"),
+        "{e}"
+    );
+    let other = write(&d, "points.xyz", b"1 2 3\n4 5 6\n");
+    let e = load_model(&other, &mut Vec::new()).unwrap_err().to_string();
+    assert!(
+        e.contains("points.xyz: not a model phong reads (OBJ .obj, PLY .ply, STL .stl)"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// The binary cube with a NaN for vertex 0's x.
+fn nan_binary() -> Vec<u8> {
+    let mut b = binary_ply_cube(false);
+    let at = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    b[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    b
+}
+
+/// Broken files are errors naming the file and the fault, quickly, never a panic or an
+/// allocation sized by a header's claim.
+#[test]
+fn broken_ply_and_stl_are_errors() {
+    let d = dir("broken");
+    let good = ascii_ply_cube();
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "index.ply",
+            good.replace("4 0 3 2 1", "4 0 3 2 9").into_bytes(),
+            "vertex index 9 is out of range",
+        ),
+        (
+            "huge.ply",
+            good.replace("element vertex 8", "element vertex 4000000000")
+                .into_bytes(),
+            "malformed PLY",
+        ),
+        ("cut.ply", binary_ply_cube(false)[..300].to_vec(), "malformed PLY"),
+        (
+            "nan.ply",
+            good.replace("1 1 1 255", "nan 1 1 255").into_bytes(),
+            "Line 6",
+        ),
+        ("nan-binary.ply", nan_binary(), "vertex 0 is not finite"),
+        (
+            "points.ply",
+            good.replace("element face 6", "element face 0").into_bytes(),
+            "no faces",
+        ),
+        (
+            "noheader.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 1\n".to_vec(),
+            "malformed PLY",
+        ),
+        // Found by the ply_stl fuzz target: a count past u64 panicked inside ply-rs.
+        (
+            "count.ply",
+            good.replace("element face 6", "element face 666666666666666666666666")
+                .into_bytes(),
+            "header line 11: the number 666666666666666666666666 is too large",
+        ),
+        (
+            "cut.stl",
+            binary_stl(&cube_triangles())[..200].to_vec(),
+            "malformed STL",
+        ),
+    ];
+    for (name, bytes, want) in cases {
+        let p = write(&d, name, &bytes);
+        let e: Error = load_model(&p, &mut Vec::new()).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            e.is_input() && msg.contains(name) && msg.contains(want),
+            "{name}: {msg}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
