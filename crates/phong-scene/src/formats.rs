@@ -3,8 +3,7 @@
 //! glTF's magic, a binary STL's size, an ASCII STL's `solid`), else by the extension; anything
 //! else is an error naming the formats phong reads.
 
-use crate::obj::obj_from_text;
-use crate::read::text_of;
+use crate::obj::{decode_text, obj_from_text};
 use crate::{Error, ObjPart, read_bounded};
 use glam::Vec3;
 use phong_core::Mesh;
@@ -82,7 +81,10 @@ pub fn load_model_sources(
     let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
     sources.push(path.to_path_buf());
     match model_format(path, &bytes)? {
-        ModelFormat::Obj => obj_from_text(path, &text_of(path, bytes, WHAT)?, warnings, sources),
+        ModelFormat::Obj => {
+            let text = decode_text(path, bytes, warnings);
+            obj_from_text(path, &text, warnings, sources)
+        }
         ModelFormat::Ply => read_ply(path, &bytes),
         ModelFormat::Stl => read_stl(path, &bytes),
     }

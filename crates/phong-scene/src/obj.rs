@@ -31,8 +31,10 @@ pub struct ObjPart {
     pub has_normals: bool,
 }
 
-fn read(path: &Path) -> Result<String, Error> {
-    crate::read_text(path, phong_core::limits::MAX_MODEL_BYTES, "model (MAX_MODEL_BYTES)")
+/// A model file's text (see [`decode_text`]).
+fn read(path: &Path, warnings: &mut Vec<String>) -> Result<String, Error> {
+    let bytes = crate::read_bounded(path, phong_core::limits::MAX_MODEL_BYTES, "model (MAX_MODEL_BYTES)")?;
+    Ok(decode_text(path, bytes, warnings))
 }
 
 /// Offset of the `n`th whitespace-separated field of `line` (0 = keyword), for columns.
@@ -169,6 +171,28 @@ fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// A model's or material library's text: UTF-8 (a byte-order mark dropped) or, where it is not,
+/// Latin-1 (every byte a character, as the files of older tools are), with a warning.
+pub(crate) fn decode_text(path: &Path, mut bytes: Vec<u8>, warnings: &mut Vec<String>) -> String {
+    if bytes.starts_with(&[0xef, 0xbb, 0xbf]) {
+        bytes.drain(..3);
+    }
+    match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => {
+            let bytes = e.into_bytes();
+            let at = std::str::from_utf8(&bytes).map_or_else(|e| e.valid_up_to(), |_| 0);
+            let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+            warnings.push(format!(
+                "{}: not UTF-8 (line {line}, byte 0x{:02x}): read as Latin-1",
+                path.display(),
+                bytes[at]
+            ));
+            bytes.iter().map(|&b| char::from(b)).collect()
+        }
+    }
 }
 
 /// The OBJ text as tobj reads it, line for line (so that the pre-check's lines stay right):
@@ -311,7 +335,7 @@ pub fn load_obj_sources(
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
 ) -> Result<Vec<ObjPart>, Error> {
-    let src = read(path)?;
+    let src = read(path, warnings)?;
     sources.push(path.to_path_buf());
     obj_from_text(path, &src, warnings, sources)
 }
@@ -326,13 +350,14 @@ pub(crate) fn obj_from_text(
 ) -> Result<Vec<ObjPart>, Error> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_mtl = std::cell::RefCell::new(Vec::new());
+    let latin1 = std::cell::RefCell::new(Vec::new());
     let out = load_obj_text(
         path,
         src,
         &|mtl| {
             let p = dir.join(mtl);
             read_mtl.borrow_mut().push(p.clone());
-            crate::read_text(
+            let bytes = crate::read_bounded(
                 &p,
                 phong_core::limits::MAX_MTL_BYTES,
                 "material library (MAX_MTL_BYTES)",
@@ -340,10 +365,12 @@ pub(crate) fn obj_from_text(
             .map_err(|e| match e {
                 Error::Read { source, .. } => source,
                 other => std::io::Error::other(other.to_string()),
-            })
+            })?;
+            Ok(decode_text(&p, bytes, &mut latin1.borrow_mut()))
         },
         warnings,
     );
+    warnings.extend(latin1.into_inner());
     sources.extend(read_mtl.into_inner());
     out
 }
@@ -357,6 +384,18 @@ pub fn load_obj_text(
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ObjPart>, Error> {
     check_obj(path, src)?;
+    let count = |kw: &str| {
+        lines(src)
+            .filter(|(_, l)| l.split_whitespace().next() == Some(kw))
+            .count()
+    };
+    let (lines_, points) = (count("l"), count("p"));
+    if lines_ + points > 0 {
+        warnings.push(format!(
+            "{}: {lines_} line (`l`) and {points} point (`p`) statements skipped: phong draws surfaces",
+            path.display()
+        ));
+    }
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
     let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
@@ -372,14 +411,27 @@ pub fn load_obj_text(
         let text = match read_mtl(mtl) {
             Ok(t) => t,
             Err(e) => {
-                // Locate the name on its `mtllib` line (not in a comment or another statement).
+                // Located at the `mtllib` statement (its line, not a comment's). A library that
+                // is not there is a warning, its faces get the default material (as other
+                // loaders do); one that is there and cannot be read (a FIFO, too large) is an
+                // error.
                 let name = mtl.to_string_lossy();
                 let at = lines(src)
                     .filter(|(_, l)| l.split('#').next().unwrap_or("").trim_start().starts_with("mtllib"))
                     .find_map(|(start, l)| l.split('#').next().unwrap_or("").find(&*name).map(|i| start + i))
                     .unwrap_or(0);
-                let msg = format!("material library {} cannot be read: {e}", p.display());
-                *mtl_error.borrow_mut() = Some(Error::at(path, src, at, Some("mtllib"), msg));
+                if e.kind() == std::io::ErrorKind::NotFound {
+                    let msg = format!(
+                        "material library {} not found: its materials are the default material",
+                        p.display()
+                    );
+                    mtl_warnings
+                        .borrow_mut()
+                        .push(Error::at(path, src, at, Some("mtllib"), msg).to_string());
+                } else {
+                    let msg = format!("material library {} cannot be read: {e}", p.display());
+                    *mtl_error.borrow_mut() = Some(Error::at(path, src, at, Some("mtllib"), msg));
+                }
                 return Err(tobj::LoadError::OpenFileFailed);
             }
         };
@@ -561,6 +613,51 @@ mod tests {
         let _ = std::fs::remove_dir_all(d);
     }
 
+    /// Text that is not UTF-8 is read as Latin-1 with a warning naming the line; a UTF-8
+    /// byte-order mark is dropped; `l` and `p` statements are skipped with one warning counting
+    /// them.
+    #[test]
+    fn latin1_bom_lines_and_points() {
+        let d = tmpdir("enc");
+        write(&d, "m.mtl", "newmtl caf\u{e9}\nKd 0.5 0.25 1\n");
+        let mtl = d.join("m.mtl");
+        let mut latin = std::fs::read(&mtl).unwrap();
+        latin.retain(|&b| b != 0xc3); // é as one Latin-1 byte
+        latin.iter_mut().for_each(|b| {
+            if *b == 0xa9 {
+                *b = 0xe9
+            }
+        });
+        std::fs::write(&mtl, &latin).unwrap();
+        let obj = write(
+            &d,
+            "m.obj",
+            "\u{feff}mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\np 3\np 1\nusemtl caf\u{e9}\nf 1 2 3\n",
+        );
+        let mut bytes = std::fs::read(&obj).unwrap();
+        let at = bytes.windows(2).position(|w| w == [0xc3, 0xa9]).unwrap();
+        bytes.splice(at..at + 2, [0xe9]);
+        std::fs::write(&obj, &bytes).unwrap();
+        let mut w = Vec::new();
+        let parts = crate::load_model(&obj, &mut w).unwrap();
+        assert_eq!(
+            parts[0].material.unwrap().diffuse(),
+            phong_core::Color::new(0.5, 0.25, 1.0)
+        );
+        assert!(
+            w.iter()
+                .any(|w| w.contains("m.obj: not UTF-8 (line 8") && w.contains("Latin-1")),
+            "{w:?}"
+        );
+        assert!(w.iter().any(|w| w.contains("m.mtl: not UTF-8 (line 1")), "{w:?}");
+        assert!(
+            w.iter()
+                .any(|w| w.contains("1 line (`l`) and 2 point (`p`) statements skipped")),
+            "{w:?}"
+        );
+        let _ = std::fs::remove_dir_all(d);
+    }
+
     #[test]
     fn malformed_obj_names_line_and_column() {
         let d = tmpdir("bad");
@@ -583,13 +680,26 @@ mod tests {
                 .to_string()
                 .contains("short.obj:1:1")
         );
-        // An `mtllib` name also in a comment: the statement's line is named.
-        let obj = write(&d, "comment.obj", "# see nope.mtl\nmtllib nope.mtl\nv 0 0 0\n");
-        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
-        assert!(e.contains("comment.obj:2:8: `mtllib`"), "{e}");
-        let obj = write(&d, "mtl.obj", "mtllib nope.mtl\nv 0 0 0\n");
-        let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();
-        assert!(e.contains("mtl.obj:1:8: `mtllib`") && e.contains("nope.mtl"), "{e}");
+        // A missing MTL library: a warning naming the `mtllib` statement (its line, not a
+        // comment's), and the default material.
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl gone\nf 1 2 3\n";
+        for (name, text, want) in [
+            (
+                "comment.obj",
+                format!("# see nope.mtl\nmtllib nope.mtl\n{tri}"),
+                "comment.obj:2:8: `mtllib`",
+            ),
+            ("mtl.obj", format!("mtllib nope.mtl\n{tri}"), "mtl.obj:1:8: `mtllib`"),
+        ] {
+            let obj = write(&d, name, &text);
+            let mut w = Vec::new();
+            let parts = load_obj(&obj, &mut w).unwrap();
+            assert!(parts[0].material.is_none(), "{name}");
+            assert!(
+                w.iter().any(|w| w.contains(want) && w.contains("nope.mtl")),
+                "{name}: {w:?}"
+            );
+        }
         write(&d, "neg.mtl", "newmtl a\nKd 1 1 1\nNs -3\n");
         let obj = write(&d, "neg.obj", "mtllib neg.mtl\nv 0 0 0\n");
         let e = load_obj(&obj, &mut Vec::new()).unwrap_err().to_string();

@@ -340,3 +340,36 @@ fn meshes_load_relative_to_the_scene() {
     assert!(e.is_input() && e.to_string().contains("nope.toml"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `normals = "file"` on a model without normals, and file normals that are zero: normals by
+/// angle instead (each unit length), with a warning naming the part.
+#[test]
+fn unusable_file_normals_fall_back_with_a_warning() {
+    let dir = std::env::temp_dir().join(format!("phong-normals-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("bare.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(
+        dir.join("zero.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 0\nf 1//1 2//2 3//1\n",
+    )
+    .unwrap();
+    for (mesh, normals, want) in [
+        ("bare.obj", "normals = \"file\"\n", "has no normals"),
+        ("zero.obj", "", "1 of its 3 file normals are zero"),
+    ] {
+        let src = format!("[[object]]\nmesh = \"{mesh}\"\n{normals}");
+        let loaded = parse_scene(&src, &dir.join("s.toml")).unwrap();
+        let m = &loaded.scene.objects[0].mesh;
+        assert!(
+            m.normals().iter().all(|n| (n.length() - 1.0).abs() < 1e-5),
+            "{mesh}: {:?}",
+            m.normals()
+        );
+        assert!(
+            loaded.warnings.iter().any(|w| w.contains(mesh) && w.contains(want)),
+            "{mesh}: {:?}",
+            loaded.warnings
+        );
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -158,8 +158,36 @@ pub(super) fn object(
             };
             let mut out = Vec::new();
             for p in parts {
-                let default = if p.has_normals { "file" } else { "angle" };
-                let mesh = apply_normals(p.mesh, default, &["file", "flat", "smooth", "angle"])?;
+                // File normals where every vertex has a usable one; else, or where `"file"`
+                // is asked of a model without them, normals by angle, with a warning.
+                let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
+                let usable = p.has_normals && bad == 0;
+                let asked = normals_choice
+                    .map(|n| ctx.name(n, "normals", &["file", "flat", "smooth", "angle"]))
+                    .transpose()?;
+                if p.has_normals && bad > 0 && asked.is_none_or(|a| a == "file") {
+                    warnings.push(format!(
+                        "{}: {bad} of its {} file normals are zero or not finite: normals computed by angle instead",
+                        p.name,
+                        p.mesh.normals().len()
+                    ));
+                } else if !p.has_normals && asked == Some("file") {
+                    warnings.push(format!(
+                        "{}: `normals = \"file\"` but the file has no normals for it: normals computed by angle",
+                        p.name
+                    ));
+                }
+                let choice = match asked {
+                    Some("file") | None if !usable => "angle",
+                    Some(a) => a,
+                    None => "file",
+                };
+                let mesh = match choice {
+                    "flat" => p.mesh.with_flat_normals(),
+                    "smooth" => p.mesh.with_smooth_normals(),
+                    "angle" => p.mesh.with_crease_normals(crease),
+                    _ => p.mesh,
+                };
                 out.push(Object {
                     name: p.name,
                     mesh: mesh.transformed(&world_from_object),
