@@ -187,14 +187,14 @@ impl PropertyAccess for PlyFace {
 }
 
 /// What ply-rs's header grammar panics on instead of refusing: a number in a header line past
-/// `u64` (its `uint` rule unwraps the parse). The header is the text up to `end_header`.
+/// `u64` (its `uint` rule unwraps the parse). The header is its lines up to the one that is
+/// `end_header` (as ply-rs reads them: a line merely containing the word goes on).
 fn check_ply_header(bytes: &[u8]) -> Result<(), String> {
-    let end = bytes
-        .windows(10)
-        .position(|w| w == b"end_header")
-        .unwrap_or(bytes.len().min(1 << 16));
-    let header = String::from_utf8_lossy(&bytes[..end]);
-    for (i, line) in header.lines().enumerate() {
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(line);
+        if line.trim() == "end_header" {
+            break;
+        }
         for run in line.split(|c: char| !c.is_ascii_digit()).filter(|r| !r.is_empty()) {
             if run.parse::<u64>().is_err() {
                 return Err(format!("header line {}: the number {run} is too large", i + 1));

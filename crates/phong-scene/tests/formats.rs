@@ -234,7 +234,17 @@ fn broken_ply_and_stl_are_errors() {
             b"ply\nformat ascii 1.0\nelement vertex 1\n".to_vec(),
             "malformed PLY",
         ),
-        // Found by the ply_stl fuzz target: a count past u64 panicked inside ply-rs.
+        // Found by the ply_stl fuzz target: a count past u64 panicked inside ply-rs, also on a
+        // line that merely contains `end_header`.
+        (
+            "word.ply",
+            good.replace(
+                "element vertex 8",
+                "element vend_headerertex 900000000000000000000000 7",
+            )
+            .into_bytes(),
+            "the number 900000000000000000000000 is too large",
+        ),
         (
             "count.ply",
             good.replace("element face 6", "element face 666666666666666666666666")
