@@ -205,15 +205,7 @@ scale = 300.0
             let clock = StageClock::default();
             let (mut drawn, mut wide, mut chosen) = (0, 0, 0);
             for index in 0..frame.bins.len() as u32 {
-                let (x0, y0, x1, y1) = frame.tile_rect(index);
-                let tile = Tile {
-                    x0,
-                    y0,
-                    x1,
-                    y1,
-                    bin: &frame.bins[index as usize],
-                    clock: &clock,
-                };
+                let tile = frame.tile(index, &clock);
                 chosen += usize::from(frame.plan_tile(&tile) == TilePlan::Gouraud { kernel: true });
                 let (tw, th) = (tile.width(), tile.height());
                 let draw = |kernel: bool| {

@@ -83,6 +83,19 @@ pub(crate) struct Multi {
 }
 
 impl Frame<'_> {
+    /// Tile `index` (row-major) of this frame, its stages added to `clock`.
+    pub fn tile<'f>(&'f self, index: u32, clock: &'f StageClock) -> Tile<'f> {
+        let (x0, y0, x1, y1) = self.tile_rect(index);
+        Tile {
+            x0,
+            y0,
+            x1,
+            y1,
+            bin: &self.bins[index as usize],
+            clock,
+        }
+    }
+
     /// The plan of `tile`.
     pub fn plan_tile(&self, tile: &Tile) -> TilePlan {
         let n = tile.bin.len();
@@ -169,16 +182,7 @@ impl Frame<'_> {
                     .into_par_iter()
                     .enumerate()
                     .for_each_init(TileBuffers::default, |buffers, (tx, mut rows)| {
-                        let index = ty as u32 * self.tiles_x + tx as u32;
-                        let (x0, y0, x1, y1) = self.tile_rect(index);
-                        let tile = Tile {
-                            x0,
-                            y0,
-                            x1,
-                            y1,
-                            bin: &self.bins[index as usize],
-                            clock,
-                        };
+                        let tile = self.tile(ty as u32 * self.tiles_x + tx as u32, clock);
                         let n = self.draw_tile(&tile, &mut rows, encoding, buffers);
                         shaded.fetch_add(n, Ordering::Relaxed);
                         let d = done.fetch_add(1, Ordering::Relaxed) + 1;
