@@ -54,6 +54,78 @@ pub struct RunArgs {
     /// Print counts, the backend and the time of each stage.
     #[arg(short, long)]
     pub verbose: bool,
+    /// How a model alone is viewed.
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// How a model alone (not a scene file) is viewed: `render MODEL`, `bench MODEL`,
+/// `serve MODEL`.
+#[derive(clap::Args, Default)]
+pub struct ViewArgs {
+    /// A model alone: its up axis, x, y, z, -x, -y or -z (default: detected).
+    #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
+    pub up: Option<String>,
+    /// A model alone: front, back, left, right, top, bottom or iso (default: the front, a
+    /// little right and above).
+    #[arg(long)]
+    pub view: Option<String>,
+    /// A model alone: the camera's position and target in the model file's coordinates.
+    #[arg(long, value_name = "PX,PY,PZ,TX,TY,TZ", allow_hyphen_values = true)]
+    pub camera: Option<String>,
+    /// A model alone: draw back faces, lit with their normals flipped (the default for a model
+    /// that is not closed).
+    #[arg(long, conflicts_with = "cull")]
+    pub two_sided: bool,
+    /// A model alone: cull back faces (the default for a closed model).
+    #[arg(long)]
+    pub cull: bool,
+}
+
+impl ViewArgs {
+    /// Whether any flag is given.
+    fn given(&self) -> bool {
+        self.up.is_some() || self.view.is_some() || self.camera.is_some() || self.two_sided || self.cull
+    }
+
+    /// The flags as the scene reader's options, framed for `aspect` (width / height).
+    pub fn options(&self, aspect: Option<f32>) -> Result<phong_scene::ModelOptions> {
+        let camera = match &self.camera {
+            None => None,
+            Some(c) => {
+                let v: Vec<f32> = c
+                    .split(',')
+                    .map(|x| x.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+                    .collect::<Option<_>>()
+                    .filter(|v: &Vec<f32>| v.len() == 6)
+                    .ok_or_else(|| {
+                        InputError(format!(
+                            "--camera must be six finite numbers PX,PY,PZ,TX,TY,TZ (position, target), got {c:?}"
+                        ))
+                    })?;
+                let (p, t) = (glam::Vec3::new(v[0], v[1], v[2]), glam::Vec3::new(v[3], v[4], v[5]));
+                if p == t {
+                    bail!(InputError(
+                        "--camera: the position and the target are the same point".into()
+                    ));
+                }
+                Some((p, t))
+            }
+        };
+        Ok(phong_scene::ModelOptions {
+            up: choice("--up", &self.up, &phong_scene::Axis::NAMES)?,
+            view: choice("--view", &self.view, &phong_scene::ViewName::NAMES)?,
+            camera,
+            sides: if self.two_sided {
+                Some(phong_scene::Sides::TwoSided)
+            } else if self.cull {
+                Some(phong_scene::Sides::Cull)
+            } else {
+                None
+            },
+            aspect,
+        })
+    }
 }
 
 /// The shading overrides `render` takes (as an object's keys override the scene's
@@ -115,9 +187,25 @@ impl RunArgs {
             ),
             None => None,
         };
-        let loaded = phong_scene::load(&self.input)?;
+        let is_model = phong_scene::is_model_path(&self.input);
+        if !is_model && self.view.given() {
+            bail!(InputError(format!(
+                "--up, --view, --camera, --two-sided and --cull apply to a model alone; {} is a scene file \
+                 (set its [camera] and [shading] two_sided instead)",
+                self.input.display()
+            )));
+        }
+        let default = phong_core::ImageSettings::default();
+        let aspect = (self.width.is_some() || self.height.is_some())
+            .then(|| self.width.unwrap_or(default.width) as f32 / self.height.unwrap_or(default.height) as f32);
+        let loaded = phong_scene::load_with(&self.input, &self.view.options(aspect)?)?;
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
+        }
+        if self.verbose {
+            for n in &loaded.notes {
+                eprintln!("phong: {n}");
+            }
         }
         let mut scene = loaded.scene;
         if let Some(w) = self.width {

@@ -76,6 +76,7 @@ pub fn render(
         "phong: triangles={} drawn={drawn} pixels_shaded={shaded}",
         job.scene.triangle_count()
     );
+    census(&job.scene);
     eprintln!(
         "phong: load={:.1}ms {}={:.1}ms {}={:.1}ms readback={:.1}ms png={:.1}ms total={:.1}ms",
         ms(load),
@@ -164,5 +165,30 @@ impl GpuSum {
                 list.join(" ")
             );
         }
+    }
+}
+
+/// Per model or shape (a model's parts, `file:group`, counted together): its triangles read
+/// and what became of them.
+fn census(scene: &phong_core::Scene) {
+    let mut groups: Vec<phong_raster::Census> = Vec::new();
+    for c in phong_raster::census(scene) {
+        let name = c.name.split(':').next().unwrap_or(&c.name).to_string();
+        match groups.iter_mut().find(|g| g.name == name) {
+            Some(g) => {
+                g.triangles += c.triangles;
+                g.outside += c.outside;
+                g.culled += c.culled;
+                g.clipped += c.clipped;
+                g.inside += c.inside;
+            }
+            None => groups.push(phong_raster::Census { name, ..c }),
+        }
+    }
+    for g in groups {
+        eprintln!(
+            "phong: {}: {} triangles read: {} drawn, {} clipped then drawn, {} culled (back faces, no area), {} outside the view",
+            g.name, g.triangles, g.inside, g.clipped, g.culled, g.outside
+        );
     }
 }

@@ -23,6 +23,9 @@ pub(crate) struct ServeArgs {
     /// Open the page in the default browser.
     #[arg(long)]
     open: bool,
+    /// How a model alone is viewed.
+    #[command(flatten)]
+    view: crate::args::ViewArgs,
 }
 
 /// `phong serve`: the explorer until Ctrl-C.
@@ -35,7 +38,7 @@ pub(crate) fn serve(a: ServeArgs) -> Result<()> {
             phong_core::limits::MAX_THREADS
         )));
     }
-    let (scene, library) = phong_serve::initial_scene(a.input.as_deref())?;
+    let (scene, library) = phong_serve::initial_scene(a.input.as_deref(), &a.view.options(None)?)?;
     let gpu = open_gpu(a.backend, GpuPathArg::Auto)?;
     let backend = match gpu {
         Some(g) => phong_serve::Backend::Gpu(Box::new(std::sync::Mutex::new(g))),

@@ -28,6 +28,7 @@
 //! same whatever the number of threads.
 
 mod binning;
+mod census;
 mod clip;
 mod fixed;
 mod frame;
@@ -38,6 +39,7 @@ mod target;
 mod tile;
 mod vertex;
 
+pub use census::{Census, census};
 pub use frame::coverage_counts;
 pub use phong_core::limits::sample_pattern;
 pub use stats::RenderStats;

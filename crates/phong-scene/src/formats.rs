@@ -5,7 +5,7 @@
 
 use crate::obj::{decode_text, obj_from_text};
 use crate::{Error, ObjPart, read_bounded};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use phong_core::Mesh;
 use phong_core::limits::MAX_MODEL_BYTES;
 use ply_rs::parser::Parser;
@@ -23,6 +23,21 @@ pub enum ModelFormat {
     Ply,
     /// STL, ASCII or binary.
     Stl,
+    /// glTF 2.0: `.gltf` (JSON, with `.bin` files or data URIs) or `.glb`.
+    Gltf,
+}
+
+/// A model file read: its parts and, for glTF, the file's first camera and its lights.
+#[derive(Clone, Debug)]
+pub struct LoadedModel {
+    /// The parts (a group and material each).
+    pub parts: Vec<ObjPart>,
+    /// The file's camera (glTF).
+    pub camera: Option<crate::gltf_model::FileCamera>,
+    /// The file's lights (glTF's KHR_lights_punctual).
+    pub lights: Vec<crate::gltf_model::FileLight>,
+    /// Its format.
+    pub format: ModelFormat,
 }
 
 /// The format of model `path` whose bytes are `bytes`; an error for glTF (not read yet) and
@@ -40,9 +55,7 @@ pub fn model_format(path: &Path, bytes: &[u8]) -> Result<ModelFormat, Error> {
         return Ok(ModelFormat::Ply);
     }
     if bytes.starts_with(b"glTF") || ext == "gltf" || ext == "glb" {
-        return Err(fail(
-            "glTF files are not read yet; export the model as OBJ, PLY or STL".into(),
-        ));
+        return Ok(ModelFormat::Gltf);
     }
     // A binary STL: an 80-byte header, a triangle count, 50 bytes a triangle (its header may
     // begin with "solid" too, so the size decides first).
@@ -61,7 +74,7 @@ pub fn model_format(path: &Path, bytes: &[u8]) -> Result<ModelFormat, Error> {
         "ply" => Ok(ModelFormat::Ply),
         "stl" => Ok(ModelFormat::Stl),
         _ => Err(fail(format!(
-            "not a model phong reads (OBJ .obj, PLY .ply, STL .stl){}",
+            "not a model phong reads (OBJ .obj, PLY .ply, STL .stl, glTF .gltf/.glb){}",
             if ext.is_empty() {
                 String::new()
             } else {
@@ -78,25 +91,72 @@ pub fn load_model_sources(
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
 ) -> Result<Vec<ObjPart>, Error> {
+    load_model_full(path, warnings, sources).map(|m| m.parts)
+}
+
+/// [`load_model_sources`] with what a glTF file also holds (its camera and lights).
+pub fn load_model_full(
+    path: &Path,
+    warnings: &mut Vec<String>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<LoadedModel, Error> {
     let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
     sources.push(path.to_path_buf());
-    match model_format(path, &bytes)? {
+    let format = model_format(path, &bytes)?;
+    let parts = match format {
         ModelFormat::Obj => {
             let text = decode_text(path, bytes, warnings);
-            obj_from_text(path, &text, warnings, sources)
+            obj_from_text(path, &text, warnings, sources)?
         }
-        ModelFormat::Ply => read_ply(path, &bytes),
-        ModelFormat::Stl => read_stl(path, &bytes),
-    }
+        ModelFormat::Ply => read_ply(path, &bytes)?,
+        ModelFormat::Stl => read_stl(path, &bytes)?,
+        ModelFormat::Gltf => {
+            let dir = path.parent().unwrap_or(Path::new(""));
+            let read = std::cell::RefCell::new(Vec::new());
+            let resource = |uri: &str| -> Result<Vec<u8>, String> {
+                let p = dir.join(uri);
+                read.borrow_mut().push(p.clone());
+                read_bounded(&p, MAX_MODEL_BYTES, WHAT).map_err(|e| match e {
+                    Error::Read { source, .. } => format!("cannot read {}: {source}", p.display()),
+                    other => other.to_string(),
+                })
+            };
+            let m = crate::gltf_model::read_gltf(path, &bytes, &resource, warnings);
+            sources.extend(read.into_inner());
+            let m = m?;
+            return Ok(LoadedModel {
+                parts: m.parts,
+                camera: m.camera,
+                lights: m.lights,
+                format,
+            });
+        }
+    };
+    Ok(LoadedModel {
+        parts,
+        camera: None,
+        lights: Vec::new(),
+        format,
+    })
 }
 
 /// A PLY or STL model from its bytes (`path` names it and tells the format as
 /// [`model_format`] does); an OBJ is refused here (its MTL libraries are files: use
 /// [`load_model_sources`] or [`load_obj_text`](crate::load_obj_text)).
 pub fn parse_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+    parse_mesh_bytes_with(path, bytes, &|uri| Err(format!("{uri} is not available here")))
+}
+
+/// [`parse_mesh_bytes`], a glTF's external buffers read by `resource` (given their URI).
+pub fn parse_mesh_bytes_with(
+    path: &Path,
+    bytes: &[u8],
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+) -> Result<Vec<ObjPart>, Error> {
     match model_format(path, bytes)? {
         ModelFormat::Ply => read_ply(path, bytes),
         ModelFormat::Stl => read_stl(path, bytes),
+        ModelFormat::Gltf => crate::gltf_model::read_gltf(path, bytes, resource, &mut Vec::new()).map(|m| m.parts),
         ModelFormat::Obj => Err(model_error(
             path,
             "an OBJ is read with its MTL libraries, not here".into(),
@@ -234,18 +294,18 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
             }
         }
     }
-    let mut positions = Vec::with_capacity(vertices.len());
+    let mut points = Vec::with_capacity(vertices.len());
     let mut normals = Vec::with_capacity(vertices.len());
     let mut has_normals = !vertices.is_empty();
     for (i, v) in vertices.iter().enumerate() {
         let [Some(x), Some(y), Some(z)] = v.p else {
             return Err(fail(format!("vertex {i} has no x, y and z")));
         };
-        let p = Vec3::new(x as f32, y as f32, z as f32);
-        if !p.is_finite() {
-            return Err(fail(format!("vertex {i} is not finite: {p}")));
+        let p = DVec3::new(x, y, z);
+        if !p.as_vec3().is_finite() {
+            return Err(fail(format!("vertex {i} is not finite in f32: {p}")));
         }
-        positions.push(p);
+        points.push(p);
         match v.n {
             [Some(x), Some(y), Some(z)] => normals.push(Vec3::new(x as f32, y as f32, z as f32).normalize_or_zero()),
             _ => {
@@ -254,8 +314,10 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
             }
         }
     }
+    let (positions, origin) = recentred(&points);
     let n = positions.len() as i64;
     let mut triangles = Vec::new();
+    let mut corners = Vec::new();
     for (k, f) in faces.iter().enumerate() {
         let idx =
             f.0.as_deref()
@@ -265,9 +327,13 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
                 "face {k}: vertex index {bad} is out of range ({n} vertices)"
             )));
         }
-        for j in 1..idx.len().saturating_sub(1) {
-            triangles.push([idx[0] as u32, idx[j] as u32, idx[j + 1] as u32]);
-        }
+        corners.clear();
+        corners.extend(idx.iter().map(|&i| positions[i as usize]));
+        triangles.extend(
+            crate::polygon::triangulate(&corners)
+                .into_iter()
+                .map(|t| t.map(|k| idx[k as usize] as u32)),
+        );
     }
     if triangles.is_empty() {
         return Err(fail("no faces: nothing to render (a point cloud?)".into()));
@@ -281,6 +347,7 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
         mesh,
         material: None,
         has_normals,
+        origin,
     }])
 }
 
@@ -290,10 +357,11 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
 fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
     let fail = |m: String| model_error(path, format!("malformed STL: {m}"));
     let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| fail(e.to_string()))?;
-    let positions: Vec<Vec3> = mesh.vertices.iter().map(|v| Vec3::from_array(v.0)).collect();
-    if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+    let points: Vec<DVec3> = mesh.vertices.iter().map(|v| Vec3::from_array(v.0).as_dvec3()).collect();
+    if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| !p.is_finite()) {
         return Err(fail(format!("vertex {i} is not finite: {p}")));
     }
+    let (positions, origin) = recentred(&points);
     let triangles: Vec<[u32; 3]> = mesh.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
     if triangles.is_empty() {
         return Err(fail("no facets: nothing to render".into()));
@@ -305,5 +373,31 @@ fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
         mesh,
         material: None,
         has_normals: false,
+        origin,
     }])
+}
+
+/// Where a model with bounds `(lo, hi)` is re-centred: its centre where that lies far from the
+/// origin for its size (more than 4 times its largest side: f32 would lose its detail
+/// there), else the origin (a model near the origin keeps its coordinates exactly).
+pub(crate) fn far_origin(lo: DVec3, hi: DVec3) -> DVec3 {
+    if lo.x.partial_cmp(&hi.x).is_none_or(|o| o.is_gt()) {
+        return DVec3::ZERO;
+    }
+    let (centre, extent) = ((lo + hi) * 0.5, (hi - lo).max_element());
+    if centre.abs().max_element() > extent.max(f64::MIN_POSITIVE) * 4.0 {
+        centre
+    } else {
+        DVec3::ZERO
+    }
+}
+
+/// `points` as f32 positions relative to their [`far_origin`], and that origin.
+pub(crate) fn recentred(points: &[DVec3]) -> (Vec<Vec3>, DVec3) {
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let origin = far_origin(lo, hi);
+    (points.iter().map(|p| (*p - origin).as_vec3()).collect(), origin)
 }

@@ -9,18 +9,24 @@
 
 mod error;
 mod formats;
+mod gltf_model;
 mod json_scene;
 mod model;
 mod obj;
 mod overrides;
 mod png_out;
+mod polygon;
 mod read;
 mod toml_scene;
 
 pub use error::Error;
-pub use formats::{ModelFormat, load_model, load_model_sources, model_format, parse_mesh_bytes};
+pub use formats::{
+    LoadedModel, ModelFormat, load_model, load_model_full, load_model_sources, model_format, parse_mesh_bytes,
+    parse_mesh_bytes_with,
+};
+pub use gltf_model::{FileCamera, FileLight, MAX_GLTF_SHININESS};
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
-pub use model::{ModelView, model_scene, model_view};
+pub use model::{Axis, ModelOptions, Sides, ViewName, model_scene, model_scene_with};
 pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
@@ -41,20 +47,33 @@ pub struct Loaded {
     /// Every file read (the scene, its models and their MTL libraries), so that an output can
     /// be checked not to be one of them.
     pub sources: Vec<std::path::PathBuf>,
+    /// What was decided for the user's information (`-v`): a model alone's up axis, culling,
+    /// re-centring.
+    pub notes: Vec<String>,
 }
 
 /// Loads a scene file (`.toml`) or a model (`.obj`, `.ply`, `.stl`, framed by a default camera
 /// and lights). A file of another extension is a model where its content says so (a PLY or
 /// STL), else a scene file.
 pub fn load(path: &Path) -> Result<Loaded, Error> {
+    load_with(path, &ModelOptions::default())
+}
+
+/// Whether `path` is read as a model rather than a scene file (its extension, else its first
+/// bytes).
+pub fn is_model_path(path: &Path) -> bool {
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    let model = match ext.as_deref() {
+    match ext.as_deref() {
         Some("toml") => false,
         Some("obj" | "ply" | "stl" | "gltf" | "glb") => true,
         _ => sniff_model(path),
-    };
-    if model {
-        model::scene_for_model(path)
+    }
+}
+
+/// [`load`], a model alone viewed as `options` says (a scene file ignores them).
+pub fn load_with(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
+    if is_model_path(path) {
+        model::scene_for_model(path, options)
     } else {
         let src = read_text(
             path,

@@ -1,38 +1,129 @@
-//! A model alone as a scene: the camera that frames it, its lights and background, the model
-//! as the only object. `phong render MODEL.obj` and `phong serve MODEL.obj` both read it.
+//! A model alone as a scene: the view that finds it, its lights and background, the model as
+//! the only object. `phong render MODEL` and `phong serve MODEL` both read it.
+//!
+//! The model is drawn with `fit = true` (centred, bounding sphere of radius 1, in f64 where it
+//! lay far from the origin), so that any finite model, whatever its size and offset, is
+//! framed by the same arithmetic. The view is built in the model's frame: its up axis (given,
+//! or detected), its front, and the camera placed so that every vertex is inside the frame.
 
-use crate::{Error, Loaded, ObjPart, load_model_sources};
-use glam::Vec3;
+use crate::{Error, Loaded, LoadedModel, ModelFormat, ObjPart, load_model_full};
+use glam::{DVec3, Vec3};
+use std::collections::HashMap;
 use std::path::Path;
 
-/// A scene for an OBJ model alone: [`model_scene`] read by the scene reader, the OBJ's parts
-/// as its mesh (so that `phong render MODEL.obj` and `phong serve MODEL.obj` draw the same).
-pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
+/// An axis, signed: the model's up (`--up`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    /// +x
+    X,
+    /// +y
+    Y,
+    /// +z
+    Z,
+    /// −x
+    NegX,
+    /// −y
+    NegY,
+    /// −z
+    NegZ,
+}
+
+impl Axis {
+    /// The names `--up` takes, with their axes.
+    pub const NAMES: [(&'static str, Axis); 6] = [
+        ("x", Axis::X),
+        ("y", Axis::Y),
+        ("z", Axis::Z),
+        ("-x", Axis::NegX),
+        ("-y", Axis::NegY),
+        ("-z", Axis::NegZ),
+    ];
+
+    /// The unit vector.
+    pub fn vector(self) -> Vec3 {
+        match self {
+            Axis::X => Vec3::X,
+            Axis::Y => Vec3::Y,
+            Axis::Z => Vec3::Z,
+            Axis::NegX => Vec3::NEG_X,
+            Axis::NegY => Vec3::NEG_Y,
+            Axis::NegZ => Vec3::NEG_Z,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        Axis::NAMES.iter().find(|(_, a)| *a == self).map_or("?", |(n, _)| n)
+    }
+}
+
+/// A named view of a model alone (`--view`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewName {
+    /// From the front, straight on.
+    Front,
+    /// From behind.
+    Back,
+    /// From the model's left (the viewer's left when seen from the front).
+    Left,
+    /// From the model's right.
+    Right,
+    /// From above, the front at the bottom of the image.
+    Top,
+    /// From below, the front at the top of the image.
+    Bottom,
+    /// From the front, right and above, at equal angles (isometric).
+    Iso,
+}
+
+impl ViewName {
+    /// The names `--view` takes.
+    pub const NAMES: [(&'static str, ViewName); 7] = [
+        ("front", ViewName::Front),
+        ("back", ViewName::Back),
+        ("left", ViewName::Left),
+        ("right", ViewName::Right),
+        ("top", ViewName::Top),
+        ("bottom", ViewName::Bottom),
+        ("iso", ViewName::Iso),
+    ];
+}
+
+/// Which faces of a model alone are drawn (`--two-sided`, `--cull`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sides {
+    /// Every face, a back face lit with its normal flipped (OpenGL's two-sided lighting).
+    TwoSided,
+    /// Front faces only (counter-clockwise, as OpenGL): back faces are culled.
+    Cull,
+}
+
+/// How a model alone is viewed; `None` fields are decided from the model.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ModelOptions {
+    /// The model's up axis (default: detected, see [`model_scene`]).
+    pub up: Option<Axis>,
+    /// A named view (default: from the front, a little right and above).
+    pub view: Option<ViewName>,
+    /// Camera position and target in the file's coordinates (overrides `view`).
+    pub camera: Option<(Vec3, Vec3)>,
+    /// Faces drawn (default: culled for a closed, consistently wound model; else two-sided).
+    pub sides: Option<Sides>,
+    /// Image width / height the view is framed for (default: the scene's default 4:3).
+    pub aspect: Option<f32>,
+}
+
+/// A scene for a model alone: [`model_scene`] read by the scene reader, the model's parts as
+/// its mesh (so that `phong render MODEL` and `phong serve MODEL` draw the same). What the view
+/// decided goes to `notes` (`-v`).
+pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     let (mut warnings, mut sources) = (Vec::new(), Vec::new());
-    let parts = load_model_sources(path, &mut warnings, &mut sources)?;
+    let model = load_model_full(path, &mut warnings, &mut sources)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let bounds = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-    let v = model_view(bounds);
-    if !(v.position.is_finite() && v.near.is_finite() && v.far.is_finite()) {
-        let extent = bounds.map_or(0.0, |(lo, hi)| (hi - lo).max_element());
-        return Err(Error::Parse {
-            path: path.to_path_buf(),
-            line: 1,
-            col: 1,
-            key: None,
-            message: format!(
-                "the model is too large for the automatic camera (its extent is {extent:e}, past f32's range once framed); \
-                 put it in a scene file with a `scale` and a camera"
-            ),
-        });
-    }
-    let json = model_scene(&name, &parts);
+    let (json, notes) = model_scene_with(&name, &model, options);
+    let parts = model.parts;
     let lookup = |_: &str| Ok(parts.clone());
     let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
@@ -44,52 +135,31 @@ pub(crate) fn scene_for_model(path: &Path) -> Result<Loaded, Error> {
     warnings.append(&mut loaded.warnings);
     loaded.warnings = warnings;
     loaded.sources = sources;
+    loaded.notes = notes;
     Ok(loaded)
 }
 
-/// The scene of a model alone, as JSON with the scene file's schema: its MTL materials (or
-/// OpenGL's default), a perspective camera framing its bounding sphere ([`model_view`]),
-/// three lights (key, fill, back), 4 samples per pixel, the model as its only object
-/// (`mesh = name`).
-pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
-    let bounds = parts
+/// The centre and bounding-sphere radius of a model's parts (half its bounding box's
+/// diagonal; 1 for a model of one point), in the parts' coordinates: what `fit = true` maps to
+/// the origin and to 1.
+pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(Vec3, f32)> {
+    let (lo, hi) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-    let v = model_view(bounds);
-    let bg = MODEL_BACKGROUND;
-    let lights: Vec<_> = MODEL_LIGHTS
-        .iter()
-        .map(|(d, c)| serde_json::json!({"type": "directional", "direction": d, "color": [c, c, c]}))
-        .collect();
-    serde_json::json!({
-        "image": {"background": [bg[0], bg[1], bg[2]], "antialias": 4},
-        "camera": {"position": v.position.to_array(), "target": v.target.to_array(), "fov": v.fov,
-                   "near": v.near, "far": v.far},
-        "shading": {"viewer": "local"},
-        "light": lights,
-        "object": [{"mesh": name}],
-    })
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let radius = (hi - lo).length() * 0.5;
+    let radius = if radius > 0.0 && radius.is_finite() {
+        radius
+    } else {
+        1.0
+    };
+    Some((((lo + hi) * 0.5).as_vec3(), radius as f32))
 }
 
-/// The view of a model alone: a perspective camera, its vertical field of view 45°, looking
-/// at the centre of the bounding box `(lo, hi)` from above right, far enough that the box's
-/// bounding sphere fits.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ModelView {
-    /// Camera position.
-    pub position: Vec3,
-    /// Camera target.
-    pub target: Vec3,
-    /// Near plane.
-    pub near: f32,
-    /// Far plane.
-    pub far: f32,
-    /// Vertical field of view, degrees.
-    pub fov: f32,
-}
-
-/// The lights of a model alone, `(direction, grey level)`: key, fill and back.
+/// The lights of a model alone, `(direction, grey level)` in the default view's camera frame
+/// (x right, y up, z toward the viewer): key, fill and back. They turn with the camera, so
+/// every view is lit alike.
 const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
     ([1.0, -1.0, -1.0], 0.8),
     ([-1.0, -0.3, -0.5], 0.35),
@@ -99,19 +169,458 @@ const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
 /// The background of a model alone.
 const MODEL_BACKGROUND: [f32; 4] = [0.08, 0.08, 0.1, 1.0];
 
-/// [`ModelView`] for a model with bounds `bounds` (the unit cube's when `None`).
-pub fn model_view(bounds: Option<(Vec3, Vec3)>) -> ModelView {
-    let (lo, hi) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
-    let centre = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1e-3);
-    let fov = 45.0f32;
-    let dist = radius / (fov.to_radians() * 0.5).sin() * 1.05;
-    let dir = Vec3::new(0.35, 0.45, 1.0).normalize();
-    ModelView {
-        position: centre + dir * dist,
-        target: centre,
-        near: (dist - radius * 1.5).max(dist * 0.01),
-        far: dist + radius * 1.5,
-        fov,
+/// The default view's direction in the model's frame (right, up, front): from the front, a
+/// little right and above.
+const DEFAULT_VIEW: Vec3 = Vec3::new(0.35, 0.45, 1.0);
+
+/// Vertical field of view of a model alone, degrees.
+const FOV: f32 = 45.0;
+
+/// The share of the frame's half-width or half-height the model may fill.
+const FILL: f32 = 0.92;
+
+/// The scene of a model alone, as JSON with the scene file's schema, and notes on what was
+/// decided (for `-v`):
+/// - the model with `fit = true` and its MTL materials (or OpenGL's default);
+/// - up: `options.up`, else detected: z where the model stands on a flat base facing −z (at
+///   least 2% of its area, and 3 times what faces −y at its lowest y: a scan of a statue or
+///   bust, like Nefertiti's), else y;
+/// - front: +z for a y-up model, −y for a z-up one (Blender's front view), the convention's
+///   axis turned likewise for other ups;
+/// - faces: `options.sides`, else culled where the model is closed (each edge shared by two
+///   faces, wound opposite ways) and wound outward (positive volume), else two-sided;
+/// - the camera: `options.camera`, else the named view (default: front, a little right and
+///   above), at the distance where every vertex is inside [`FILL`] of the frame, its near and
+///   far planes from the vertices' depths; perspective, 45°.
+pub fn model_scene(name: &str, parts: &[ObjPart], options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
+    let model = LoadedModel {
+        parts: parts.to_vec(),
+        camera: None,
+        lights: Vec::new(),
+        format: ModelFormat::Obj,
+    };
+    model_scene_with(name, &model, options)
+}
+
+/// [`model_scene`] of a model file read whole: a glTF is y up with its front +z (the
+/// format's convention, so neither is detected), viewed from its first camera where it has one
+/// (unless `options` name a view or camera), and lit by its KHR_lights_punctual lights where it
+/// has some: their colours times their intensities, scaled so that the brightest is 1, without
+/// distance falloff (glTF's are physical units, which Phong's clamped sum has no use for).
+pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
+    let parts = &model.parts[..];
+    let gltf = model.format == ModelFormat::Gltf;
+    let mut notes = Vec::new();
+    let (centre, radius) = fit_of(parts).unwrap_or((Vec3::ZERO, 1.0));
+    // Vertices in the fitted frame (centred, radius 1).
+    let fitted = |p: Vec3| (p - centre) / radius;
+    let origin = parts.first().map_or(DVec3::ZERO, |p| p.origin);
+    if origin != DVec3::ZERO {
+        notes.push(format!(
+            "the model lies far from the origin: re-centred on ({}, {}, {}) in f64",
+            origin.x, origin.y, origin.z
+        ));
+    }
+    let up = match options.up {
+        Some(a) => a,
+        None if gltf => Axis::Y,
+        None => {
+            let a = detect_up(parts);
+            notes.push(format!(
+                "up axis {} (detected{}; --up to choose)",
+                a.name(),
+                if a == Axis::Z { ": a flat base facing -z" } else { "" }
+            ));
+            a
+        }
+    };
+    let u = up.vector();
+    // The front: the convention's axis for this up (+z for y up, -y for z up).
+    let f = match up {
+        Axis::Y => Vec3::Z,
+        Axis::NegY => Vec3::NEG_Z,
+        Axis::Z => Vec3::NEG_Y,
+        Axis::NegZ => Vec3::Y,
+        Axis::X => Vec3::Z,
+        Axis::NegX => Vec3::Z,
+    };
+    let closed = closedness(parts);
+    let detected = if gltf { None } else { detect_front(parts, u, f, closed) };
+    let f = match detected {
+        Some((front, why)) => {
+            if options.camera.is_none() {
+                notes.push(format!("front {} ({why})", axis_name(front)));
+            }
+            front
+        }
+        None => f,
+    };
+    let r = u.cross(f);
+    let two_sided = match options.sides {
+        Some(s) => s == Sides::TwoSided,
+        None => {
+            let c = closed;
+            let two = !c.closed_outward();
+            notes.push(match (two, c) {
+                (false, _) => {
+                    "back faces culled: the model is closed and wound outward (--two-sided to draw them)".into()
+                }
+                (
+                    true,
+                    Closed::Open {
+                        open_edges,
+                        inconsistent,
+                    },
+                ) => format!(
+                    "two-sided lighting, no culling: the model is not closed ({open_edges} open edges, \
+                     {inconsistent} edges wound alike; --cull to cull)"
+                ),
+                (true, Closed::Inward) => {
+                    "two-sided lighting, no culling: the model is closed but wound inward (--cull to cull)".into()
+                }
+                (true, _) => "two-sided lighting, no culling: the model was not checked (too large)".into(),
+            });
+            two
+        }
+    };
+    let aspect = options.aspect.filter(|a| a.is_finite() && *a > 0.0).unwrap_or(4.0 / 3.0);
+    let to_parts = |x: DVec3| (x - origin).as_vec3();
+    let mut fov = FOV;
+    let file_camera = model.camera.filter(|_| options.camera.is_none() && options.view.is_none());
+    let camera = match (options.camera, file_camera) {
+        (Some(c), _) => Some(c),
+        (None, Some(c)) => {
+            // Looking at the model's centre's depth along the camera's axis.
+            let eye = c.position;
+            let centre_file = centre.as_dvec3() + origin;
+            let depth = (centre_file - eye).dot(c.forward).max(f64::from(radius) * 1e-3);
+            fov = c.fov_deg.filter(|f| *f > 0.0 && *f < 180.0).unwrap_or(FOV);
+            notes.push(format!(
+                "the file's camera{} (--view or --camera to choose another)",
+                if c.fov_deg.is_none() { ", orthographic, drawn in perspective" } else { "" }
+            ));
+            Some((eye.as_vec3(), (eye + c.forward * depth).as_vec3()))
+        }
+        (None, None) => None,
+    };
+    let file_up = file_camera.map(|c| c.up.as_vec3());
+    let (position, target, cam_up) = match camera {
+        Some((p, t)) => {
+            let (p, t) = (fitted(to_parts(p.as_dvec3())), fitted(to_parts(t.as_dvec3())));
+            let d = (p - t).normalize_or_zero();
+            // The file camera's up, else the model's unless the camera looks along it.
+            let cu = file_up.unwrap_or(if d.cross(u).length() > 1e-3 { u } else { f });
+            (p, t, cu)
+        }
+        None => {
+            let (dir, cu) = match options.view {
+                None => (
+                    (r * DEFAULT_VIEW.x + u * DEFAULT_VIEW.y + f * DEFAULT_VIEW.z).normalize(),
+                    u,
+                ),
+                Some(ViewName::Front) => (f, u),
+                Some(ViewName::Back) => (-f, u),
+                Some(ViewName::Right) => (r, u),
+                Some(ViewName::Left) => (-r, u),
+                Some(ViewName::Top) => (u, -f),
+                Some(ViewName::Bottom) => (-u, f),
+                Some(ViewName::Iso) => ((r + u + f).normalize(), u),
+            };
+            let dist = framing_distance(parts, &fitted, dir, cu, aspect);
+            (dir * dist, Vec3::ZERO, cu)
+        }
+    };
+    let (near, far) = depth_range(parts, &fitted, position, target);
+    // Lights: the default view's camera frame carried to this camera's.
+    let d0 = DEFAULT_VIEW.normalize();
+    let r0 = Vec3::Y.cross(d0).normalize();
+    let u0 = d0.cross(r0);
+    let dc = (position - target).normalize_or(Vec3::Z);
+    let rc = cam_up.cross(dc).normalize_or(Vec3::X);
+    let uc = dc.cross(rc);
+    let mut lights: Vec<_> = MODEL_LIGHTS
+        .iter()
+        .map(|(d, c)| {
+            let l = Vec3::from_array(*d);
+            let (x, y, z) = (l.dot(r0), l.dot(u0), l.dot(d0));
+            let w = rc * x + uc * y + dc * z;
+            serde_json::json!({"type": "directional", "direction": round6(w), "color": [c, c, c]})
+        })
+        .collect();
+    let brightest = model.lights.iter().flat_map(|l| l.color).fold(0.0f32, f32::max);
+    if brightest > 0.0 && brightest.is_finite() {
+        notes.push(format!("the file's {} lights", model.lights.len()));
+        lights = model
+            .lights
+            .iter()
+            .filter_map(|l| {
+                let color = l.color.map(|c| (c / brightest * 1e6).round() / 1e6);
+                let dir = round6(l.direction.as_vec3());
+                let pos = round6(fitted(to_parts(l.position)));
+                (Vec3::from_array(dir) != Vec3::ZERO || l.kind == "point").then(|| match l.kind {
+                    "directional" => serde_json::json!({"type": "directional", "direction": dir, "color": color}),
+                    "point" => serde_json::json!({"type": "point", "position": pos, "color": color}),
+                    _ => serde_json::json!({"type": "spot", "position": pos, "direction": dir, "color": color,
+                                            "cutoff": l.cutoff_deg, "exponent": 0.0}),
+                })
+            })
+            .collect();
+    }
+    let bg = MODEL_BACKGROUND;
+    let json = serde_json::json!({
+        "image": {"background": [bg[0], bg[1], bg[2]], "antialias": 4},
+        "camera": {"position": round6(position), "target": round6(target), "up": cam_up.to_array(),
+                   "fov": fov, "near": near, "far": far},
+        "shading": {"viewer": "local", "two_sided": two_sided},
+        "light": lights,
+        "object": [{"mesh": name, "fit": true}],
+    });
+    (json, notes)
+}
+
+/// `v` with 6 decimals, so the scene's text (and the explorer's "Download TOML") is short.
+fn round6(v: Vec3) -> [f32; 3] {
+    v.to_array().map(|x| (x * 1e6).round() / 1e6)
+}
+
+/// The camera distance along `dir` (from the origin of the fitted frame) at which every vertex
+/// is inside [`FILL`] of a frame of aspect `aspect`, the camera's up `up`.
+fn framing_distance(parts: &[ObjPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec3, up: Vec3, aspect: f32) -> f32 {
+    let right = up.cross(dir).normalize();
+    let up = dir.cross(right);
+    let ty = (FOV.to_radians() * 0.5).tan() * FILL;
+    let tx = ty * aspect;
+    let mut dist = 0.0f32;
+    for p in parts.iter().flat_map(|p| p.mesh.positions()) {
+        let q = fitted(*p);
+        let z = q.dot(dir);
+        dist = dist.max(z + q.dot(right).abs() / tx).max(z + q.dot(up).abs() / ty);
+    }
+    // Never inside the bounding sphere.
+    dist.max(1.05)
+}
+
+/// Near and far planes for a camera at `eye` looking at `target`: just outside the vertices'
+/// depths (a camera inside the model gets a near plane of 1/1000 of the model's radius).
+fn depth_range(parts: &[ObjPart], fitted: &dyn Fn(Vec3) -> Vec3, eye: Vec3, target: Vec3) -> (f32, f32) {
+    let d = (target - eye).normalize_or(Vec3::NEG_Z);
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for p in parts.iter().flat_map(|p| p.mesh.positions()) {
+        let z = (fitted(*p) - eye).dot(d);
+        lo = lo.min(z);
+        hi = hi.max(z);
+    }
+    let near = (lo * 0.95).max(1e-3);
+    let far = (hi * 1.05).max(near * 2.0);
+    (((near * 1e6).floor() / 1e6).max(1e-3), (far * 1e6).ceil() / 1e6)
+}
+
+/// The name of a unit axis vector (`+x`, `-z`).
+fn axis_name(v: Vec3) -> String {
+    let i = v.abs().max_position();
+    format!("{}{}", if v[i] < 0.0 { '-' } else { '+' }, ['x', 'y', 'z'][i])
+}
+
+/// The model's front where it tells one other than the convention's `f` (`None` keeps `f`),
+/// with the reason, looking only across the four horizontal axes (`±f`, `±(u × f)`):
+/// - a model that is not closed faces the way its surface does: the horizontal part of its
+///   area vector (Σ area·n), where that holds at least 10% of its area (the open side of a
+///   Cornell box, a single triangle, a flat model standing on edge);
+/// - else, a model longer along `f` than it is tall (an animal on its legs, as Spot) turns its
+///   top toward its front (the head above the body): `−f` when the vertices of its top tenth
+///   lie behind the middle by more than 10% of its depth.
+fn detect_front(parts: &[ObjPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(Vec3, &'static str)> {
+    let r = u.cross(f);
+    let (lo, hi) = parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
+    if !matches!(closed, Closed::Outward | Closed::Inward) {
+        let (mut area, mut total) = (DVec3::ZERO, 0.0f64);
+        for p in parts {
+            for t in 0..p.mesh.triangles().len() {
+                let [a, b, c] = p.mesh.corners(t);
+                let n = (b - a).cross(c - a).as_dvec3() * 0.5;
+                area += n;
+                total += n.length();
+            }
+        }
+        let area = area.as_vec3();
+        let best = [f, -f, r, -r]
+            .into_iter()
+            .max_by(|a, b| a.dot(area).total_cmp(&b.dot(area)))?;
+        if f64::from(best.dot(area)) >= 0.1 * total {
+            return (best != f).then_some((best, "the open model's surface faces that way"));
+        }
+    }
+    // A model longer along the front axis than it is tall (an animal on its legs).
+    let (h_lo, h_hi) = (lo.dot(u).min(hi.dot(u)), lo.dot(u).max(hi.dot(u)));
+    let (d_lo, d_hi) = (lo.dot(f).min(hi.dot(f)), lo.dot(f).max(hi.dot(f)));
+    let depth = f64::from(d_hi - d_lo);
+    if depth < f64::from(h_hi - h_lo) {
+        return None;
+    }
+    let top = h_hi - 0.1 * (h_hi - h_lo);
+    let (mut sum, mut n) = (0.0f64, 0u64);
+    for p in parts.iter().flat_map(|p| p.mesh.positions()) {
+        if p.dot(u) >= top {
+            sum += f64::from(p.dot(f));
+            n += 1;
+        }
+    }
+    let middle = f64::from(d_lo + d_hi) * 0.5;
+    (n > 0 && depth > 0.0 && sum / n as f64 - middle < -0.1 * depth).then_some((-f, "its top, a head, leans that way"))
+}
+
+/// The up axis: z where the model stands on a flat base facing −z (faces within 18° of −z in
+/// the lowest 2% of its height hold at least 2% of its area, and 3 times the area that faces
+/// −y in its lowest 2% along y), else y.
+fn detect_up(parts: &[ObjPart]) -> Axis {
+    let Some((lo, hi)) = parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    else {
+        return Axis::Y;
+    };
+    let ext = hi - lo;
+    let (mut total, mut base_z, mut base_y) = (0.0f64, 0.0f64, 0.0f64);
+    for p in parts {
+        for t in 0..p.mesh.triangles().len() {
+            let [a, b, c] = p.mesh.corners(t);
+            let n = (b - a).cross(c - a);
+            let area2 = f64::from(n.length());
+            if area2.is_nan() || area2 <= 0.0 {
+                continue;
+            }
+            total += area2;
+            let centroid = (a + b + c) / 3.0;
+            let unit = n / n.length();
+            if unit.z < -0.95 && centroid.z - lo.z <= 0.02 * ext.z {
+                base_z += area2;
+            }
+            if unit.y < -0.95 && centroid.y - lo.y <= 0.02 * ext.y {
+                base_y += area2;
+            }
+        }
+    }
+    if total > 0.0 && base_z >= 0.02 * total && base_z > 3.0 * base_y {
+        Axis::Z
+    } else {
+        Axis::Y
+    }
+}
+
+/// Whether a model is closed, and which way it is wound.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Closed {
+    /// Every edge is shared by two faces wound opposite ways, and the volume is positive.
+    Outward,
+    /// Closed and consistent, but the volume is negative (normals point in).
+    Inward,
+    /// Edges with one face (open) or with faces wound alike.
+    Open { open_edges: usize, inconsistent: usize },
+    /// Not checked (more than [`MAX_CLOSED_CHECK`] triangles).
+    Unchecked,
+}
+
+impl Closed {
+    fn closed_outward(self) -> bool {
+        self == Closed::Outward
+    }
+}
+
+/// Models with more triangles than this are not checked for closedness (and drawn two-sided):
+/// the edge table would take about 40 bytes a triangle.
+const MAX_CLOSED_CHECK: usize = 4_000_000;
+
+/// [`Closed`] for a model's parts together, vertices joined where their positions are equal.
+fn closedness(parts: &[ObjPart]) -> Closed {
+    let count: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
+    if count > MAX_CLOSED_CHECK {
+        return Closed::Unchecked;
+    }
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    // Per edge (lower id first): the sum of its faces' orientations (+1 one way, -1 the
+    // other) and their number; a closed, consistent model has (0, 2) on every edge.
+    let mut edges: HashMap<(u32, u32), (i32, u32)> = HashMap::with_capacity(count * 3 / 2);
+    let mut volume = 0.0f64;
+    for p in parts {
+        let pos = p.mesh.positions();
+        let id: Vec<u32> = pos
+            .iter()
+            .map(|v| {
+                let n = ids.len() as u32;
+                *ids.entry(v.to_array().map(|x| (x + 0.0).to_bits())).or_insert(n)
+            })
+            .collect();
+        for t in p.mesh.triangles() {
+            let [a, b, c] = t.map(|i| id[i as usize]);
+            if a == b || b == c || c == a {
+                continue;
+            }
+            let [pa, pb, pc] = t.map(|i| pos[i as usize].as_dvec3());
+            volume += pa.dot(pb.cross(pc));
+            for (x, y) in [(a, b), (b, c), (c, a)] {
+                let (k, s) = if x < y { ((x, y), 1) } else { ((y, x), -1) };
+                let e = edges.entry(k).or_insert((0, 0));
+                e.0 += s;
+                e.1 += 1;
+            }
+        }
+    }
+    let (mut open_edges, mut inconsistent) = (0, 0);
+    for &(orient, faces) in edges.values() {
+        if faces != 2 {
+            open_edges += 1;
+        } else if orient != 0 {
+            inconsistent += 1;
+        }
+    }
+    match (open_edges + inconsistent, volume > 0.0) {
+        (0, true) => Closed::Outward,
+        (0, false) => Closed::Inward,
+        _ => Closed::Open {
+            open_edges,
+            inconsistent,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use phong_core::{Mesh, primitives};
+
+    fn part(mesh: Mesh) -> ObjPart {
+        ObjPart {
+            name: "t".into(),
+            mesh,
+            material: None,
+            has_normals: false,
+            origin: DVec3::ZERO,
+        }
+    }
+
+    #[test]
+    fn closedness_of_shapes() {
+        assert_eq!(closedness(&[part(primitives::cube())]), Closed::Outward);
+        assert_eq!(closedness(&[part(primitives::sphere(16).welded())]), Closed::Outward);
+        let open = closedness(&[part(primitives::plane(2))]);
+        assert!(
+            matches!(
+                open,
+                Closed::Open {
+                    open_edges: 8,
+                    inconsistent: 0
+                }
+            ),
+            "{open:?}"
+        );
+        // The cube inside out.
+        let c = primitives::cube();
+        let flipped: Vec<[u32; 3]> = c.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let inward = Mesh::from_triangles(c.positions().to_vec(), flipped).unwrap();
+        assert_eq!(closedness(&[part(inward)]), Closed::Inward);
     }
 }

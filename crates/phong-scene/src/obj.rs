@@ -12,7 +12,7 @@
 //! with a warning. Missing `Ka`/`Kd`/`Ks` take OpenGL's default material's values.
 
 use crate::Error;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use phong_core::{Color, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -29,6 +29,82 @@ pub struct ObjPart {
     pub material: Option<Material>,
     /// True when the file gave normals for every vertex of this part.
     pub has_normals: bool,
+    /// The point the positions are relative to, in the file's coordinates: a model far from
+    /// the origin for its size is re-centred in f64 before its positions become f32 (so that
+    /// it keeps its detail); zero otherwise. Every part of a model has the same.
+    pub origin: DVec3,
+}
+
+/// The triangles of a tobj mesh's faces (`arities` empty when all are triangles), each
+/// polygon triangulated by [`polygon::triangulate`](crate::polygon::triangulate).
+fn polygons_to_triangles(positions: &[Vec3], indices: &[u32], arities: &[u32]) -> Vec<[u32; 3]> {
+    if arities.is_empty() {
+        return indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    }
+    let mut tris = Vec::with_capacity(indices.len());
+    let mut at = 0usize;
+    let mut corners = Vec::new();
+    for &n in arities {
+        let face = &indices[at..at + n as usize];
+        at += n as usize;
+        if n == 3 {
+            tris.push([face[0], face[1], face[2]]);
+            continue;
+        }
+        corners.clear();
+        corners.extend(face.iter().map(|&i| positions[i as usize]));
+        tris.extend(
+            crate::polygon::triangulate(&corners)
+                .into_iter()
+                .map(|t| t.map(|k| face[k as usize])),
+        );
+    }
+    tris
+}
+
+/// The material libraries an `mtllib` statement names: first the whole text as one name
+/// (tried first by the caller: a name with spaces in it), then each name, names separated by
+/// whitespace except where it is quoted (`"my file.mtl"`) or escaped (`my\ file.mtl`); other
+/// backslashes are path separators (`textures\\a.mtl`).
+fn mtl_names(text: &str) -> Vec<PathBuf> {
+    let mut names = Vec::new();
+    let mut whole = String::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = text.trim().chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => quoted = !quoted,
+            '\\' if chars.peek().is_some_and(|n| n.is_whitespace()) => {
+                let n = chars.next().unwrap_or(' ');
+                cur.push(n);
+                whole.push(n);
+            }
+            '\\' => {
+                cur.push('/');
+                whole.push('/');
+            }
+            c if c.is_whitespace() && !quoted => {
+                if !cur.is_empty() {
+                    names.push(PathBuf::from(std::mem::take(&mut cur)));
+                }
+                whole.push(c);
+            }
+            c => {
+                cur.push(c);
+                whole.push(c);
+            }
+        }
+    }
+    if !cur.is_empty() {
+        names.push(PathBuf::from(cur));
+    }
+    let whole = PathBuf::from(whole.trim());
+    if names.len() == 1 {
+        return names;
+    }
+    names.insert(0, whole);
+    names
 }
 
 /// A model file's text (see [`decode_text`]).
@@ -81,40 +157,170 @@ fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
     })
 }
 
-/// Checks the OBJ records tobj would accept or reject without a location.
-fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
+/// A number as C's `strtod` reads it, which is how other loaders read OBJ numbers: Rust's
+/// grammar (`1.e-3`, `.8e-001`, `1e+02`), else the longest prefix that is a decimal number
+/// (`3.1+e2` is 3.1). The second value is true when characters were left over.
+pub(crate) fn strtod(s: &str) -> Option<(f64, bool)> {
+    if let Ok(x) = s.parse::<f64>() {
+        return Some((x, false));
+    }
+    let b = s.as_bytes();
+    let digits = |mut i: usize| {
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    let mut i = usize::from(matches!(b.first(), Some(b'+' | b'-')));
+    let int_end = digits(i);
+    let mut n = int_end - i;
+    i = int_end;
+    if b.get(i) == Some(&b'.') {
+        let frac_end = digits(i + 1);
+        n += frac_end - i - 1;
+        i = frac_end;
+    }
+    if n == 0 {
+        return None;
+    }
+    if matches!(b.get(i), Some(b'e' | b'E')) {
+        let j = i + 1 + usize::from(matches!(b.get(i + 1), Some(b'+' | b'-')));
+        let exp_end = digits(j);
+        if exp_end > j {
+            i = exp_end;
+        }
+    }
+    s[..i].parse().ok().map(|x| (x, true))
+}
+
+/// An OBJ's text prepared for tobj, with what the preparation found.
+struct Prepared {
+    /// The text tobj reads, line for line the file's (so that locations stay right).
+    text: String,
+    /// What was skipped or repaired, for warnings.
+    notes: Vec<String>,
+    /// Subtracted from every position (in f64, before they become f32): the centre of a
+    /// model that lies far from the origin, else zero.
+    origin: DVec3,
+}
+
+/// Checks the OBJ records tobj would accept or reject without a location, and writes the
+/// text as tobj reads it, line for line:
+/// - numbers as `strtod` reads them, positions re-centred in f64 (see [`Prepared::origin`]);
+/// - comments after a statement removed (tobj reads them as values);
+/// - `v` records cut to `x y z` (a `w`, which the format gives no meaning for polygon
+///   vertices and tobj divides by, is dropped; so are vertex colours, which phong does not use
+///   and which tobj refuses unless every vertex has them), and `vt u` given its `v` of 0;
+/// - faces with fewer than 3 vertices removed, and a face's texture or normal indices that
+///   refer to nothing dropped from that face (its normals are then computed);
+/// - `l` and `p` statements removed (phong draws surfaces).
+///
+/// A vertex index out of range, a malformed number or a non-finite coordinate is an error at
+/// its line and column.
+fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
     let c = Checker { path, src };
-    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
-    for (start, line) in lines(src) {
+    fn words(line: &str) -> Vec<(usize, &str)> {
         let content = line.split('#').next().unwrap_or("");
-        let mut it = content.split_whitespace();
-        let Some(kw) = it.next() else { continue };
-        let rest: Vec<&str> = it.collect();
+        let mut out = Vec::new();
+        let mut start = None;
+        for (i, ch) in content.char_indices().chain([(content.len(), ' ')]) {
+            match (ch.is_whitespace(), start) {
+                (true, Some(s)) => {
+                    out.push((s, &content[s..i]));
+                    start = None;
+                }
+                (false, None) => start = Some(i),
+                _ => {}
+            }
+        }
+        out
+    }
+    // The positions' bounds, for the origin (malformed records are reported below).
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for (_, line) in lines(src) {
+        let w = words(line);
+        if w.first().map(|w| w.1) == Some("v") && w.len() >= 4 {
+            let p: Vec<f64> = w[1..4].iter().filter_map(|(_, t)| strtod(t).map(|x| x.0)).collect();
+            if p.len() == 3 && p.iter().all(|x| x.is_finite()) {
+                let p = DVec3::new(p[0], p[1], p[2]);
+                (lo, hi) = (lo.min(p), hi.max(p));
+            }
+        }
+    }
+    let origin = crate::formats::far_origin(lo, hi);
+    let mut out = String::with_capacity(src.len() + 64);
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    let (mut short_faces, mut bad_refs, mut colours, mut lenient) = (0usize, 0usize, 0usize, None);
+    let (mut lines_, mut points) = (0usize, 0usize);
+    for (start, line) in lines(src) {
+        let w = words(line);
+        let Some(&(_, kw)) = w.first() else {
+            // Blank or a comment: kept blank.
+            out.push('\n');
+            continue;
+        };
+        let field = |i: usize| start + w[i].0;
+        let number = |i: usize, lenient: &mut Option<usize>| -> Result<f64, Error> {
+            let t = w[i].1;
+            match strtod(t) {
+                Some((x, rest)) if x.is_finite() => {
+                    if rest && lenient.is_none() {
+                        *lenient = Some(crate::error::line_col(src, field(i)).0);
+                    }
+                    Ok(x)
+                }
+                Some(_) => Err(Error::at(
+                    path,
+                    src,
+                    field(i),
+                    Some(kw),
+                    format!("{t:?} is not a finite number"),
+                )),
+                None => Err(Error::at(
+                    path,
+                    src,
+                    field(i),
+                    Some(kw),
+                    format!("{t:?} is not a number"),
+                )),
+            }
+        };
         match kw {
             "v" | "vn" | "vt" => {
                 let need = if kw == "vt" { 1 } else { 3 };
-                if rest.len() < need {
+                if w.len() - 1 < need {
                     return Err(c.err(
                         start,
                         line,
                         0,
                         kw,
-                        format!("needs {need} numbers, found {}", rest.len()),
+                        format!("needs {need} numbers, found {}", w.len() - 1),
                     ));
                 }
-                // `v x y z [w | r g b]`, `vn x y z`, `vt u [v [w]]`: every number finite (those
-                // beyond the ones used are checked too, so tobj never meets a bad one).
-                let used = match kw {
-                    "v" => rest.len().min(6),
-                    "vn" => 3,
-                    _ => rest.len().min(3),
-                };
-                for (i, f) in rest.iter().enumerate().take(used) {
-                    match f.parse::<f32>() {
-                        Ok(x) if x.is_finite() => {}
-                        _ => return Err(c.err(start, line, i + 1, kw, format!("{f:?} is not a finite number"))),
+                let used = if kw == "vt" { (w.len() - 1).min(2) } else { 3 };
+                let mut xs = Vec::with_capacity(3);
+                for i in 1..=used {
+                    xs.push(number(i, &mut lenient)?);
+                }
+                if kw == "v" && w.len() > 6 {
+                    colours += 1;
+                }
+                out.push_str(kw);
+                for (i, x) in xs.iter().enumerate() {
+                    out.push(' ');
+                    let o = if kw == "v" { origin[i] } else { 0.0 };
+                    // The file's own digits where they read as they are; else the number as
+                    // tobj will read it back (f32's shortest form).
+                    if o == 0.0 && w[i + 1].1.parse::<f32>().is_ok() {
+                        out.push_str(w[i + 1].1);
+                    } else {
+                        out.push_str(&((x - o) as f32).to_string());
                     }
                 }
+                if kw == "vt" && xs.len() == 1 {
+                    out.push_str(" 0");
+                }
+                out.push('\n');
                 match kw {
                     "v" => nv += 1,
                     "vt" => nt += 1,
@@ -122,55 +328,110 @@ fn check_obj(path: &Path, src: &str) -> Result<(), Error> {
                 }
             }
             "f" => {
-                if rest.len() < 3 {
-                    return Err(c.err(
-                        start,
-                        line,
-                        0,
-                        "f",
-                        format!("a face needs at least 3 vertices, found {}", rest.len()),
-                    ));
+                if w.len() - 1 < 3 {
+                    short_faces += 1;
+                    out.push('\n');
+                    continue;
                 }
-                for (i, r) in rest.iter().enumerate() {
+                let mut refs = Vec::with_capacity(w.len() - 1);
+                let (mut keep_t, mut keep_n) = (true, true);
+                for (i, &(_, r)) in w.iter().enumerate().skip(1) {
                     let parts: Vec<&str> = r.split('/').collect();
                     if parts.len() > 3 {
-                        return Err(c.err(
-                            start,
-                            line,
-                            i + 1,
-                            "f",
-                            format!("{r:?} is not v, v/vt, v//vn or v/vt/vn"),
-                        ));
+                        return Err(c.err(start, line, i, "f", format!("{r:?} is not v, v/vt, v//vn or v/vt/vn")));
                     }
-                    for (k, (p, count, what)) in parts
+                    let mut idx = [None; 3];
+                    for (k, (p, (count, what))) in parts
                         .iter()
                         .zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")])
-                        .map(|(p, (n, w))| (p, n, w))
                         .enumerate()
                     {
                         if p.is_empty() && k > 0 {
                             continue;
                         }
-                        let idx: i64 = p
+                        let v: i64 = p
                             .parse()
-                            .map_err(|_| c.err(start, line, i + 1, "f", format!("{r:?}: {p:?} is not an index")))?;
-                        let resolved = if idx < 0 { count + idx + 1 } else { idx };
-                        if idx == 0 || resolved < 1 || resolved > count {
-                            return Err(c.err(
-                                start,
-                                line,
-                                i + 1,
-                                "f",
-                                format!("{what} index {idx} is out of range: {count} defined so far"),
-                            ));
+                            .map_err(|_| c.err(start, line, i, "f", format!("{r:?}: {p:?} is not an index")))?;
+                        let resolved = if v < 0 { count + v + 1 } else { v };
+                        if v == 0 || resolved < 1 || resolved > count {
+                            if k == 0 {
+                                return Err(c.err(
+                                    start,
+                                    line,
+                                    i,
+                                    "f",
+                                    format!("{what} index {v} is out of range: {count} defined so far"),
+                                ));
+                            }
+                            // A texture or normal index that refers to nothing: dropped.
+                            bad_refs += 1;
+                            if k == 1 {
+                                keep_t = false;
+                            } else {
+                                keep_n = false;
+                            }
                         }
+                        idx[k] = Some(resolved);
+                    }
+                    refs.push(idx);
+                }
+                out.push('f');
+                for [v, t, n] in refs {
+                    let v = v.unwrap_or(0);
+                    match (t.filter(|_| keep_t), n.filter(|_| keep_n)) {
+                        (None, None) => out.push_str(&format!(" {v}")),
+                        (Some(t), None) => out.push_str(&format!(" {v}/{t}")),
+                        (None, Some(n)) => out.push_str(&format!(" {v}//{n}")),
+                        (Some(t), Some(n)) => out.push_str(&format!(" {v}/{t}/{n}")),
                     }
                 }
+                out.push('\n');
             }
-            _ => {}
+            "l" | "p" => {
+                if kw == "l" {
+                    lines_ += 1;
+                } else {
+                    points += 1;
+                }
+                out.push('\n');
+            }
+            _ => {
+                let content = line.split('#').next().unwrap_or("");
+                out.push_str(content.trim_end());
+                out.push('\n');
+            }
         }
     }
-    Ok(())
+    let mut notes = Vec::new();
+    let file = path.display();
+    if let Some(l) = lenient {
+        notes.push(format!(
+            "{file}:{l}: numbers with trailing characters read as C's strtod reads them (the rest ignored)"
+        ));
+    }
+    if short_faces > 0 {
+        notes.push(format!(
+            "{file}: {short_faces} faces with fewer than 3 vertices skipped"
+        ));
+    }
+    if bad_refs > 0 {
+        notes.push(format!(
+            "{file}: {bad_refs} texture or normal indices refer to nothing: dropped from their faces"
+        ));
+    }
+    if colours > 0 {
+        notes.push(format!("{file}: vertex colours ({colours} vertices) are not used"));
+    }
+    if lines_ + points > 0 {
+        notes.push(format!(
+            "{file}: {lines_} line (`l`) and {points} point (`p`) statements skipped: phong draws surfaces"
+        ));
+    }
+    Ok(Prepared {
+        text: out,
+        notes,
+        origin,
+    })
 }
 
 /// A model's or material library's text: UTF-8 (a byte-order mark dropped) or, where it is not,
@@ -193,34 +454,6 @@ pub(crate) fn decode_text(path: &Path, mut bytes: Vec<u8>, warnings: &mut Vec<St
             bytes.iter().map(|&b| char::from(b)).collect()
         }
     }
-}
-
-/// The OBJ text as tobj reads it, line for line (so that the pre-check's lines stay right):
-/// comments after a statement removed (tobj reads them as values), `v` records cut to
-/// `x y z` (a `w`, which the format gives no meaning for polygon vertices and tobj divides
-/// by, is dropped; so are vertex colours, which phong does not use yet and which tobj refuses
-/// unless every vertex has them), and `vt u` given its `v` of 0.
-fn normalize_obj(src: &str) -> String {
-    let mut out = String::with_capacity(src.len() + 64);
-    for line in src.split_inclusive('\n') {
-        let content = line.split('#').next().unwrap_or("");
-        let words: Vec<&str> = content.split_whitespace().collect();
-        match words.as_slice() {
-            ["v", rest @ ..] if rest.len() >= 3 => {
-                out.push_str("v ");
-                out.push_str(&rest[..3].join(" "));
-                out.push('\n');
-            }
-            ["vt", u] => out.push_str(&format!("vt {u} 0\n")),
-            [] if line.trim_start().starts_with('#') => out.push('\n'),
-            _ if content.len() < line.trim_end_matches(['\n', '\r']).len() => {
-                out.push_str(content.trim_end());
-                out.push('\n');
-            }
-            _ => out.push_str(line),
-        }
-    }
-    out
 }
 
 /// The MTL text as tobj can read it: a colour given as one number (`Kd 0.5`, which the format
@@ -383,44 +616,56 @@ pub fn load_obj_text(
     read_mtl: &dyn Fn(&Path) -> std::io::Result<String>,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ObjPart>, Error> {
-    check_obj(path, src)?;
-    let count = |kw: &str| {
-        lines(src)
-            .filter(|(_, l)| l.split_whitespace().next() == Some(kw))
-            .count()
-    };
-    let (lines_, points) = (count("l"), count("p"));
-    if lines_ + points > 0 {
-        warnings.push(format!(
-            "{}: {lines_} line (`l`) and {points} point (`p`) statements skipped: phong draws surfaces",
-            path.display()
-        ));
-    }
+    let prepared = prepare_obj(path, src)?;
+    warnings.extend(prepared.notes.iter().cloned());
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
     let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
     let opts = tobj::LoadOptions {
-        triangulate: true,
+        triangulate: false,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let normalized = normalize_obj(src);
-    let loaded = tobj::load_obj_buf(&mut BufReader::new(normalized.as_bytes()), &opts, |mtl: &Path| {
-        let p: PathBuf = dir.join(mtl);
-        let text = match read_mtl(mtl) {
-            Ok(t) => t,
-            Err(e) => {
-                // Located at the `mtllib` statement (its line, not a comment's). A library that
-                // is not there is a warning, its faces get the default material (as other
-                // loaders do); one that is there and cannot be read (a FIFO, too large) is an
-                // error.
-                let name = mtl.to_string_lossy();
-                let at = lines(src)
-                    .filter(|(_, l)| l.split('#').next().unwrap_or("").trim_start().starts_with("mtllib"))
-                    .find_map(|(start, l)| l.split('#').next().unwrap_or("").find(&*name).map(|i| start + i))
-                    .unwrap_or(0);
-                if e.kind() == std::io::ErrorKind::NotFound {
+    let loaded = tobj::load_obj_buf(&mut BufReader::new(prepared.text.as_bytes()), &opts, |mtl: &Path| {
+        // Located at the `mtllib` statement (its line, not a comment's).
+        let name = mtl.to_string_lossy();
+        let at = lines(src)
+            .filter(|(_, l)| l.split('#').next().unwrap_or("").trim_start().starts_with("mtllib"))
+            .find_map(|(start, l)| l.split('#').next().unwrap_or("").find(&*name).map(|i| start + i))
+            .unwrap_or(0);
+        let mut text = String::new();
+        let mut found = false;
+        // The statement's text as one name (spaces and all) where it names a library, else
+        // each of its names.
+        let names = mtl_names(&name);
+        let libs = match names.split_first() {
+            Some((whole, each)) if !each.is_empty() && read_mtl(whole).is_err() => each,
+            _ => &names[..1],
+        };
+        for lib in libs {
+            // The name as written, else its file name beside the OBJ (a path from another
+            // machine).
+            let mut result = read_mtl(lib);
+            let base = lib.file_name().map(PathBuf::from).unwrap_or_default();
+            if matches!(&result, Err(e) if e.kind() == std::io::ErrorKind::NotFound) && &base != lib {
+                result = read_mtl(&base).map_err(|_| std::io::Error::from(std::io::ErrorKind::NotFound));
+            }
+            let p: PathBuf = dir.join(lib);
+            match result {
+                Ok(t) => {
+                    if let Err(e) = check_mtl(&p, &t, &mut mtl_warnings.borrow_mut()) {
+                        *mtl_error.borrow_mut() = Some(e);
+                        return Err(tobj::LoadError::MaterialParseError);
+                    }
+                    text.push_str(&normalize_mtl(&t));
+                    text.push('\n');
+                    found = true;
+                }
+                // A library that is not there is a warning, its faces get the default material
+                // (as other loaders do); one that is there and cannot be read (a FIFO, too
+                // large) is an error.
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                     let msg = format!(
                         "material library {} not found: its materials are the default material",
                         p.display()
@@ -428,18 +673,18 @@ pub fn load_obj_text(
                     mtl_warnings
                         .borrow_mut()
                         .push(Error::at(path, src, at, Some("mtllib"), msg).to_string());
-                } else {
+                }
+                Err(e) => {
                     let msg = format!("material library {} cannot be read: {e}", p.display());
                     *mtl_error.borrow_mut() = Some(Error::at(path, src, at, Some("mtllib"), msg));
+                    return Err(tobj::LoadError::OpenFileFailed);
                 }
-                return Err(tobj::LoadError::OpenFileFailed);
             }
-        };
-        if let Err(e) = check_mtl(&p, &text, &mut mtl_warnings.borrow_mut()) {
-            *mtl_error.borrow_mut() = Some(e);
-            return Err(tobj::LoadError::MaterialParseError);
         }
-        tobj::load_mtl_buf(&mut BufReader::new(normalize_mtl(&text).as_bytes()))
+        if !found {
+            return Err(tobj::LoadError::OpenFileFailed);
+        }
+        tobj::load_mtl_buf(&mut BufReader::new(text.as_bytes()))
     });
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);
@@ -494,7 +739,7 @@ pub fn load_obj_text(
         } else {
             vec![Vec3::ZERO; positions.len()]
         };
-        let tris = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let tris = polygons_to_triangles(&positions, &m.indices, &m.face_arities);
         let mesh = Mesh::new(positions, normals, tris)
             .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
         parts.push(ObjPart {
@@ -502,6 +747,7 @@ pub fn load_obj_text(
             mesh,
             material: m.material_id.and_then(|i| materials.get(i).copied()),
             has_normals,
+            origin: prepared.origin,
         });
     }
     if parts.is_empty() {
@@ -510,7 +756,14 @@ pub fn load_obj_text(
             src,
             0,
             None,
-            "no faces (`f` records): nothing to render".into(),
+            format!(
+                "no faces (`f` records with 3 or more vertices): nothing to render{}",
+                prepared
+                    .notes
+                    .iter()
+                    .map(|n| format!("; {}", n.rsplit(": ").next().unwrap_or(n)))
+                    .collect::<String>()
+            ),
         ));
     }
     // Merge parts that share a material within the same group name.

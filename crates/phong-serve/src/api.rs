@@ -662,10 +662,10 @@ fn valid_upload_name(name: &str) -> Result<(), ApiError> {
             "a model's name is 1 to 128 letters, digits, spaces, '.', '-' or '_', not starting with '.'",
         ));
     }
-    if !matches!(ext.as_deref(), Some("obj" | "mtl")) {
+    if !matches!(ext.as_deref(), Some("obj" | "mtl" | "ply" | "stl")) {
         return Err(ApiError::at(
             "name",
-            "uploads are Wavefront .obj models and their .mtl libraries",
+            "uploads are models (Wavefront .obj with their .mtl libraries, .ply, .stl)",
         ));
     }
     Ok(())
@@ -682,7 +682,8 @@ async fn upload(
     valid_upload_name(&name)?;
     let client = client_id(&headers, peer);
     let bytes = read_body(body, SERVE_MAX_UPLOAD, "SERVE_MAX_UPLOAD").await?;
-    let is_obj = name.to_ascii_lowercase().ends_with(".obj");
+    let lower = name.to_ascii_lowercase();
+    let is_obj = [".obj", ".ply", ".stl"].iter().any(|e| lower.ends_with(e));
     let files = {
         let mut clients = state
             .uploads

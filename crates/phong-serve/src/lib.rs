@@ -47,14 +47,17 @@ impl StartError {
 /// The initial scene for `file` (a scene `.toml`, a model `.obj`, or the default scene), as
 /// JSON, and the models it names, loaded from disk by the operator's command (requests never
 /// name files).
-pub fn initial_scene(file: Option<&Path>) -> Result<(serde_json::Value, models::Library), StartError> {
+pub fn initial_scene(
+    file: Option<&Path>,
+    view: &phong_scene::ModelOptions,
+) -> Result<(serde_json::Value, models::Library), StartError> {
     let mut library = models::Library::default();
-    let is_obj = file.is_some_and(|f| f.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")));
+    let is_obj = file.is_some_and(phong_scene::is_model_path);
     let json = match file {
         None => toml_to_json(DEFAULT_SCENE, Path::new("default.toml"))?,
         Some(f) if is_obj => {
             let mut warnings = Vec::new();
-            let parts = phong_scene::load_model(f, &mut warnings)?;
+            let model = phong_scene::load_model_full(f, &mut warnings, &mut Vec::new())?;
             for w in warnings {
                 eprintln!("warning: {w}");
             }
@@ -62,8 +65,8 @@ pub fn initial_scene(file: Option<&Path>) -> Result<(serde_json::Value, models::
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let scene = models::model_scene(&name, &parts);
-            library.insert(name, parts);
+            let (scene, _) = phong_scene::model_scene_with(&name, &model, view);
+            library.insert(name, model.parts);
             scene
         }
         Some(f) => {

@@ -1,5 +1,5 @@
 //! Models: those the operator's command loaded from disk (shared, read-only) and those
-//! clients upload (OBJ and MTL files kept in memory per client, capped, dropped when idle).
+//! clients upload (OBJ with MTL, PLY and STL files kept in memory per client, capped, dropped when idle).
 //! A scene's `mesh = "NAME"` is looked up here, never on disk.
 
 use crate::api::AppState;
@@ -122,6 +122,12 @@ pub struct Files(HashMap<String, Arc<Vec<u8>>>);
 /// the scene's `mesh` key (or the upload).
 pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, String> {
     let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
+    let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".ply") || lower.ends_with(".stl") {
+        return phong_scene::parse_mesh_bytes(Path::new(name), data)
+            .map(Arc::new)
+            .map_err(|e| e.to_string());
+    }
     let src = std::str::from_utf8(data).map_err(|_| format!("uploaded {name} is not UTF-8 text"))?;
     let read = |mtl: &Path| -> std::io::Result<String> {
         let key = mtl.to_string_lossy();
@@ -149,7 +155,7 @@ pub async fn sweep_idle(state: Arc<AppState>) {
     }
 }
 
-/// The page's scene for a model alone: `phong render MODEL.obj`'s.
+/// The page's scene for a model alone: `phong render MODEL`'s with the default view.
 pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
-    phong_scene::model_scene(name, parts)
+    phong_scene::model_scene(name, parts, &phong_scene::ModelOptions::default()).0
 }

@@ -79,6 +79,7 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         scene,
         warnings: ctx.warnings,
         sources: ctx.sources,
+        notes: Vec::new(),
     })
 }
 

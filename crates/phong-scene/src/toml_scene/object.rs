@@ -125,6 +125,9 @@ pub(super) fn object(
                 "plane" => primitives::plane(segments),
                 _ => primitives::teapot(segments),
             };
+            if let Some(f) = &o.fit {
+                return ctx.err(&f.span(), "fit", "only a mesh has `fit`; a shape is already unit-sized");
+            }
             let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
             Ok(vec![Object {
                 name: kind.to_string(),
@@ -139,6 +142,7 @@ pub(super) fn object(
             }
             let mut warnings = Vec::new();
             let mut sources = Vec::new();
+            let fit = o.fit.as_ref().is_some_and(|f| *f.get_ref());
             let parts = match ctx.meshes {
                 Some(lookup) => match lookup(m.get_ref()) {
                     Ok(parts) => parts,
@@ -155,6 +159,20 @@ pub(super) fn object(
                         r => r?,
                     }
                 }
+            };
+            // The file's coordinates (the re-centred model moved back to where the file puts
+            // it), or with `fit` the model centred at the origin with a bounding sphere of
+            // radius 1, before the object's own transform.
+            let world_from_file = match crate::model::fit_of(&parts) {
+                Some((centre, radius)) if fit => {
+                    world_from_object * Mat4::from_scale(Vec3::splat(radius.recip())) * Mat4::from_translation(-centre)
+                }
+                _ => match parts.first() {
+                    Some(p) if p.origin != glam::DVec3::ZERO => {
+                        world_from_object * Mat4::from_translation(p.origin.as_vec3())
+                    }
+                    _ => world_from_object,
+                },
             };
             let mut out = Vec::new();
             for p in parts {
@@ -190,7 +208,7 @@ pub(super) fn object(
                 };
                 out.push(Object {
                     name: p.name,
-                    mesh: mesh.transformed(&world_from_object),
+                    mesh: mesh.transformed(&world_from_file),
                     material: material.or(p.material).unwrap_or_default(),
                     shading,
                 });

@@ -135,6 +135,7 @@ pub(crate) enum Scale {
 pub(crate) struct RawObject {
     pub shape: Option<S<String>>,
     pub mesh: Option<S<String>>,
+    pub fit: Option<S<bool>>,
     pub segments: Option<S<i64>>,
     pub radius: Option<S<f32>>,
     pub tube: Option<S<f32>>,

@@ -1,0 +1,453 @@
+//! glTF 2.0 models (`.gltf` with `.bin` files or data URIs, `.glb`), with the `gltf` crate:
+//! every triangle primitive of the default scene, placed by its nodes' transforms, with its
+//! material turned into a Phong material; the file's first camera and its KHR_lights_punctual
+//! lights, for a model alone.
+//!
+//! The material mapping (metallic-roughness, the glTF default):
+//! `diffuse = base·(1 − metallic)`, `specular = mix(0.04, base, metallic)`,
+//! `ambient = diffuse`, `emission = emissive·strength`, `alpha = base alpha`, and the
+//! shininess from the roughness as Blinn-Phong's equivalent of the Beckmann distribution:
+//! `α = roughness²`, `s = 2/α² − 2` (capped at [`MAX_GLTF_SHININESS`]).
+//! KHR_materials_pbrSpecularGlossiness: `diffuse`, `specular` as given, `roughness = 1 −
+//! glossiness`. A primitive without a material gets OpenGL's default material (as an OBJ
+//! without MTL), not glTF's metallic default, which would be a black mirror here.
+
+use crate::formats::recentred;
+use crate::{Error, ObjPart};
+use base64::Engine;
+use glam::{DMat3, DMat4, DVec3, Vec3};
+use phong_core::{Color, Material, Mesh};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// The highest shininess a glTF roughness maps to (roughness 0 would be infinite).
+pub const MAX_GLTF_SHININESS: f32 = 10_000.0;
+
+/// Extensions phong reads (or whose absence of support is harmless to the geometry); any
+/// other required extension is refused.
+const SUPPORTED: [&str; 5] = [
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+    "KHR_materials_unlit",
+];
+
+/// A camera of the file, in its coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FileCamera {
+    /// Eye.
+    pub position: DVec3,
+    /// The direction it looks (the node's −z).
+    pub forward: DVec3,
+    /// Its up (the node's +y).
+    pub up: DVec3,
+    /// Vertical field of view, degrees (`None`: orthographic).
+    pub fov_deg: Option<f32>,
+}
+
+/// A light of the file (KHR_lights_punctual), in its coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileLight {
+    /// `"directional"`, `"point"` or `"spot"`.
+    pub kind: &'static str,
+    /// Position (point, spot).
+    pub position: DVec3,
+    /// Direction the light travels (directional, spot).
+    pub direction: DVec3,
+    /// Colour times intensity.
+    pub color: [f32; 3],
+    /// Spot: the outer cone's half-angle, degrees.
+    pub cutoff_deg: f32,
+}
+
+/// A glTF model: its parts, and the file's first camera and its lights.
+#[derive(Clone, Debug, Default)]
+pub struct GltfModel {
+    /// One part per primitive (positions in world space, re-centred together).
+    pub parts: Vec<ObjPart>,
+    /// The first camera met in the default scene.
+    pub camera: Option<FileCamera>,
+    /// The KHR_lights_punctual lights of the default scene.
+    pub lights: Vec<FileLight>,
+}
+
+/// Reads a glTF model from `bytes` (a `.gltf` JSON or a `.glb`), its external buffers read
+/// by `resource` (given the URI, percent-decoded, relative to the model's folder).
+pub fn read_gltf(
+    path: &Path,
+    bytes: &[u8],
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+    warnings: &mut Vec<String>,
+) -> Result<GltfModel, Error> {
+    let fail = |m: String| Error::Model {
+        path: path.to_path_buf(),
+        message: format!("glTF: {m}"),
+    };
+    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
+    let doc = &file.document;
+    for ext in doc.extensions_required() {
+        if !SUPPORTED.contains(&ext) {
+            return Err(fail(format!(
+                "the file requires the extension {ext}, which phong does not read{}",
+                if ext.contains("draco") || ext.contains("meshopt") {
+                    " (compressed geometry: decompress it first, e.g. with gltf-transform)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in doc.buffers() {
+        let data = match b.source() {
+            ::gltf::buffer::Source::Bin => file
+                .blob
+                .clone()
+                .ok_or_else(|| fail(format!("buffer {} is the GLB's binary chunk, which is missing", b.index())))?,
+            ::gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, data) = rest
+                        .split_once(";base64,")
+                        .ok_or_else(|| fail(format!("buffer {}: a data URI that is not base64", b.index())))?;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(data)
+                        .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?
+                } else {
+                    resource(&percent_decode(uri)).map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?
+                }
+            }
+        };
+        if data.len() < b.length() {
+            return Err(fail(format!(
+                "buffer {} has {} bytes; the file says {}",
+                b.index(),
+                data.len(),
+                b.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<::gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        None => {
+            // No scene: every node that is no node's child (as other viewers do).
+            let children: BTreeSet<usize> = doc.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    // The nodes with their world transforms, depth first; a node met again on its own path is
+    // a cycle.
+    let mut instances: Vec<(::gltf::Node, DMat4)> = Vec::new();
+    let mut stack: Vec<(::gltf::Node, DMat4, Vec<usize>)> =
+        roots.into_iter().rev().map(|n| (n, DMat4::IDENTITY, Vec::new())).collect();
+    while let Some((node, parent, mut path_)) = stack.pop() {
+        if path_.contains(&node.index()) {
+            return Err(fail(format!("node {} is its own ancestor (a cycle in the node tree)", node.index())));
+        }
+        if instances.len() > 1_000_000 {
+            return Err(fail("more than a million node instances".into()));
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        path_.push(node.index());
+        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((c, world, path_.clone()));
+        }
+        instances.push((node, world));
+    }
+    let mut model = GltfModel::default();
+    let (mut skipped_modes, mut textures, mut colours, mut transparent) = (0usize, BTreeSet::new(), 0usize, 0usize);
+    // Positions in f64 world space for all parts, re-centred together below.
+    let mut pending: Vec<(String, Vec<DVec3>, Vec<Vec3>, Vec<[u32; 3]>, Option<Material>, bool)> = Vec::new();
+    let mut triangles_total: u64 = 0;
+    for (node, world) in &instances {
+        if model.camera.is_none()
+            && let Some(cam) = node.camera()
+        {
+            let fov_deg = match cam.projection() {
+                ::gltf::camera::Projection::Perspective(p) => Some(p.yfov().to_degrees()),
+                ::gltf::camera::Projection::Orthographic(_) => None,
+            };
+            model.camera = Some(FileCamera {
+                position: world.transform_point3(DVec3::ZERO),
+                forward: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+                up: world.transform_vector3(DVec3::Y).normalize_or(DVec3::Y),
+                fov_deg,
+            });
+        }
+        if let Some(light) = node.light() {
+            let c = light.color().map(|c| c * light.intensity());
+            let (kind, cutoff_deg) = match light.kind() {
+                ::gltf::khr_lights_punctual::Kind::Directional => ("directional", 0.0),
+                ::gltf::khr_lights_punctual::Kind::Point => ("point", 0.0),
+                ::gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => {
+                    ("spot", outer_cone_angle.to_degrees().clamp(0.0, 90.0))
+                }
+            };
+            model.lights.push(FileLight {
+                kind,
+                position: world.transform_point3(DVec3::ZERO),
+                direction: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+                color: c,
+                cutoff_deg,
+            });
+        }
+        let Some(mesh) = node.mesh() else { continue };
+        let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
+        let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
+        for prim in mesh.primitives() {
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                ::gltf::mesh::Mode::Triangles | ::gltf::mesh::Mode::TriangleStrip | ::gltf::mesh::Mode::TriangleFan
+            ) {
+                skipped_modes += 1;
+                continue;
+            }
+            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            let pos_acc = prim
+                .get(&::gltf::Semantic::Positions)
+                .ok_or_else(|| fail(format!("{what} has no POSITION")))?;
+            check_accessor(&pos_acc, &buffers, &[::gltf::accessor::Dimensions::Vec3], true)
+                .map_err(|m| fail(format!("{what}: POSITION (accessor {}): {m}", pos_acc.index())))?;
+            let normal_acc = prim.get(&::gltf::Semantic::Normals);
+            if let Some(a) = &normal_acc {
+                check_accessor(a, &buffers, &[::gltf::accessor::Dimensions::Vec3], true)
+                    .map_err(|m| fail(format!("{what}: NORMAL (accessor {}): {m}", a.index())))?;
+            }
+            if let Some(a) = prim.indices() {
+                check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Scalar], false)
+                    .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
+                if a.data_type() == ::gltf::accessor::DataType::F32 || a.normalized() {
+                    return Err(fail(format!("{what}: indices (accessor {}) are not integers", a.index())));
+                }
+            }
+            if prim.get(&::gltf::Semantic::Colors(0)).is_some() {
+                colours += 1;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let positions: Vec<[f32; 3]> = reader
+                .read_positions()
+                .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?
+                .collect();
+            if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.iter().all(|x| x.is_finite())) {
+                return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
+            }
+            let n = positions.len();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..n as u32).collect(),
+            };
+            if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+                return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
+            }
+            let mut tris: Vec<[u32; 3]> = match mode {
+                ::gltf::mesh::Mode::TriangleStrip => (2..indices.len())
+                    .map(|k| {
+                        let t = [indices[k - 2], indices[k - 1], indices[k]];
+                        // Every other triangle of a strip is wound the other way.
+                        if k % 2 == 1 { [t[1], t[0], t[2]] } else { t }
+                    })
+                    .collect(),
+                ::gltf::mesh::Mode::TriangleFan => (2..indices.len())
+                    .map(|k| [indices[0], indices[k - 1], indices[k]])
+                    .collect(),
+                _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            };
+            if mirrored {
+                tris.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            triangles_total += tris.len() as u64;
+            if triangles_total > phong_core::limits::MAX_SCENE_TRIANGLES {
+                return Err(fail(format!(
+                    "more than {} triangles (MAX_SCENE_TRIANGLES)",
+                    phong_core::limits::MAX_SCENE_TRIANGLES
+                )));
+            }
+            let world_pos: Vec<DVec3> = positions
+                .iter()
+                .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
+                .collect();
+            let (normals, has_normals) = match normal_acc.as_ref().and_then(|_| reader.read_normals()) {
+                Some(ns) => {
+                    let ns: Vec<Vec3> = ns
+                        .map(|v| (normal_matrix * DVec3::from_array(v.map(f64::from))).normalize_or_zero().as_vec3())
+                        .collect();
+                    let ok = ns.len() == n;
+                    (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
+                }
+                None => (vec![Vec3::ZERO; n], false),
+            };
+            let mat = prim.material();
+            let material = mat.index().map(|_| {
+                for (name, t) in [
+                    ("baseColorTexture", mat.pbr_metallic_roughness().base_color_texture().is_some()),
+                    ("metallicRoughnessTexture", mat.pbr_metallic_roughness().metallic_roughness_texture().is_some()),
+                    ("normalTexture", mat.normal_texture().is_some()),
+                    ("occlusionTexture", mat.occlusion_texture().is_some()),
+                    ("emissiveTexture", mat.emissive_texture().is_some()),
+                ] {
+                    if t {
+                        textures.insert(name);
+                    }
+                }
+                let m = phong_material(&mat);
+                if m.alpha() < 1.0 || mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
+                    transparent += 1;
+                }
+                m
+            });
+            let name = format!(
+                "{}:{}",
+                path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
+                mesh.name().map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
+            );
+            pending.push((name, world_pos, normals, tris, material, has_normals));
+        }
+    }
+    if pending.is_empty() {
+        return Err(fail(format!(
+            "no triangles in the default scene: nothing to render{}",
+            if skipped_modes > 0 {
+                format!(" ({skipped_modes} primitives of points or lines skipped)")
+            } else {
+                String::new()
+            }
+        )));
+    }
+    let file = path.display();
+    if skipped_modes > 0 {
+        warnings.push(format!("{file}: {skipped_modes} primitives of points or lines skipped: phong draws surfaces"));
+    }
+    if !textures.is_empty() {
+        let names: Vec<&str> = textures.into_iter().collect();
+        warnings.push(format!("{file}: textures are not rendered yet ({}): the factors alone are used", names.join(", ")));
+    }
+    if colours > 0 {
+        warnings.push(format!("{file}: vertex colours (COLOR_0, {colours} primitives) are not used"));
+    }
+    if transparent > 0 {
+        warnings.push(format!(
+            "{file}: {transparent} primitives are transparent or alpha-masked: drawn opaque (transparency is not rendered)"
+        ));
+    }
+    // Re-centre the whole model together (one origin for every part).
+    let all: Vec<DVec3> = pending.iter().flat_map(|p| p.1.iter().copied()).collect();
+    let (_, origin) = recentred(&all);
+    for (name, world_pos, normals, tris, material, has_normals) in pending {
+        let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
+        let mesh = Mesh::new(positions, normals, tris).map_err(|e| fail(format!("{name}: {e}")))?;
+        model.parts.push(ObjPart {
+            name,
+            mesh,
+            material,
+            has_normals,
+            origin,
+        });
+    }
+    Ok(model)
+}
+
+/// The Phong material of a glTF material (the mapping in the module's doc).
+fn phong_material(m: &::gltf::Material) -> Material {
+    let pbr = m.pbr_metallic_roughness();
+    let base = pbr.base_color_factor();
+    let (diffuse, specular, roughness, alpha) = match m.pbr_specular_glossiness() {
+        Some(sg) => {
+            let d = sg.diffuse_factor();
+            ([d[0], d[1], d[2]], sg.specular_factor(), 1.0 - sg.glossiness_factor(), d[3])
+        }
+        None => {
+            let metal = pbr.metallic_factor().clamp(0.0, 1.0);
+            let rgb = [base[0], base[1], base[2]];
+            (
+                rgb.map(|c| c * (1.0 - metal)),
+                rgb.map(|c| 0.04 + (c - 0.04) * metal),
+                pbr.roughness_factor(),
+                base[3],
+            )
+        }
+    };
+    let a = roughness.clamp(0.0, 1.0).powi(2);
+    let shininess = if a > 0.0 {
+        (2.0 / (a * a) - 2.0).clamp(0.0, MAX_GLTF_SHININESS)
+    } else {
+        MAX_GLTF_SHININESS
+    };
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let col = |c: [f32; 3]| {
+        let c = c.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+        Color::new(c[0], c[1], c[2])
+    };
+    let d = col(diffuse);
+    let built = Material::new(d, d, col(specular), col(m.emissive_factor().map(|e| e * strength)), shininess)
+        .unwrap_or_default();
+    built.with_alpha(alpha.clamp(0.0, 1.0)).unwrap_or(built)
+}
+
+/// Checks an accessor before the reader trusts it: its type, a float component type where
+/// `float`, at least one element, and every element inside its buffer view and buffer.
+fn check_accessor(
+    a: &::gltf::Accessor,
+    buffers: &[Vec<u8>],
+    dims: &[::gltf::accessor::Dimensions],
+    float: bool,
+) -> Result<(), String> {
+    if !dims.contains(&a.dimensions()) {
+        return Err(format!("type {:?}, expected {:?}", a.dimensions(), dims[0]));
+    }
+    if float && (a.data_type() != ::gltf::accessor::DataType::F32 || a.normalized()) {
+        return Err(format!(
+            "component type {:?}; phong reads 32-bit floats here (quantized meshes are not read)",
+            a.data_type()
+        ));
+    }
+    if a.count() == 0 {
+        return Err("it has no elements".into());
+    }
+    if a.sparse().is_some() {
+        return Err("sparse accessors are not read".into());
+    }
+    let Some(view) = a.view() else {
+        return Err("it has no buffer view".into());
+    };
+    let size = a.size();
+    let stride = view.stride().unwrap_or(size);
+    let end = (a.count() as u64 - 1)
+        .checked_mul(stride as u64)
+        .and_then(|x| x.checked_add((a.offset() + size) as u64))
+        .ok_or("its size overflows")?;
+    if end > view.length() as u64 {
+        return Err(format!("it ends at byte {end} of a {}-byte buffer view", view.length()));
+    }
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
+    if view.offset() as u64 + view.length() as u64 > buffer_len {
+        return Err(format!(
+            "its buffer view ends at byte {} of a {buffer_len}-byte buffer",
+            view.offset() + view.length()
+        ));
+    }
+    Ok(())
+}
+
+/// `%20` and the like decoded (glTF URIs are percent-encoded).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let Ok(v) = u8::from_str_radix(std::str::from_utf8(&b[i + 1..i + 3]).unwrap_or("zz"), 16)
+        {
+            out.push(v);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
