@@ -3,7 +3,7 @@
 # checkout has it, ../shared/models/ (read there, never copied into the repository's files).
 set -euo pipefail
 cd "$(dirname "$0")"
-mkdir -p corpus/scene_toml corpus/obj_mtl corpus/scene_json corpus/ply_stl
+mkdir -p corpus/scene_toml corpus/obj_mtl corpus/scene_json corpus/ply_stl corpus/gltf
 for f in ../examples/scenes/*.toml ../benches/scenes/*.toml ../examples/fit/*.toml ../crates/phong-serve/src/default.toml; do
   cp "$f" "corpus/scene_toml/$(echo "$f" | tr '/.' '__')"
 done
@@ -37,3 +37,8 @@ b = b"solid binary".ljust(80) + struct.pack("<I", len(T)) + b"".join(struct.pack
 open("corpus/ply_stl/cube_binary_stl", "wb").write(b"\1" + b)
 PY
 for d in corpus/*; do echo "$d: $(ls "$d" | wc -l) inputs"; done
+# glTF: the shared samples small enough, behind the byte that picks the name (0: .gltf, 1: .glb).
+find "$models" \( -name '*.gltf' -o -name '*.glb' \) -size -100k 2>/dev/null | while IFS= read -r g; do
+  case "$g" in *.glb) pick='\001' ;; *) pick='\000' ;; esac
+  { printf "$pick"; cat "$g"; } > "corpus/gltf/$(echo "$g" | md5sum | cut -c1-12)"
+done

@@ -93,17 +93,17 @@ impl ViewArgs {
         let camera = match &self.camera {
             None => None,
             Some(c) => {
-                let v: Vec<f32> = c
+                let v: Vec<f64> = c
                     .split(',')
-                    .map(|x| x.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+                    .map(|x| x.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
                     .collect::<Option<_>>()
-                    .filter(|v: &Vec<f32>| v.len() == 6)
+                    .filter(|v: &Vec<f64>| v.len() == 6)
                     .ok_or_else(|| {
                         InputError(format!(
                             "--camera must be six finite numbers PX,PY,PZ,TX,TY,TZ (position, target), got {c:?}"
                         ))
                     })?;
-                let (p, t) = (glam::Vec3::new(v[0], v[1], v[2]), glam::Vec3::new(v[3], v[4], v[5]));
+                let (p, t) = (glam::DVec3::new(v[0], v[1], v[2]), glam::DVec3::new(v[3], v[4], v[5]));
                 if p == t {
                     bail!(InputError(
                         "--camera: the position and the target are the same point".into()

@@ -1,5 +1,10 @@
 //! Golden images: every example scene on every CPU path gives exactly the committed bytes. The
-//! CPU's output is deterministic, so the comparison is exact, not within 1/255.
+//! CPU's output is deterministic, so the comparison is exact, not within 1/255, with one
+//! exception: the AVX2 kernels start their reciprocals and inverse square roots from the
+//! hardware's estimates (`vrcpps`, `vrsqrtps`), whose bits differ between CPU makers (Intel's
+//! and AMD's tables are not the same), so on a CPU other than the one that blessed them the
+//! AVX2 images are checked against the golden PNG within 1/255 instead of by digest. The
+//! reference and portable paths use IEEE operations only and are exact everywhere.
 //!
 //! The paths differ from each other in rounding (the reference's scalar `shade`, the kernels'
 //! portable and AVX2 builds), so each has its own golden bytes: `tests/golden/NAME.png` is
@@ -59,7 +64,7 @@ fn example_scenes_match_their_golden_images() {
     scenes.sort();
     assert!(scenes.len() >= 7, "{} example scenes", scenes.len());
     let isas = common::isas();
-    let (mut checked, mut pngs) = (0, 0);
+    let (mut checked, mut pngs, mut estimated) = (0, 0, 0);
     for path in &scenes {
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         let scene = phong_scene::load(path).unwrap().scene;
@@ -104,7 +109,12 @@ fn example_scenes_match_their_golden_images() {
             let want = digests
                 .get(&key)
                 .unwrap_or_else(|| panic!("{key}: no digest (PHONG_BLESS=1 writes it)"));
-            assert_eq!(&digest, want, "{key}: the image differs from its golden digest");
+            // The AVX2 images: exact where this CPU's estimates are the blessing CPU's, else
+            // within 1/255 of the golden PNG (checked below).
+            let estimates_differ = label == "fast-avx2" && &digest != want;
+            if !estimates_differ {
+                assert_eq!(&digest, want, "{key}: the image differs from its golden digest");
+            }
             checked += 1;
             if label == "fast-avx2" {
                 let png = golden(&format!("{name}.png"));
@@ -118,7 +128,17 @@ fn example_scenes_match_their_golden_images() {
                     ((scene.image.width, scene.image.height), alpha),
                     "{name}"
                 );
-                assert!(bytes == want, "{name}: the image differs from {}", png.display());
+                if estimates_differ {
+                    let worst = bytes.iter().zip(&want).map(|(a, b)| a.abs_diff(*b)).max();
+                    assert!(
+                        bytes.len() == want.len() && worst <= Some(1),
+                        "{name}: the image differs from {} by up to {worst:?}/255",
+                        png.display()
+                    );
+                    estimated += 1;
+                } else {
+                    assert!(bytes == want, "{name}: the image differs from {}", png.display());
+                }
                 pngs += 1;
             }
         }
@@ -127,5 +147,8 @@ fn example_scenes_match_their_golden_images() {
         let text: String = digests.iter().map(|(k, v)| format!("{k} {v}\n")).collect();
         std::fs::write(&digests_file, text).unwrap();
     }
-    eprintln!("{checked} golden digests and {pngs} golden PNGs matched");
+    eprintln!(
+        "{checked} golden digests and {pngs} golden PNGs matched ({estimated} AVX2 images within 1/255: \
+         this CPU's estimates differ from the blessing CPU's)"
+    );
 }

@@ -12,7 +12,7 @@
 //! glossiness`. A primitive without a material gets OpenGL's default material (as an OBJ
 //! without MTL), not glTF's metallic default, which would be a black mirror here.
 
-use crate::formats::recentred;
+use crate::formats::far_origin;
 use crate::{Error, ObjPart};
 use base64::Engine;
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -84,9 +84,9 @@ pub fn read_gltf(
         path: path.to_path_buf(),
         message: format!("glTF: {m}"),
     };
-    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
-    let doc = &file.document;
-    for ext in doc.extensions_required() {
+    // Required extensions first (the crate's validation refuses them without saying why).
+    let unchecked = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    for ext in unchecked.document.extensions_required() {
         if !SUPPORTED.contains(&ext) {
             return Err(fail(format!(
                 "the file requires the extension {ext}, which phong does not read{}",
@@ -98,13 +98,17 @@ pub fn read_gltf(
             )));
         }
     }
+    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
+    let doc = &file.document;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in doc.buffers() {
         let data = match b.source() {
-            ::gltf::buffer::Source::Bin => file
-                .blob
-                .clone()
-                .ok_or_else(|| fail(format!("buffer {} is the GLB's binary chunk, which is missing", b.index())))?,
+            ::gltf::buffer::Source::Bin => file.blob.clone().ok_or_else(|| {
+                fail(format!(
+                    "buffer {} is the GLB's binary chunk, which is missing",
+                    b.index()
+                ))
+            })?,
             ::gltf::buffer::Source::Uri(uri) => {
                 if let Some(rest) = uri.strip_prefix("data:") {
                     let (_, data) = rest
@@ -140,11 +144,17 @@ pub fn read_gltf(
     // The nodes with their world transforms, depth first; a node met again on its own path is
     // a cycle.
     let mut instances: Vec<(::gltf::Node, DMat4)> = Vec::new();
-    let mut stack: Vec<(::gltf::Node, DMat4, Vec<usize>)> =
-        roots.into_iter().rev().map(|n| (n, DMat4::IDENTITY, Vec::new())).collect();
+    let mut stack: Vec<(::gltf::Node, DMat4, Vec<usize>)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, DMat4::IDENTITY, Vec::new()))
+        .collect();
     while let Some((node, parent, mut path_)) = stack.pop() {
         if path_.contains(&node.index()) {
-            return Err(fail(format!("node {} is its own ancestor (a cycle in the node tree)", node.index())));
+            return Err(fail(format!(
+                "node {} is its own ancestor (a cycle in the node tree)",
+                node.index()
+            )));
         }
         if instances.len() > 1_000_000 {
             return Err(fail("more than a million node instances".into()));
@@ -160,7 +170,7 @@ pub fn read_gltf(
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut textures, mut colours, mut transparent) = (0usize, BTreeSet::new(), 0usize, 0usize);
     // Positions in f64 world space for all parts, re-centred together below.
-    let mut pending: Vec<(String, Vec<DVec3>, Vec<Vec3>, Vec<[u32; 3]>, Option<Material>, bool)> = Vec::new();
+    let mut pending: Vec<Pending> = Vec::new();
     let mut triangles_total: u64 = 0;
     for (node, world) in &instances {
         if model.camera.is_none()
@@ -221,7 +231,10 @@ pub fn read_gltf(
                 check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Scalar], false)
                     .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
                 if a.data_type() == ::gltf::accessor::DataType::F32 || a.normalized() {
-                    return Err(fail(format!("{what}: indices (accessor {}) are not integers", a.index())));
+                    return Err(fail(format!(
+                        "{what}: indices (accessor {}) are not integers",
+                        a.index()
+                    )));
                 }
             }
             if prim.get(&::gltf::Semantic::Colors(0)).is_some() {
@@ -232,7 +245,11 @@ pub fn read_gltf(
                 .read_positions()
                 .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?
                 .collect();
-            if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.iter().all(|x| x.is_finite())) {
+            if let Some((i, p)) = positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+            {
                 return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
             }
             let n = positions.len();
@@ -273,7 +290,11 @@ pub fn read_gltf(
             let (normals, has_normals) = match normal_acc.as_ref().and_then(|_| reader.read_normals()) {
                 Some(ns) => {
                     let ns: Vec<Vec3> = ns
-                        .map(|v| (normal_matrix * DVec3::from_array(v.map(f64::from))).normalize_or_zero().as_vec3())
+                        .map(|v| {
+                            (normal_matrix * DVec3::from_array(v.map(f64::from)))
+                                .normalize_or_zero()
+                                .as_vec3()
+                        })
                         .collect();
                     let ok = ns.len() == n;
                     (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
@@ -283,8 +304,14 @@ pub fn read_gltf(
             let mat = prim.material();
             let material = mat.index().map(|_| {
                 for (name, t) in [
-                    ("baseColorTexture", mat.pbr_metallic_roughness().base_color_texture().is_some()),
-                    ("metallicRoughnessTexture", mat.pbr_metallic_roughness().metallic_roughness_texture().is_some()),
+                    (
+                        "baseColorTexture",
+                        mat.pbr_metallic_roughness().base_color_texture().is_some(),
+                    ),
+                    (
+                        "metallicRoughnessTexture",
+                        mat.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
+                    ),
                     ("normalTexture", mat.normal_texture().is_some()),
                     ("occlusionTexture", mat.occlusion_texture().is_some()),
                     ("emissiveTexture", mat.emissive_texture().is_some()),
@@ -301,10 +328,20 @@ pub fn read_gltf(
             });
             let name = format!(
                 "{}:{}",
-                path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-                mesh.name().map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
+                path.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                mesh.name()
+                    .map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
             );
-            pending.push((name, world_pos, normals, tris, material, has_normals));
+            pending.push(Pending {
+                name,
+                world_pos,
+                normals,
+                tris,
+                material,
+                has_normals,
+            });
         }
     }
     if pending.is_empty() {
@@ -319,14 +356,21 @@ pub fn read_gltf(
     }
     let file = path.display();
     if skipped_modes > 0 {
-        warnings.push(format!("{file}: {skipped_modes} primitives of points or lines skipped: phong draws surfaces"));
+        warnings.push(format!(
+            "{file}: {skipped_modes} primitives of points or lines skipped: phong draws surfaces"
+        ));
     }
     if !textures.is_empty() {
         let names: Vec<&str> = textures.into_iter().collect();
-        warnings.push(format!("{file}: textures are not rendered yet ({}): the factors alone are used", names.join(", ")));
+        warnings.push(format!(
+            "{file}: textures are not rendered yet ({}): the factors alone are used",
+            names.join(", ")
+        ));
     }
     if colours > 0 {
-        warnings.push(format!("{file}: vertex colours (COLOR_0, {colours} primitives) are not used"));
+        warnings.push(format!(
+            "{file}: vertex colours (COLOR_0, {colours} primitives) are not used"
+        ));
     }
     if transparent > 0 {
         warnings.push(format!(
@@ -334,9 +378,20 @@ pub fn read_gltf(
         ));
     }
     // Re-centre the whole model together (one origin for every part).
-    let all: Vec<DVec3> = pending.iter().flat_map(|p| p.1.iter().copied()).collect();
-    let (_, origin) = recentred(&all);
-    for (name, world_pos, normals, tris, material, has_normals) in pending {
+    let (lo, hi) = pending.iter().flat_map(|p| &p.world_pos).fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let origin = far_origin(lo, hi);
+    for Pending {
+        name,
+        world_pos,
+        normals,
+        tris,
+        material,
+        has_normals,
+    } in pending
+    {
         let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
         let mesh = Mesh::new(positions, normals, tris).map_err(|e| fail(format!("{name}: {e}")))?;
         model.parts.push(ObjPart {
@@ -350,6 +405,16 @@ pub fn read_gltf(
     Ok(model)
 }
 
+/// A primitive read, in f64 world space, waiting for the model's common origin.
+struct Pending {
+    name: String,
+    world_pos: Vec<DVec3>,
+    normals: Vec<Vec3>,
+    tris: Vec<[u32; 3]>,
+    material: Option<Material>,
+    has_normals: bool,
+}
+
 /// The Phong material of a glTF material (the mapping in the module's doc).
 fn phong_material(m: &::gltf::Material) -> Material {
     let pbr = m.pbr_metallic_roughness();
@@ -357,7 +422,12 @@ fn phong_material(m: &::gltf::Material) -> Material {
     let (diffuse, specular, roughness, alpha) = match m.pbr_specular_glossiness() {
         Some(sg) => {
             let d = sg.diffuse_factor();
-            ([d[0], d[1], d[2]], sg.specular_factor(), 1.0 - sg.glossiness_factor(), d[3])
+            (
+                [d[0], d[1], d[2]],
+                sg.specular_factor(),
+                1.0 - sg.glossiness_factor(),
+                d[3],
+            )
         }
         None => {
             let metal = pbr.metallic_factor().clamp(0.0, 1.0);
@@ -382,8 +452,14 @@ fn phong_material(m: &::gltf::Material) -> Material {
         Color::new(c[0], c[1], c[2])
     };
     let d = col(diffuse);
-    let built = Material::new(d, d, col(specular), col(m.emissive_factor().map(|e| e * strength)), shininess)
-        .unwrap_or_default();
+    let built = Material::new(
+        d,
+        d,
+        col(specular),
+        col(m.emissive_factor().map(|e| e * strength)),
+        shininess,
+    )
+    .unwrap_or_default();
     built.with_alpha(alpha.clamp(0.0, 1.0)).unwrap_or(built)
 }
 

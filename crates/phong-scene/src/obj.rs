@@ -302,6 +302,11 @@ fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 for i in 1..=used {
                     xs.push(number(i, &mut lenient)?);
                 }
+                // A `v`'s `w` or colour, and a `vt`'s `w`, are not used, but a broken one is
+                // a broken file.
+                for i in used + 1..w.len().min(8) {
+                    number(i, &mut lenient)?;
+                }
                 if kw == "v" && w.len() > 6 {
                     colours += 1;
                 }
@@ -476,11 +481,25 @@ fn normalize_mtl(src: &str) -> String {
 /// Checks an MTL file's values; returns the warnings (unsupported `illum`).
 fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), Error> {
     let c = Checker { path, src };
+    let mut maps: Vec<&str> = Vec::new();
+    let mut transparent = 0usize;
     for (start, line) in lines(src) {
         let content = line.split('#').next().unwrap_or("");
         let mut it = content.split_whitespace();
         let Some(kw) = it.next() else { continue };
         let rest: Vec<&str> = it.collect();
+        if (kw.starts_with("map_") || matches!(kw, "bump" | "norm" | "disp" | "decal" | "refl")) && !maps.contains(&kw)
+        {
+            maps.push(kw);
+        }
+        let opacity = match (kw, rest.first().and_then(|x| x.parse::<f32>().ok())) {
+            ("d", Some(d)) => Some(d),
+            ("Tr", Some(t)) => Some(1.0 - t),
+            _ => None,
+        };
+        if opacity.is_some_and(|o| o < 1.0) {
+            transparent += 1;
+        }
         let num = |i: usize| -> Result<f32, Error> {
             let f = rest
                 .get(i)
@@ -534,6 +553,19 @@ fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), E
             _ => {}
         }
     }
+    if !maps.is_empty() {
+        warnings.push(format!(
+            "{}: texture maps are not rendered yet ({}): the materials' colours alone are used",
+            path.display(),
+            maps.join(", ")
+        ));
+    }
+    if transparent > 0 {
+        warnings.push(format!(
+            "{}: {transparent} materials are transparent (`d` or `Tr`): drawn opaque (transparency is not rendered)",
+            path.display()
+        ));
+    }
     Ok(())
 }
 
@@ -554,7 +586,15 @@ fn to_material(m: &tobj::Material) -> Material {
     };
     // Values were checked line by line before tobj parsed them.
     let built = built.unwrap_or_default();
-    built.with_alpha(m.dissolve.unwrap_or(1.0)).unwrap_or(built)
+    // `d` is the opacity; `Tr`, where there is no `d`, its complement (tinyobjloader's reading).
+    let tr = m
+        .unknown_param
+        .get("Tr")
+        .and_then(|t| t.trim().parse::<f32>().ok())
+        .map(|t| 1.0 - t);
+    built
+        .with_alpha(m.dissolve.or(tr).unwrap_or(1.0).clamp(0.0, 1.0))
+        .unwrap_or(built)
 }
 
 /// Loads an OBJ file and its MTL materials: one part per group and material.
@@ -761,7 +801,10 @@ pub fn load_obj_text(
                 prepared
                     .notes
                     .iter()
-                    .map(|n| format!("; {}", n.rsplit(": ").next().unwrap_or(n)))
+                    .map(|n| {
+                        let file = format!("{}: ", path.display());
+                        format!("; {}", n.strip_prefix(&file).unwrap_or(n))
+                    })
                     .collect::<String>()
             ),
         ));

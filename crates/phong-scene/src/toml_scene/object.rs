@@ -163,19 +163,25 @@ pub(super) fn object(
             // The file's coordinates (the re-centred model moved back to where the file puts
             // it), or with `fit` the model centred at the origin with a bounding sphere of
             // radius 1, before the object's own transform.
-            let world_from_file = match crate::model::fit_of(&parts) {
-                Some((centre, radius)) if fit => {
-                    world_from_object * Mat4::from_scale(Vec3::splat(radius.recip())) * Mat4::from_translation(-centre)
-                }
+            // With `fit`, the model is fitted before its normals are computed (a model at 1e30
+            // would overflow f32 in their cross products).
+            let (fitted_from_parts, world_from_file) = match crate::model::fit_of(&parts) {
+                Some((centre, radius)) if fit => (
+                    Some(Mat4::from_scale(Vec3::splat(radius.recip())) * Mat4::from_translation(-centre)),
+                    world_from_object,
+                ),
                 _ => match parts.first() {
                     Some(p) if p.origin != glam::DVec3::ZERO => {
-                        world_from_object * Mat4::from_translation(p.origin.as_vec3())
+                        (None, world_from_object * Mat4::from_translation(p.origin.as_vec3()))
                     }
-                    _ => world_from_object,
+                    _ => (None, world_from_object),
                 },
             };
             let mut out = Vec::new();
-            for p in parts {
+            for mut p in parts {
+                if let Some(m) = &fitted_from_parts {
+                    p.mesh = p.mesh.transformed(m);
+                }
                 // File normals where every vertex has a usable one; else, or where `"file"`
                 // is asked of a model without them, normals by angle, with a warning.
                 let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();

@@ -1,0 +1,525 @@
+//! Models as people have them: OBJ as it is in the wild, glTF, and the view of a model alone.
+//! Files are written here byte by byte (so what they hold is known independently of the
+//! readers), and the real models of `../shared/models/` are read where they are.
+
+use base64::Engine;
+use glam::{DVec3, Vec3};
+use phong_scene::{Axis, ModelOptions, ViewName, load_model, load_model_full, load_with};
+use std::path::{Path, PathBuf};
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("phong-models-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(d: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = d.join(name);
+    if let Some(parent) = p.parent() {
+        std::fs::create_dir_all(parent).unwrap();
+    }
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// `../shared/models/`, or `None` (the test is skipped) where this checkout has none, unless
+/// `PHONG_REQUIRE_MODELS` is set (CI sets it).
+fn shared() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        assert!(
+            std::env::var_os("PHONG_REQUIRE_MODELS").is_none(),
+            "PHONG_REQUIRE_MODELS is set but {} is missing",
+            p.display()
+        );
+        eprintln!("skipped: {} is missing", p.display());
+        None
+    }
+}
+
+/// Twice the area of the triangles of every part (|Σ cross| per triangle, summed).
+fn area(parts: &[phong_scene::ObjPart]) -> f64 {
+    parts
+        .iter()
+        .map(|p| {
+            (0..p.mesh.triangles().len())
+                .map(|t| {
+                    let [a, b, c] = p.mesh.corners(t).map(|v| v.as_dvec3());
+                    (b - a).cross(c - a).length()
+                })
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// An L-shaped hexagon written from its reflex corner (tobj's fan would fill the notch), and a
+/// concave 64-gon from another project (assimp's ring): the triangles cover exactly the
+/// polygon's area (the shoelace formula), with no triangle facing the other way.
+#[test]
+fn concave_polygons_are_triangulated_exactly() {
+    let d = dir("concave");
+    let obj = write(
+        &d,
+        "l.obj",
+        b"v 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4 5 6\n",
+    );
+    let parts = load_model(&obj, &mut Vec::new()).unwrap();
+    assert_eq!(parts[0].mesh.triangles().len(), 4);
+    assert!((area(&parts) / 2.0 - 3.0).abs() < 1e-6, "{}", area(&parts) / 2.0);
+    for t in 0..4 {
+        let [a, b, c] = parts[0].mesh.corners(t);
+        assert!((b - a).cross(c - a).z > 0.0, "triangle {t} is wound backwards");
+    }
+    let Some(shared) = shared() else { return };
+    let ring = shared.join("assimp/OBJ/concave_polygon.obj");
+    let parts = load_model(&ring, &mut Vec::new()).unwrap();
+    // The polygon's area by Newell's formula on the file's own vertices.
+    let text = std::fs::read_to_string(&ring).unwrap();
+    let v: Vec<DVec3> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let x: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            DVec3::new(x[0], x[1], x[2])
+        })
+        .collect();
+    let face: Vec<usize> = text
+        .lines()
+        .find_map(|l| l.strip_prefix("f "))
+        .unwrap()
+        .split_whitespace()
+        .map(|t| t.split('/').next().unwrap().parse::<usize>().unwrap() - 1)
+        .collect();
+    let newell: DVec3 = (0..face.len())
+        .map(|i| v[face[i]].cross(v[face[(i + 1) % face.len()]]))
+        .sum();
+    let want = newell.length();
+    let got = area(&parts);
+    assert!((got - want).abs() < 1e-4 * want, "triangles {got}, polygon {want}");
+    // A fan from the first vertex would cover more (the ring's hole).
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// Numbers as C's strtod reads them, `w` ignored, several MTL libraries on one line with
+/// escaped spaces, a backslash path, a quoted name, `Tr` as the complement of `d`.
+#[test]
+fn obj_as_it_is_in_the_wild() {
+    let d = dir("wild");
+    write(&d, "a b.mtl", b"newmtl spaced\nKd 0.25 0.5 0.75\n");
+    write(&d, "sub/c.mtl", b"newmtl sub\nKd 1 0 0\nTr 0.25\n");
+    write(&d, "q.mtl", b"newmtl quoted\nKd 0 1 0\nd 0.5\nTr 0.9\n");
+    let obj = write(
+        &d,
+        "wild.obj",
+        b"mtllib missing.mtl a\\ b.mtl sub\\c.mtl\nmtllib \"q.mtl\"\n\
+          v .8e-1 -.7e+2 1.e-3 2.0\nv 3.1+e2 0 0\nv 0 1e+01 0\n\
+          usemtl spaced\nf 1 2 3\nusemtl sub\nf 1 3 2\nusemtl quoted\nf 2 1 3\n",
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&obj, &mut w).unwrap();
+    let p = parts[0].mesh.positions();
+    assert!(p.contains(&Vec3::new(0.08, -70.0, 0.001)), "{p:?}");
+    assert!(p.contains(&Vec3::new(3.1, 0.0, 0.0)), "{p:?}");
+    assert!(p.contains(&Vec3::new(0.0, 10.0, 0.0)), "{p:?}");
+    assert!(
+        w.iter()
+            .any(|w| w.contains("wild.obj:4: numbers with trailing characters")),
+        "{w:?}"
+    );
+    assert!(w.iter().any(|w| w.contains("missing.mtl not found")), "{w:?}");
+    assert!(w.iter().any(|w| w.contains("transparent")), "{w:?}");
+    let find = |r: f32| parts.iter().find_map(|p| p.material.filter(|m| m.diffuse().r == r));
+    let spaced = parts
+        .iter()
+        .find_map(|p| p.material.filter(|m| m.diffuse().g == 0.5))
+        .unwrap();
+    assert_eq!(spaced.diffuse().b, 0.75);
+    assert_eq!(find(1.0).unwrap().alpha(), 0.75, "Tr 0.25 is d 0.75");
+    let quoted = parts
+        .iter()
+        .find_map(|p| p.material.filter(|m| m.diffuse().g == 1.0))
+        .unwrap();
+    assert_eq!(quoted.alpha(), 0.5, "d wins over Tr");
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// Faces with fewer than 3 vertices are skipped and texture or normal indices that refer to
+/// nothing are dropped, with warnings; a file of lines alone is refused, saying so; a vertex
+/// index out of range and a NaN stay errors at their line and column.
+#[test]
+fn broken_records_are_skipped_or_refused_at_their_line() {
+    let d = dir("broken");
+    let obj = write(
+        &d,
+        "b.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1//1 2//1 3//1\nl 1 2\n",
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&obj, &mut w).unwrap();
+    assert_eq!(parts.iter().map(|p| p.mesh.triangles().len()).sum::<usize>(), 1);
+    assert!(!parts[0].has_normals);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("1 faces with fewer than 3 vertices skipped")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter()
+            .any(|w| w.contains("3 texture or normal indices refer to nothing")),
+        "{w:?}"
+    );
+    let lines = write(&d, "l.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n");
+    let e = load_model(&lines, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("no faces") && e.contains("1 line (`l`)"), "{e}");
+    let bad = write(&d, "bad.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    let e = load_model(&bad, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("bad.obj:4:7: `f`: vertex index 4 is out of range"), "{e}");
+    let nan = write(&d, "nan.obj", b"v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
+    let e = load_model(&nan, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("nan.obj:2:5: `v`: \"nan\" is not a finite number"), "{e}");
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// A model far from the origin for its size is re-centred in f64: a triangle with 1 mm detail
+/// at 10 000 km keeps its shape exactly (f32 alone would put its corners 1 m apart), and a
+/// scene that places it without `fit` puts it back where the file says.
+#[test]
+fn far_models_keep_their_detail() {
+    let d = dir("far");
+    let obj = write(
+        &d,
+        "far.obj",
+        b"v 10000000.000 20000000.000 5\nv 10000000.001 20000000.000 5\nv 10000000.000 20000000.001 5\nf 1 2 3\n",
+    );
+    let parts = load_model(&obj, &mut Vec::new()).unwrap();
+    let origin = parts[0].origin;
+    assert!(
+        (origin - DVec3::new(10000000.0005, 20000000.0005, 5.0)).length() < 1e-6,
+        "{origin}"
+    );
+    let [a, b, c] = parts[0].mesh.corners(0);
+    assert!(((b - a).length() - 0.001).abs() < 1e-7 && ((c - a).length() - 0.001).abs() < 1e-7);
+    // In a scene without `fit`, the file's coordinates (as f32 can hold them).
+    write(&d, "s.toml", b"[[object]]\nmesh = \"far.obj\"\n");
+    let scene = phong_scene::load(&d.join("s.toml")).unwrap().scene;
+    let p = scene.objects[0].mesh.positions()[0];
+    assert!((p - Vec3::new(1e7, 2e7, 5.0)).length() < 4.0, "{p}");
+    // With `fit`, centred with a bounding sphere of radius 1.
+    write(&d, "f.toml", b"[[object]]\nmesh = \"far.obj\"\nfit = true\n");
+    let scene = phong_scene::load(&d.join("f.toml")).unwrap().scene;
+    let (lo, hi) = scene.objects[0].mesh.bounds().unwrap();
+    assert!(((hi - lo).length() - 2.0).abs() < 1e-5 && ((lo + hi) * 0.5).length() < 1e-5);
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// A model alone: the same model framed alike whatever its size and offset (the camera in the
+/// fitted frame is the same); culling for a closed model, two-sided lighting for an open one;
+/// z up for a bust on a flat base; the named views and `--camera` place the camera as asked.
+#[test]
+fn a_model_alone_is_framed_whatever_its_size_and_offset() {
+    let d = dir("frame");
+    // A closed tetrahedron, wound outward.
+    let tet = |k: f64, o: f64| {
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let mut s = String::new();
+        for p in v {
+            s += &format!("v {} {} {}\n", p[0] * k + o, p[1] * k + o, p[2] * k + o);
+        }
+        s + "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    };
+    let mut cameras = Vec::new();
+    for (name, k, o) in [
+        ("unit", 1.0, 0.0),
+        ("tiny", 1e-6, 0.0),
+        ("huge", 1e30, 0.0),
+        ("far", 1.0, 1e8),
+    ] {
+        let p = write(&d, &format!("{name}.obj"), tet(k, o).as_bytes());
+        let loaded = load_with(&p, &ModelOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let c = loaded.scene.camera;
+        assert!(c.eye().is_finite(), "{name}");
+        assert!(
+            loaded.notes.iter().any(|n| n.contains("back faces culled")),
+            "{name}: {:?}",
+            loaded.notes
+        );
+        cameras.push((name, c.eye(), c.target()));
+        // Every vertex is in front of the camera, inside the near and far planes.
+        for v in loaded.scene.objects[0].mesh.positions() {
+            let depth = (*v - c.eye()).dot((c.target() - c.eye()).normalize());
+            assert!(depth > c.near() && depth < c.far(), "{name}: {v} at {depth}");
+        }
+    }
+    for (name, p, t) in &cameras[1..] {
+        assert!(
+            (*p - cameras[0].1).length() < 1e-4 && (*t - cameras[0].2).length() < 1e-4,
+            "{name}: {p} {t}"
+        );
+    }
+    // Open: one triangle is drawn two-sided, seen from the side its face looks to.
+    let tri = write(&d, "tri.obj", b"v 0 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
+    let loaded = load_with(&tri, &ModelOptions::default()).unwrap();
+    assert!(
+        loaded.notes.iter().any(|n| n.contains("two-sided")),
+        "{:?}",
+        loaded.notes
+    );
+    let normal = Vec3::X; // (0,1,0) × (0,0,1)
+    let c = loaded.scene.camera;
+    assert!(
+        (c.eye() - c.target()).normalize().dot(normal) > 0.5,
+        "{:?}",
+        loaded.notes
+    );
+    // Named views: `top` looks down the up axis; `--camera` in the file's coordinates.
+    let far = d.join("far.obj");
+    let top = load_with(
+        &far,
+        &ModelOptions {
+            view: Some(ViewName::Top),
+            up: Some(Axis::Z),
+            ..ModelOptions::default()
+        },
+    )
+    .unwrap()
+    .scene
+    .camera;
+    let dir_ = (top.eye() - top.target()).normalize();
+    assert!(dir_.dot(Vec3::Z) > 0.999, "{dir_}");
+    let cam = load_with(
+        &far,
+        &ModelOptions {
+            camera: Some((DVec3::new(1e8 + 0.5, 1e8 + 0.5, 1e8 + 10.0), DVec3::new(1e8, 1e8, 1e8))),
+            ..ModelOptions::default()
+        },
+    )
+    .unwrap()
+    .scene
+    .camera;
+    let dir_ = (cam.eye() - cam.target()).normalize();
+    let want = Vec3::new(0.5, 0.5, 10.0).normalize();
+    assert!(dir_.dot(want) > 0.9999, "{dir_} vs {want}");
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// The shared real models: Nefertiti's scan stands z up on a flat base; Spot faces −z and is
+/// closed; the Cornell box is open, drawn two-sided and seen from its open side.
+#[test]
+fn real_models_are_viewed_sensibly() {
+    let Some(shared) = shared() else { return };
+    let load = |p: &str| load_with(&shared.join(p), &ModelOptions::default()).unwrap();
+    let nef = load("common-3d/nefertiti.obj");
+    assert!(nef.notes.iter().any(|n| n.starts_with("up axis z")), "{:?}", nef.notes);
+    let up = nef.scene.camera.view_from_world().row(1).truncate();
+    assert!(up.dot(Vec3::Z) > 0.9, "{up}");
+    let spot = load("spot/spot_triangulated.obj");
+    assert!(spot.notes.iter().any(|n| n.starts_with("front -z")), "{:?}", spot.notes);
+    assert!(
+        spot.notes.iter().any(|n| n.contains("back faces culled")),
+        "{:?}",
+        spot.notes
+    );
+    let c = spot.scene.camera;
+    assert!(c.eye().z < c.target().z, "the camera is on Spot's -z side");
+    let cb = load("tinyobjloader/models/cornell_box.obj");
+    assert!(cb.notes.iter().any(|n| n.contains("two-sided")), "{:?}", cb.notes);
+    assert!(cb.scene.objects.iter().all(|o| o.shading.options.two_sided));
+    let c = cb.scene.camera;
+    assert!(c.eye().z < c.target().z, "the camera is at the box's open side (-z)");
+}
+
+/// Every model of `../shared/models/` loads, or fails with an error naming the file for the
+/// ones that are truly broken (a vertex index out of range or zero, a NaN, no faces at all).
+#[test]
+fn every_shared_model_loads_or_says_why() {
+    let Some(shared) = shared() else { return };
+    let broken = [
+        "invalid-relative-texture-index.obj",
+        "invalid-relative-vertex-index.obj",
+        "issue-140-zero-face-idx.obj",
+        "test-nan.obj",
+        "invalid-face-definition.obj",
+        "issue-356-leading-spaces-newmtl.obj",
+        "line-prim.obj",
+        "points-prim.obj",
+    ];
+    let mut stack = vec![shared];
+    let mut seen = 0;
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            let ext = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+            if !matches!(ext.as_deref(), Some("obj" | "gltf" | "glb" | "ply" | "stl")) {
+                continue;
+            }
+            seen += 1;
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            match load_with(&p, &ModelOptions::default()) {
+                Ok(l) => {
+                    assert!(!broken.contains(&name.as_str()), "{name} loaded");
+                    assert!(l.scene.triangle_count() > 0, "{name}");
+                    assert!(l.scene.camera.eye().is_finite(), "{name}");
+                }
+                Err(e) => {
+                    assert!(broken.contains(&name.as_str()), "{name}: {e}");
+                    assert!(e.is_input() && e.to_string().contains(&name), "{name}: {e}");
+                }
+            }
+        }
+    }
+    assert!(seen >= 70, "{seen} models");
+}
+
+/// A glTF file written here: a buffer as a data URI holding a quad's 4 positions, a strip and
+/// a fan of its 4 indices, a node tree that moves, scales and mirrors it, materials, a camera
+/// and a light.
+fn gltf_json(extra_nodes: &str, required: &str, bad_index: bool) -> String {
+    let mut bin = Vec::new();
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]] {
+        for x in p {
+            bin.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    // The strip's indices, then the fan's (around the quad).
+    let idx: [u16; 8] = if bad_index {
+        [0, 1, 2, 9, 0, 1, 3, 2]
+    } else {
+        [0, 1, 2, 3, 0, 1, 3, 2]
+    };
+    for i in idx {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, {required}
+  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 8}},
+                  {{"buffer": 0, "byteOffset": 56, "byteLength": 8}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 4, "type": "SCALAR"}},
+    {{"bufferView": 2, "componentType": 5123, "count": 4, "type": "SCALAR"}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.8, 0.4, 0.2, 1.0], "metallicFactor": 0.25, "roughnessFactor": 0.5}},
+                  "emissiveFactor": [0.1, 0.0, 0.0]}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "mode": 5, "material": 0}},
+                             {{"attributes": {{"POSITION": 0}}, "indices": 2, "mode": 6}}]}}],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.5, "znear": 0.1}}}}],
+  "nodes": [{{"children": [1]}}, {{"mesh": 0, "translation": [10, 0, 0], "scale": [2, 2, -2]}},
+            {{"camera": 0, "translation": [0, 0, 20]}}{extra_nodes}],
+  "scenes": [{{"nodes": [0, 2]}}], "scene": 0}}"#,
+        len = bin.len()
+    )
+}
+
+/// glTF: strips and fans, node transforms (a mirroring scale flips the winding back), the
+/// metallic-roughness mapping, glTF's camera; a cycle, an index out of range, a missing
+/// buffer file and a required extension phong does not read are errors naming the file.
+#[test]
+fn gltf_geometry_materials_and_errors() {
+    let d = dir("gltf");
+    let p = write(&d, "quad.gltf", gltf_json("", "", false).as_bytes());
+    let model = load_model_full(&p, &mut Vec::new(), &mut Vec::new()).unwrap();
+    assert_eq!(model.parts.len(), 2);
+    for part in &model.parts {
+        assert_eq!(part.mesh.triangles().len(), 2);
+        // World = T(10,0,0)·S(2,2,-2): the quad spans x 10..12, y 0..2; area 4 per part.
+        let (lo, hi) = part.mesh.bounds().unwrap();
+        let shift = part.origin.as_vec3();
+        assert_eq!(
+            (lo + shift, hi + shift),
+            (Vec3::new(10.0, 0.0, 0.0), Vec3::new(12.0, 2.0, 0.0))
+        );
+        assert!((area(std::slice::from_ref(part)) / 2.0 - 4.0).abs() < 1e-5);
+        // Every triangle faces the same way: +z in the file, mirrored by z -> -z, winding
+        // flipped back, so its normal (by winding) is -z... as drawn by the file: n·z < 0.
+        for t in 0..2 {
+            let [a, b, c] = part.mesh.corners(t);
+            assert!((b - a).cross(c - a).z < 0.0, "triangle {t}");
+        }
+    }
+    // base (0.8, 0.4, 0.2), metallic 0.25, roughness 0.5: diffuse = base·0.75, specular =
+    // 0.04 + (base − 0.04)·0.25, α = 0.25, s = 2/α² − 2 = 30.
+    let m = model.parts[0].material.unwrap();
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-6;
+    assert!(close(m.diffuse().r, 0.6) && close(m.diffuse().g, 0.3) && close(m.diffuse().b, 0.15));
+    assert!(close(m.specular().r, 0.23) && close(m.specular().g, 0.13) && close(m.specular().b, 0.08));
+    assert!(close(m.shininess(), 30.0) && close(m.emission().r, 0.1));
+    assert!(model.parts[1].material.is_none(), "no material: OpenGL's default");
+    let cam = model.camera.unwrap();
+    assert_eq!(cam.position, DVec3::new(0.0, 0.0, 20.0));
+    assert!((cam.fov_deg.unwrap() - 0.5f32.to_degrees()).abs() < 1e-4);
+    // The model alone is seen through the file's camera.
+    let loaded = load_with(&p, &ModelOptions::default()).unwrap();
+    assert!(
+        loaded.notes.iter().any(|n| n.contains("the file's camera")),
+        "{:?}",
+        loaded.notes
+    );
+    let fail = |name: &str, text: String| {
+        let p = write(&d, name, text.as_bytes());
+        let e = load_model(&p, &mut Vec::new()).unwrap_err();
+        assert!(e.is_input() && e.to_string().contains(name), "{e}");
+        e.to_string()
+    };
+    let e = fail(
+        "cycle.gltf",
+        gltf_json(r#", {"children": [4]}, {"children": [3]}"#, "", false)
+            .replace("\"nodes\": [0, 2]", "\"nodes\": [0, 2, 3]"),
+    );
+    assert!(e.contains("cycle"), "{e}");
+    let e = fail("range.gltf", gltf_json("", "", true));
+    assert!(e.contains("index 9 is out of range"), "{e}");
+    let e = fail(
+        "draco.gltf",
+        gltf_json(
+            "",
+            r#""extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],"#,
+            false,
+        ),
+    );
+    assert!(
+        e.contains("KHR_draco_mesh_compression") && e.contains("decompress"),
+        "{e}"
+    );
+    let mut missing = gltf_json("", "", false);
+    let start = missing.find("data:").unwrap();
+    let end = start + missing[start..].find('"').unwrap();
+    missing.replace_range(start..end, "gone.bin");
+    let e = fail("missing.gltf", missing);
+    assert!(e.contains("gone.bin"), "{e}");
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// The shared glTF samples: the textured boxes (24 vertices, 12 triangles; textures named in
+/// a warning), the two-cylinder engine's many parts, and the cameras sample's camera.
+#[test]
+fn shared_gltf_samples() {
+    let Some(shared) = shared() else { return };
+    let g = shared.join("assimp/glTF2");
+    for f in [
+        "BoxTextured-glTF/BoxTextured.gltf",
+        "BoxTextured-glTF-Binary/BoxTextured.glb",
+        "BoxTextured-glTF-Embedded/BoxTextured.gltf",
+        "BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
+    ] {
+        let mut w = Vec::new();
+        let parts = load_model(&g.join(f), &mut w).unwrap();
+        let tris: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
+        assert_eq!(tris, 12, "{f}");
+        assert!(w.iter().any(|w| w.contains("baseColorTexture")), "{f}: {w:?}");
+    }
+    let engine = load_model(
+        &g.join("2CylinderEngine-glTF-Binary/2CylinderEngine.glb"),
+        &mut Vec::new(),
+    )
+    .unwrap();
+    assert!(engine.len() > 20, "{} parts", engine.len());
+    let cams = load_model_full(&g.join("cameras/Cameras.gltf"), &mut Vec::new(), &mut Vec::new()).unwrap();
+    assert!(cams.camera.is_some());
+}

@@ -1,0 +1,24 @@
+//! The glTF reader on any bytes, named `.gltf` or `.glb` by the first byte (external buffers
+//! are refused, data URIs and the GLB chunk are read): no panic, every error a model error
+//! naming the file, every accepted model a valid mesh.
+#![no_main]
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&pick, bytes)) = data.split_first() else {
+        return;
+    };
+    let name = ["fuzz.gltf", "fuzz.glb"][usize::from(pick % 2)];
+    match phong_scene::parse_mesh_bytes(Path::new(name), bytes) {
+        Ok(parts) => {
+            for p in parts {
+                let n = p.mesh.positions().len() as u32;
+                assert!(p.mesh.triangles().iter().flatten().all(|&i| i < n));
+                assert!(p.mesh.positions().iter().all(|v| v.is_finite()));
+            }
+        }
+        Err(e @ phong_scene::Error::Model { .. }) => assert!(e.to_string().starts_with(name)),
+        Err(e) => panic!("not a model error: {e}"),
+    }
+});
