@@ -293,3 +293,52 @@ fn every_shared_model_renders_or_says_why() {
     }
     assert!(n >= 70, "{n} models");
 }
+
+/// A few real models as `phong render MODEL` draws them by default (240×180), against
+/// `tests/golden/models/*.png`, within 1/255 (the AVX2 kernels' estimates differ between CPU
+/// makers; see phong-raster's golden test). `PHONG_BLESS=1` rewrites them.
+#[test]
+fn shared_models_match_their_golden_images() {
+    let Some(shared) = shared() else { return };
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/models");
+    let bless = std::env::var_os("PHONG_BLESS").is_some();
+    let dir = tempfile::tempdir().unwrap();
+    for (model, name) in [
+        ("spot/spot_quadrangulated.obj", "spot"),
+        ("common-3d/nefertiti.obj", "nefertiti"),
+        ("tinyobjloader/models/cornell_box.obj", "cornell_box"),
+        ("assimp/OBJ/concave_polygon.obj", "concave_polygon"),
+        ("assimp/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb", "engine"),
+    ] {
+        let out = dir.path().join(format!("{name}.png"));
+        let o = phong(
+            dir.path(),
+            &[
+                "render",
+                shared.join(model).to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--width",
+                "240",
+                "--height",
+                "180",
+            ],
+        );
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let want = golden.join(format!("{name}.png"));
+        if bless {
+            std::fs::create_dir_all(&golden).unwrap();
+            std::fs::copy(&out, &want).unwrap();
+        }
+        let (got, want) = (read_png(&out), read_png(&want));
+        assert_eq!((got.0, got.1, got.2), (want.0, want.1, want.2), "{name}");
+        let worst = got
+            .3
+            .iter()
+            .zip(&want.3)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap_or(0);
+        assert!(worst <= 1, "{name}: differs from its golden image by up to {worst}/255");
+    }
+}

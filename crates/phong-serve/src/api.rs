@@ -662,10 +662,13 @@ fn valid_upload_name(name: &str) -> Result<(), ApiError> {
             "a model's name is 1 to 128 letters, digits, spaces, '.', '-' or '_', not starting with '.'",
         ));
     }
-    if !matches!(ext.as_deref(), Some("obj" | "mtl" | "ply" | "stl")) {
+    if !matches!(
+        ext.as_deref(),
+        Some("obj" | "mtl" | "ply" | "stl" | "gltf" | "glb" | "bin")
+    ) {
         return Err(ApiError::at(
             "name",
-            "uploads are models (Wavefront .obj with their .mtl libraries, .ply, .stl)",
+            "uploads are models (Wavefront .obj with their .mtl libraries, .gltf with their .bin buffers, .glb, .ply, .stl)",
         ));
     }
     Ok(())
@@ -683,7 +686,9 @@ async fn upload(
     let client = client_id(&headers, peer);
     let bytes = read_body(body, SERVE_MAX_UPLOAD, "SERVE_MAX_UPLOAD").await?;
     let lower = name.to_ascii_lowercase();
-    let is_obj = [".obj", ".ply", ".stl"].iter().any(|e| lower.ends_with(e));
+    let is_obj = [".obj", ".ply", ".stl", ".gltf", ".glb"]
+        .iter()
+        .any(|e| lower.ends_with(e));
     let files = {
         let mut clients = state
             .uploads

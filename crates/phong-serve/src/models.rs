@@ -1,5 +1,5 @@
 //! Models: those the operator's command loaded from disk (shared, read-only) and those
-//! clients upload (OBJ with MTL, PLY and STL files kept in memory per client, capped, dropped when idle).
+//! clients upload (OBJ with MTL, glTF with its buffers, PLY and STL files kept in memory per client, capped, dropped when idle).
 //! A scene's `mesh = "NAME"` is looked up here, never on disk.
 
 use crate::api::AppState;
@@ -123,8 +123,17 @@ pub struct Files(HashMap<String, Arc<Vec<u8>>>);
 pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, String> {
     let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
     let lower = name.to_ascii_lowercase();
-    if lower.ends_with(".ply") || lower.ends_with(".stl") {
-        return phong_scene::parse_mesh_bytes(Path::new(name), data)
+    if [".ply", ".stl", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
+        // A glTF's external buffers are looked up among the client's uploads, by file name.
+        let buffer = |uri: &str| -> Result<Vec<u8>, String> {
+            let key = uri.rsplit(['/', '\\']).next().unwrap_or(uri);
+            files
+                .0
+                .get(key)
+                .map(|f| f.to_vec())
+                .ok_or_else(|| format!("{key} is not uploaded (upload it with the glTF)"))
+        };
+        return phong_scene::parse_mesh_bytes_with(Path::new(name), data, &buffer)
             .map(Arc::new)
             .map_err(|e| e.to_string());
     }

@@ -638,3 +638,55 @@ async fn upload_limits_per_client_and_in_all() {
     let r = call(&st, "POST", "/api/fit", "a", body).await;
     assert_eq!(refused(&r), (413, String::new(), "SERVE_MAX_FIT_BODY".into()));
 }
+
+/// PLY, STL and glTF uploads: a model of each kind is parsed at upload and answered with the
+/// scene of the model alone; a glTF finds its external buffer among the client's uploads, and
+/// one whose buffer was not uploaded is refused naming it.
+#[tokio::test]
+async fn ply_stl_and_gltf_uploads() {
+    let st = state();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+               element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let r = call(&st, "PUT", "/api/models/t.ply", "a", ply).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.json());
+    assert_eq!(r.json()["triangles"], json!(1));
+    assert_eq!(r.json()["scene"]["object"][0]["fit"], json!(true));
+    let stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+    let r = call(&st, "PUT", "/api/models/t.stl", "a", stl).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.json());
+    // A glTF triangle whose positions are in q.bin.
+    let mut bin = Vec::new();
+    for x in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    let gltf = r#"{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 36, "uri": "q.bin"}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}"#;
+    let r = call(&st, "PUT", "/api/models/q.gltf", "a", gltf).await;
+    assert_eq!(r.status, StatusCode::BAD_REQUEST, "{}", r.json());
+    assert!(
+        r.json()["error"]
+            .as_str()
+            .unwrap_or("")
+            .contains("q.bin is not uploaded"),
+        "{}",
+        r.json()
+    );
+    assert_eq!(
+        call(&st, "PUT", "/api/models/q.bin", "a", bin).await.status,
+        StatusCode::CREATED
+    );
+    let r = call(&st, "PUT", "/api/models/q.gltf", "a", gltf).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.json());
+    assert_eq!(r.json()["triangles"], json!(1));
+    // The answered scene renders, the triangle drawn (two-sided: it is open).
+    let mut scene = r.json()["scene"].clone();
+    scene["image"] = json!({"width": 32, "height": 24});
+    let r = call(&st, "POST", "/api/render", "a", scene.to_string()).await;
+    assert_eq!(r.status, StatusCode::OK);
+    let (_, _, px) = decode(&r.body);
+    let bg = px[..3].to_vec();
+    assert!(px.chunks(3).filter(|p| *p != &bg[..]).count() > 20);
+}
