@@ -4,6 +4,7 @@
 
 use crate::Error;
 use glam::{Mat3, Mat4, Vec3};
+use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 
 /// An indexed triangle mesh with one normal per vertex. Triangles are
@@ -135,7 +136,7 @@ impl Mesh {
     /// Vertices at the same position merged (exact match), so that normals
     /// can be averaged across faces that a file gave separate vertices.
     pub fn welded(&self) -> Mesh {
-        let mut map: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut map: FxHashMap<[u32; 3], u32> = FxHashMap::default();
         let mut positions = Vec::new();
         let remap: Vec<u32> = self
             .positions
@@ -203,12 +204,26 @@ impl Mesh {
             })
             .collect();
         let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
-        let mut around: Vec<Vec<u32>> = vec![Vec::new(); w.positions.len()];
-        for (f, t) in w.triangles.iter().enumerate() {
+        // The faces around each vertex, in face order: `around[v]` is
+        // `faces[start[v]..start[v + 1]]` (one allocation, not one per vertex).
+        let mut start = vec![0u32; w.positions.len() + 1];
+        for t in &w.triangles {
             for &i in t {
-                around[i as usize].push(f as u32);
+                start[i as usize + 1] += 1;
             }
         }
+        for v in 0..w.positions.len() {
+            start[v + 1] += start[v];
+        }
+        let mut faces = vec![0u32; w.triangles.len() * 3];
+        let mut fill = start.clone();
+        for (f, t) in w.triangles.iter().enumerate() {
+            for &i in t {
+                faces[fill[i as usize] as usize] = f as u32;
+                fill[i as usize] += 1;
+            }
+        }
+        let around = |v: usize| &faces[start[v] as usize..start[v + 1] as usize];
         let mut work = 0u64;
         // At a vertex with many faces, faces of the same facet direction are one group (summed
         // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
@@ -217,14 +232,13 @@ impl Mesh {
         // made with.
         const MANY: usize = 32;
         const MANY_GROUPS: usize = 64;
-        let vertex_rule: Vec<Rule> = around
-            .iter()
-            .enumerate()
-            .map(|(v, fs)| {
+        let vertex_rule: Vec<Rule> = (0..w.positions.len())
+            .map(|v| {
+                let fs = around(v);
                 if fs.len() <= MANY {
                     return Rule::Plain;
                 }
-                let mut index: HashMap<[u32; 3], usize> = HashMap::new();
+                let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
                 let mut g: Vec<(Vec3, Vec3)> = Vec::new();
                 for &f in fs {
                     work += 1;
@@ -250,20 +264,20 @@ impl Mesh {
                 }
             })
             .collect();
-        let mut memo: HashMap<(u32, [u32; 3]), Vec3> = HashMap::new();
+        let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
         let mut positions = Vec::new();
         let mut normals = Vec::new();
-        let mut dedup: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+        let mut dedup: FxHashMap<(u32, [u32; 3]), u32> = FxHashMap::default();
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
             let own = unit[f];
             let tri = t.map(|v| {
                 let n = match &vertex_rule[v as usize] {
-                    Rule::Plain => around[v as usize]
+                    Rule::Plain => around(v as usize)
                         .iter()
                         .filter(|&&g| {
                             work += 1;
-                            facet[g as usize].normalize_or_zero().dot(own) >= cos_crease
+                            unit[g as usize].dot(own) >= cos_crease
                         })
                         .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
                         .normalize_or_zero(),

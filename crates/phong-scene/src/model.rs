@@ -8,7 +8,7 @@
 
 use crate::{Error, Loaded, LoadedModel, ModelFormat, ObjPart, load_model_full};
 use glam::{DVec3, Vec3};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// An axis, signed: the model's up (`--up`).
@@ -550,10 +550,11 @@ fn closedness(parts: &[ObjPart]) -> Closed {
     if count > MAX_CLOSED_CHECK {
         return Closed::Unchecked;
     }
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut ids: FxHashMap<[u32; 3], u32> = FxHashMap::default();
     // Per edge (lower id first): the sum of its faces' orientations (+1 one way, -1 the
     // other) and their number; a closed, consistent model has (0, 2) on every edge.
-    let mut edges: HashMap<(u32, u32), (i32, u32)> = HashMap::with_capacity(count * 3 / 2);
+    let mut edges: FxHashMap<(u32, u32), (i32, u32)> = FxHashMap::default();
+    edges.reserve(count * 3 / 2);
     let mut volume = 0.0f64;
     for p in parts {
         let pos = p.mesh.positions();
