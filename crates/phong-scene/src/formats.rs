@@ -377,10 +377,15 @@ fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
     }])
 }
 
-/// Where a model with bounds `(lo, hi)` is re-centred: its centre where that lies far from the
-/// origin for its size (more than 4 times its largest side: f32 would lose its detail
-/// there), else the origin (a model near the origin keeps its coordinates exactly).
-pub(crate) fn far_origin(lo: DVec3, hi: DVec3) -> DVec3 {
+/// Where a model with vertices `points` is re-centred: the centre of its bounding box where
+/// that lies far from the origin for its size (more than 4 times its largest side: f32 would
+/// lose its detail there), else the origin (a model near the origin keeps its coordinates
+/// exactly).
+pub(crate) fn far_origin(points: impl IntoIterator<Item = DVec3>) -> DVec3 {
+    let (lo, hi) = points.into_iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
     if lo.x.partial_cmp(&hi.x).is_none_or(|o| o.is_gt()) {
         return DVec3::ZERO;
     }
@@ -394,10 +399,6 @@ pub(crate) fn far_origin(lo: DVec3, hi: DVec3) -> DVec3 {
 
 /// `points` as f32 positions relative to their [`far_origin`], and that origin.
 pub(crate) fn recentred(points: &[DVec3]) -> (Vec<Vec3>, DVec3) {
-    let (lo, hi) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let origin = far_origin(lo, hi);
+    let origin = far_origin(points.iter().copied());
     (points.iter().map(|p| (*p - origin).as_vec3()).collect(), origin)
 }

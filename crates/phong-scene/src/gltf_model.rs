@@ -378,11 +378,7 @@ pub fn read_gltf(
         ));
     }
     // Re-centre the whole model together (one origin for every part).
-    let (lo, hi) = pending.iter().flat_map(|p| &p.world_pos).fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let origin = far_origin(lo, hi);
+    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
     for Pending {
         name,
         world_pos,

@@ -235,19 +235,15 @@ fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
         }
         out
     }
-    // The positions' bounds, for the origin (malformed records are reported below).
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for (_, line) in lines(src) {
+    // The positions, for the origin (malformed records are reported below).
+    let origin = crate::formats::far_origin(lines(src).filter_map(|(_, line)| {
         let w = words(line);
-        if w.first().map(|w| w.1) == Some("v") && w.len() >= 4 {
-            let p: Vec<f64> = w[1..4].iter().filter_map(|(_, t)| strtod(t).map(|x| x.0)).collect();
-            if p.len() == 3 && p.iter().all(|x| x.is_finite()) {
-                let p = DVec3::new(p[0], p[1], p[2]);
-                (lo, hi) = (lo.min(p), hi.max(p));
-            }
+        if w.first().map(|w| w.1) != Some("v") || w.len() < 4 {
+            return None;
         }
-    }
-    let origin = crate::formats::far_origin(lo, hi);
+        let p: Vec<f64> = w[1..4].iter().filter_map(|(_, t)| strtod(t).map(|x| x.0)).collect();
+        (p.len() == 3 && p.iter().all(|x| x.is_finite())).then(|| DVec3::new(p[0], p[1], p[2]))
+    }));
     let mut out = String::with_capacity(src.len() + 64);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let (mut short_faces, mut bad_refs, mut colours, mut lenient) = (0usize, 0usize, 0usize, None);
