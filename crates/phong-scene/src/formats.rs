@@ -36,6 +36,9 @@ pub struct LoadedModel {
     pub camera: Option<crate::gltf_model::FileCamera>,
     /// The file's lights (glTF's KHR_lights_punctual).
     pub lights: Vec<crate::gltf_model::FileLight>,
+    /// Whether the file says which faces are drawn (glTF: `Some(true)` where a material is
+    /// double-sided, `Some(false)` where none is); `None` for formats that do not say.
+    pub double_sided: Option<bool>,
     /// Its format.
     pub format: ModelFormat,
 }
@@ -128,6 +131,7 @@ pub fn load_model_full(
                 parts: m.parts,
                 camera: m.camera,
                 lights: m.lights,
+                double_sided: Some(m.double_sided),
                 format,
             });
         }
@@ -136,6 +140,7 @@ pub fn load_model_full(
         parts,
         camera: None,
         lights: Vec::new(),
+        double_sided: None,
         format,
     })
 }

@@ -70,6 +70,8 @@ pub struct GltfModel {
     pub camera: Option<FileCamera>,
     /// The KHR_lights_punctual lights of the default scene.
     pub lights: Vec<FileLight>,
+    /// Whether any primitive's material is double-sided (glTF culls back faces otherwise).
+    pub double_sided: bool,
 }
 
 /// Reads a glTF model from `bytes` (a `.gltf` JSON or a `.glb`), its external buffers read
@@ -302,6 +304,7 @@ pub fn read_gltf(
                 None => (vec![Vec3::ZERO; n], false),
             };
             let mat = prim.material();
+            model.double_sided |= mat.double_sided();
             let material = mat.index().map(|_| {
                 for (name, t) in [
                     (

@@ -188,8 +188,9 @@ const FILL: f32 = 0.92;
 ///   bust, like Nefertiti's), else y;
 /// - front: +z for a y-up model, −y for a z-up one (Blender's front view), the convention's
 ///   axis turned likewise for other ups;
-/// - faces: `options.sides`, else culled where the model is closed (each edge shared by two
-///   faces, wound opposite ways) and wound outward (positive volume), else two-sided;
+/// - faces: `options.sides`, else as the file says (glTF's `doubleSided`), else culled where
+///   the model is closed (each edge shared by two faces, wound opposite ways) and wound
+///   outward (positive volume), else two-sided;
 /// - the camera: `options.camera`, else the named view (default: front, a little right and
 ///   above), at the distance where every vertex is inside [`FILL`] of the frame, its near and
 ///   far planes from the vertices' depths; perspective, 45°.
@@ -198,6 +199,7 @@ pub fn model_scene(name: &str, parts: &[ObjPart], options: &ModelOptions) -> (se
         parts: parts.to_vec(),
         camera: None,
         lights: Vec::new(),
+        double_sided: None,
         format: ModelFormat::Obj,
     };
     model_scene_with(name, &model, options)
@@ -257,9 +259,17 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         None => f,
     };
     let r = u.cross(f);
-    let two_sided = match options.sides {
-        Some(s) => s == Sides::TwoSided,
-        None => {
+    let two_sided = match (options.sides, model.double_sided) {
+        (Some(s), _) => s == Sides::TwoSided,
+        (None, Some(d)) => {
+            notes.push(if d {
+                "two-sided lighting, no culling: the file's materials are double-sided (--cull to cull)".into()
+            } else {
+                "back faces culled: the file's materials are single-sided (--two-sided to draw them)".into()
+            });
+            d
+        }
+        (None, None) => {
             let c = closed;
             let two = !c.closed_outward();
             notes.push(match (two, c) {
@@ -354,7 +364,7 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
             let l = Vec3::from_array(*d);
             let (x, y, z) = (l.dot(r0), l.dot(u0), l.dot(d0));
             let w = rc * x + uc * y + dc * z;
-            serde_json::json!({"type": "directional", "direction": round6(w), "color": [c, c, c]})
+            serde_json::json!({"type": "directional", "direction": round6(w), "color": [short(*c), short(*c), short(*c)]})
         })
         .collect();
     let brightest = model.lights.iter().flat_map(|l| l.color).fold(0.0f32, f32::max);
@@ -364,10 +374,10 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
             .lights
             .iter()
             .filter_map(|l| {
-                let color = l.color.map(|c| (c / brightest * 1e6).round() / 1e6);
+                let color = l.color.map(|c| short(c / brightest));
                 let dir = round6(l.direction.as_vec3());
                 let pos = round6(fitted(to_parts(l.position)));
-                (Vec3::from_array(dir) != Vec3::ZERO || l.kind == "point").then(|| match l.kind {
+                (dir != [0.0; 3] || l.kind == "point").then(|| match l.kind {
                     "directional" => serde_json::json!({"type": "directional", "direction": dir, "color": color}),
                     "point" => serde_json::json!({"type": "point", "position": pos, "color": color}),
                     _ => serde_json::json!({"type": "spot", "position": pos, "direction": dir, "color": color,
@@ -378,9 +388,9 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
     }
     let bg = MODEL_BACKGROUND;
     let json = serde_json::json!({
-        "image": {"background": [bg[0], bg[1], bg[2]], "antialias": 4},
-        "camera": {"position": round6(position), "target": round6(target), "up": cam_up.to_array(),
-                   "fov": fov, "near": near, "far": far},
+        "image": {"background": [short(bg[0]), short(bg[1]), short(bg[2])], "antialias": 4},
+        "camera": {"position": round6(position), "target": round6(target), "up": round6(cam_up),
+                   "fov": short(fov), "near": short(near), "far": short(far)},
         "shading": {"viewer": "local", "two_sided": two_sided},
         "light": lights,
         "object": [{"mesh": name, "fit": true}],
@@ -388,9 +398,15 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
     (json, notes)
 }
 
-/// `v` with 6 decimals, so the scene's text (and the explorer's "Download TOML") is short.
-fn round6(v: Vec3) -> [f32; 3] {
-    v.to_array().map(|x| (x * 1e6).round() / 1e6)
+/// `x` with 6 decimals, so that the scene's text (and the explorer's "Download TOML") is
+/// short: `0.8`, not f32's `0.800000011920929` written as f64.
+fn short(x: f32) -> f64 {
+    (f64::from(x) * 1e6).round() / 1e6
+}
+
+/// [`short`] of each coordinate.
+fn round6(v: Vec3) -> [f64; 3] {
+    v.to_array().map(short)
 }
 
 /// The camera distance along `dir` (from the origin of the fitted frame) at which every vertex

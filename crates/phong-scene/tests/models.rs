@@ -461,6 +461,23 @@ fn gltf_geometry_materials_and_errors() {
         "{:?}",
         loaded.notes
     );
+    // Its materials are single-sided (glTF's default): back faces culled, as the format says,
+    // though the quad is open; a double-sided material draws them.
+    assert!(
+        loaded.notes.iter().any(|n| n.contains("single-sided")),
+        "{:?}",
+        loaded.notes
+    );
+    assert!(!loaded.scene.objects[0].shading.options.two_sided);
+    let two = write(
+        &d,
+        "two.gltf",
+        gltf_json("", "", false)
+            .replace("\"emissiveFactor\"", "\"doubleSided\": true, \"emissiveFactor\"")
+            .as_bytes(),
+    );
+    let loaded = load_with(&two, &ModelOptions::default()).unwrap();
+    assert!(loaded.scene.objects[0].shading.options.two_sided, "{:?}", loaded.notes);
     let fail = |name: &str, text: String| {
         let p = write(&d, name, text.as_bytes());
         let e = load_model(&p, &mut Vec::new()).unwrap_err();
