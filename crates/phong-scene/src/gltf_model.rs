@@ -100,6 +100,20 @@ pub fn read_gltf(
             )));
         }
     }
+    // gltf-json's validation indexes the POSITION accessor unchecked (a panic on an index out
+    // of range, found by the `gltf` fuzz target): every primitive's accessors are checked first.
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let refs = prim.attributes.values().chain(prim.indices.as_ref());
+            if let Some(bad) = refs.map(|i| i.value()).find(|&i| i >= json.accessors.len()) {
+                return Err(fail(format!(
+                    "mesh {m} primitive {p} names accessor {bad}, but the file has {}",
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
     let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
     let doc = &file.document;
     let mut buffers: Vec<Vec<u8>> = Vec::new();

@@ -490,6 +490,12 @@ fn gltf_geometry_materials_and_errors() {
             .replace("\"nodes\": [0, 2]", "\"nodes\": [0, 2, 3]"),
     );
     assert!(e.contains("cycle"), "{e}");
+    // An accessor index past the accessors (gltf-json's validation panicked on it).
+    let e = fail(
+        "accessor.gltf",
+        gltf_json("", "", false).replace("\"POSITION\": 0}, \"indices\": 1", "\"POSITION\": 7}, \"indices\": 1"),
+    );
+    assert!(e.contains("names accessor 7, but the file has 3"), "{e}");
     let e = fail("range.gltf", gltf_json("", "", true));
     assert!(e.contains("index 9 is out of range"), "{e}");
     let e = fail(
