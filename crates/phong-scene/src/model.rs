@@ -466,16 +466,18 @@ fn detect_front(parts: &[ObjPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(
         for p in parts {
             for t in 0..p.mesh.triangles().len() {
                 let [a, b, c] = p.mesh.corners(t);
-                let n = (b - a).cross(c - a).as_dvec3() * 0.5;
+                // In f64: a model's coordinates may be near f32's largest.
+                let [a, b, c] = [a, b, c].map(Vec3::as_dvec3);
+                let n = (b - a).cross(c - a) * 0.5;
                 area += n;
                 total += n.length();
             }
         }
-        let area = area.as_vec3();
+        let along = |d: Vec3| d.as_dvec3().dot(area);
         let best = [f, -f, r, -r]
             .into_iter()
-            .max_by(|a, b| a.dot(area).total_cmp(&b.dot(area)))?;
-        if f64::from(best.dot(area)) >= 0.1 * total {
+            .max_by(|a, b| along(*a).total_cmp(&along(*b)))?;
+        if along(best) >= 0.1 * total {
             return (best != f).then_some((best, "the open model's surface faces that way"));
         }
     }
@@ -509,19 +511,21 @@ fn detect_up(parts: &[ObjPart]) -> Axis {
     else {
         return Axis::Y;
     };
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let ext = hi - lo;
     let (mut total, mut base_z, mut base_y) = (0.0f64, 0.0f64, 0.0f64);
     for p in parts {
         for t in 0..p.mesh.triangles().len() {
             let [a, b, c] = p.mesh.corners(t);
+            let [a, b, c] = [a, b, c].map(Vec3::as_dvec3);
             let n = (b - a).cross(c - a);
-            let area2 = f64::from(n.length());
+            let area2 = n.length();
             if area2.is_nan() || area2 <= 0.0 {
                 continue;
             }
             total += area2;
             let centroid = (a + b + c) / 3.0;
-            let unit = n / n.length();
+            let unit = n / area2;
             if unit.z < -0.95 && centroid.z - lo.z <= 0.02 * ext.z {
                 base_z += area2;
             }

@@ -259,20 +259,26 @@ fn a_model_alone_is_framed_whatever_its_size_and_offset() {
         );
     }
     // Open: one triangle is drawn two-sided, seen from the side its face looks to.
-    let tri = write(&d, "tri.obj", b"v 0 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
-    let loaded = load_with(&tri, &ModelOptions::default()).unwrap();
-    assert!(
-        loaded.notes.iter().any(|n| n.contains("two-sided")),
-        "{:?}",
-        loaded.notes
-    );
-    let normal = Vec3::X; // (0,1,0) × (0,0,1)
-    let c = loaded.scene.camera;
-    assert!(
-        (c.eye() - c.target()).normalize().dot(normal) > 0.5,
-        "{:?}",
-        loaded.notes
-    );
+    // (At 1e30 too: the analysis is in f64, where f32 cross products would overflow.)
+    for (name, text) in [
+        ("tri.obj", "v 0 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n"),
+        ("hugetri.obj", "v 0 0 0\nv 0 1e30 0\nv 0 0 1e30\nf 1 2 3\n"),
+    ] {
+        let tri = write(&d, name, text.as_bytes());
+        let loaded = load_with(&tri, &ModelOptions::default()).unwrap();
+        assert!(
+            loaded.notes.iter().any(|n| n.contains("two-sided")),
+            "{:?}",
+            loaded.notes
+        );
+        let normal = Vec3::X; // (0,1,0) × (0,0,1)
+        let c = loaded.scene.camera;
+        assert!(
+            (c.eye() - c.target()).normalize().dot(normal) > 0.5,
+            "{name}: {:?}",
+            loaded.notes
+        );
+    }
     // Named views: `top` looks down the up axis; `--camera` in the file's coordinates.
     let far = d.join("far.obj");
     let top = load_with(

@@ -162,9 +162,8 @@ pub(super) fn object(
             };
             // The file's coordinates (the re-centred model moved back to where the file puts
             // it), or with `fit` the model centred at the origin with a bounding sphere of
-            // radius 1, before the object's own transform.
-            // With `fit`, the model is fitted before its normals are computed (a model at 1e30
-            // would overflow f32 in their cross products).
+            // radius 1, before the object's own transform. A fitted model is fitted before its
+            // normals are computed (at 1e30, f32 cross products overflow).
             let (fitted_from_parts, world_from_file) = match crate::model::fit_of(&parts) {
                 Some((centre, radius)) if fit => (
                     Some(Mat4::from_scale(Vec3::splat(radius.recip())) * Mat4::from_translation(-centre)),
@@ -180,7 +179,16 @@ pub(super) fn object(
             let mut out = Vec::new();
             for mut p in parts {
                 if let Some(m) = &fitted_from_parts {
-                    p.mesh = p.mesh.transformed(m);
+                    // A uniform scale and a move: the file's normals keep their directions (the
+                    // inverse transpose of a 1e-30 scale would not survive f32).
+                    let positions = p.mesh.positions().iter().map(|x| m.transform_point3(*x)).collect();
+                    p.mesh =
+                        Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec()).map_err(|e| {
+                            Error::Model {
+                                path: ctx.path.to_path_buf(),
+                                message: format!("{}: {e}", p.name),
+                            }
+                        })?;
                 }
                 // File normals where every vertex has a usable one; else, or where `"file"`
                 // is asked of a model without them, normals by angle, with a warning.
