@@ -143,7 +143,7 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
 /// The centre and bounding-sphere radius of a model's parts (half its bounding box's
 /// diagonal; 1 for a model of one point), in the parts' coordinates: what `fit = true` maps to
 /// the origin and to 1.
-pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(Vec3, f32)> {
+pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(DVec3, f64)> {
     let (lo, hi) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
@@ -155,7 +155,7 @@ pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(Vec3, f32)> {
     } else {
         1.0
     };
-    Some((((lo + hi) * 0.5).as_vec3(), radius as f32))
+    Some(((lo + hi) * 0.5, radius))
 }
 
 /// The lights of a model alone, `(direction, grey level)` in the default view's camera frame
@@ -214,9 +214,11 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
     let parts = &model.parts[..];
     let gltf = model.format == ModelFormat::Gltf;
     let mut notes = Vec::new();
-    let (centre, radius) = fit_of(parts).unwrap_or((Vec3::ZERO, 1.0));
+    let (centre, radius) = fit_of(parts).unwrap_or((DVec3::ZERO, 1.0));
     // Vertices in the fitted frame (centred, radius 1).
-    let fitted = |p: Vec3| (p - centre) / radius;
+    // In f64: a model's coordinates may be near f32's largest, its radius's inverse below f32's
+    // smallest normal number.
+    let fitted = |p: Vec3| ((p.as_dvec3() - centre) / radius).as_vec3();
     let origin = parts.first().map_or(DVec3::ZERO, |p| p.origin);
     if origin != DVec3::ZERO {
         notes.push(format!(
@@ -308,8 +310,8 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         (None, Some(c)) => {
             // Looking at the model's centre's depth along the camera's axis.
             let eye = c.position;
-            let centre_file = centre.as_dvec3() + origin;
-            let depth = (centre_file - eye).dot(c.forward).max(f64::from(radius) * 1e-3);
+            let centre_file = centre + origin;
+            let depth = (centre_file - eye).dot(c.forward).max(radius * 1e-3);
             fov = c.fov_deg.filter(|f| *f > 0.0 && *f < 180.0).unwrap_or(FOV);
             notes.push(format!(
                 "the file's camera{} (--view or --camera to choose another)",

@@ -164,11 +164,8 @@ pub(super) fn object(
             // it), or with `fit` the model centred at the origin with a bounding sphere of
             // radius 1, before the object's own transform. A fitted model is fitted before its
             // normals are computed (at 1e30, f32 cross products overflow).
-            let (fitted_from_parts, world_from_file) = match crate::model::fit_of(&parts) {
-                Some((centre, radius)) if fit => (
-                    Some(Mat4::from_scale(Vec3::splat(radius.recip())) * Mat4::from_translation(-centre)),
-                    world_from_object,
-                ),
+            let (fit_frame, world_from_file) = match crate::model::fit_of(&parts) {
+                Some(frame) if fit => (Some(frame), world_from_object),
                 _ => match parts.first() {
                     Some(p) if p.origin != glam::DVec3::ZERO => {
                         (None, world_from_object * Mat4::from_translation(p.origin.as_vec3()))
@@ -178,10 +175,16 @@ pub(super) fn object(
             };
             let mut out = Vec::new();
             for mut p in parts {
-                if let Some(m) = &fitted_from_parts {
-                    // A uniform scale and a move: the file's normals keep their directions (the
-                    // inverse transpose of a 1e-30 scale would not survive f32).
-                    let positions = p.mesh.positions().iter().map(|x| m.transform_point3(*x)).collect();
+                if let Some((centre, radius)) = fit_frame {
+                    // In f64 (coordinates near f32's largest, a radius whose inverse is below its
+                    // smallest normal number). A uniform scale and a move: the file's normals keep
+                    // their directions.
+                    let positions = p
+                        .mesh
+                        .positions()
+                        .iter()
+                        .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
+                        .collect();
                     p.mesh =
                         Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec()).map_err(|e| {
                             Error::Model {
