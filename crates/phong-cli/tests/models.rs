@@ -139,6 +139,17 @@ fn far_huge_and_tiny_models_are_framed_alike() {
             "{name}: {differ} pixels differ from the unit model's image"
         );
     }
+    // Coordinates near f32's largest (3.4e38): framed too.
+    std::fs::write(
+        d.join("max.obj"),
+        "v 3e38 3e38 3e38\nv -3e38 3e38 3e38\nv 3e38 -3e38 -3e38\nf 1 2 3\n",
+    )
+    .unwrap();
+    let o = phong(d, &["render", "max.obj", "-o", "max.png", "--antialias", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let px = read_png(&d.join("max.png")).3;
+    let drawn = px.chunks(3).filter(|p| *p != &px[..3]).count();
+    assert!(drawn > 800 * 600 / 10, "{drawn} pixels drawn");
 }
 
 /// The Cornell box (open at its front, single-sided walls): every triangle is drawn
