@@ -246,9 +246,12 @@ pub fn read_gltf(
             if let Some(a) = prim.indices() {
                 check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Scalar], false)
                     .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
-                if a.data_type() == ::gltf::accessor::DataType::F32 || a.normalized() {
+                // Unsigned integers only, as the specification says (the crate's reader treats any
+                // other component type as unreachable: found by the `gltf` fuzz target).
+                use ::gltf::accessor::DataType;
+                if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) || a.normalized() {
                     return Err(fail(format!(
-                        "{what}: indices (accessor {}) are not integers",
+                        "{what}: indices (accessor {}) are not unsigned integers",
                         a.index()
                     )));
                 }

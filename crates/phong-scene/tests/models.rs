@@ -502,6 +502,15 @@ fn gltf_geometry_materials_and_errors() {
         gltf_json("", "", false).replace("\"POSITION\": 0}, \"indices\": 1", "\"POSITION\": 7}, \"indices\": 1"),
     );
     assert!(e.contains("names accessor 7, but the file has 3"), "{e}");
+    // Signed indices (the gltf crate's reader took them for unreachable and panicked).
+    let e = fail(
+        "signed.gltf",
+        gltf_json("", "", false).replace(
+            r#"{"bufferView": 1, "componentType": 5123"#,
+            r#"{"bufferView": 1, "componentType": 5122"#,
+        ),
+    );
+    assert!(e.contains("not unsigned integers"), "{e}");
     let e = fail("range.gltf", gltf_json("", "", true));
     assert!(e.contains("index 9 is out of range"), "{e}");
     let e = fail(
