@@ -192,7 +192,7 @@ const FILL: f32 = 0.92;
 ///   the model is closed (each edge shared by two faces, wound opposite ways) and wound
 ///   outward (positive volume), else two-sided;
 /// - the camera: `options.camera`, else the named view (default: front, a little right and
-///   above), at the distance where every vertex is inside [`FILL`] of the frame, its near and
+///   above), at the distance where every vertex is inside 92% of the frame, its near and
 ///   far planes from the vertices' depths; perspective, 45°.
 pub fn model_scene(name: &str, parts: &[ObjPart], options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
     let model = LoadedModel {
