@@ -116,73 +116,8 @@ pub fn read_gltf(
     }
     let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
     let doc = &file.document;
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
-    for b in doc.buffers() {
-        let data = match b.source() {
-            ::gltf::buffer::Source::Bin => file.blob.clone().ok_or_else(|| {
-                fail(format!(
-                    "buffer {} is the GLB's binary chunk, which is missing",
-                    b.index()
-                ))
-            })?,
-            ::gltf::buffer::Source::Uri(uri) => {
-                if let Some(rest) = uri.strip_prefix("data:") {
-                    let (_, data) = rest
-                        .split_once(";base64,")
-                        .ok_or_else(|| fail(format!("buffer {}: a data URI that is not base64", b.index())))?;
-                    base64::engine::general_purpose::STANDARD
-                        .decode(data)
-                        .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?
-                } else {
-                    resource(&percent_decode(uri)).map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?
-                }
-            }
-        };
-        if data.len() < b.length() {
-            return Err(fail(format!(
-                "buffer {} has {} bytes; the file says {}",
-                b.index(),
-                data.len(),
-                b.length()
-            )));
-        }
-        buffers.push(data);
-    }
-    let scene = doc.default_scene().or_else(|| doc.scenes().next());
-    let roots: Vec<::gltf::Node> = match &scene {
-        Some(s) => s.nodes().collect(),
-        None => {
-            // No scene: every node that is no node's child (as other viewers do).
-            let children: BTreeSet<usize> = doc.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
-            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
-        }
-    };
-    // The nodes with their world transforms, depth first; a node met again on its own path is
-    // a cycle.
-    let mut instances: Vec<(::gltf::Node, DMat4)> = Vec::new();
-    let mut stack: Vec<(::gltf::Node, DMat4, Vec<usize>)> = roots
-        .into_iter()
-        .rev()
-        .map(|n| (n, DMat4::IDENTITY, Vec::new()))
-        .collect();
-    while let Some((node, parent, mut path_)) = stack.pop() {
-        if path_.contains(&node.index()) {
-            return Err(fail(format!(
-                "node {} is its own ancestor (a cycle in the node tree)",
-                node.index()
-            )));
-        }
-        if instances.len() > 1_000_000 {
-            return Err(fail("more than a million node instances".into()));
-        }
-        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-        let world = parent * local;
-        path_.push(node.index());
-        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((c, world, path_.clone()));
-        }
-        instances.push((node, world));
-    }
+    let buffers = load_buffers(&file, resource, &fail)?;
+    let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut textures, mut colours, mut transparent) = (0usize, BTreeSet::new(), 0usize, 0usize);
     // Positions in f64 world space for all parts, re-centred together below.
@@ -419,6 +354,84 @@ pub fn read_gltf(
         });
     }
     Ok(model)
+}
+
+/// The file's buffers: the GLB's binary chunk, base64 data URIs, and files read by `resource`;
+/// each at least as long as the file says.
+fn load_buffers(
+    file: &::gltf::Gltf,
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Vec<Vec<u8>>, Error> {
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in file.document.buffers() {
+        let data = match b.source() {
+            ::gltf::buffer::Source::Bin => file.blob.clone().ok_or_else(|| {
+                fail(format!(
+                    "buffer {} is the GLB's binary chunk, which is missing",
+                    b.index()
+                ))
+            })?,
+            ::gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, data) = rest
+                        .split_once(";base64,")
+                        .ok_or_else(|| fail(format!("buffer {}: a data URI that is not base64", b.index())))?;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(data)
+                        .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?
+                } else {
+                    resource(&percent_decode(uri)).map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?
+                }
+            }
+        };
+        if data.len() < b.length() {
+            return Err(fail(format!(
+                "buffer {} has {} bytes; the file says {}",
+                b.index(),
+                data.len(),
+                b.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// The nodes of the default scene (else of the first, else every node that is no node's
+/// child, as other viewers do) with their world transforms (composed in f64), depth first. A
+/// node reached twice (a cycle, or a node with two parents, which the format forbids) is an
+/// error; each node is visited once, so the work is linear in the nodes.
+fn node_instances<'a>(
+    doc: &'a ::gltf::Document,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Vec<(::gltf::Node<'a>, DMat4)>, Error> {
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<::gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let children: BTreeSet<usize> = doc.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut instances = Vec::new();
+    let mut stack: Vec<(::gltf::Node, DMat4)> = roots.into_iter().rev().map(|n| (n, DMat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(fail(format!(
+                "node {} is reached twice (a cycle in the node tree, or a node with two parents)",
+                node.index()
+            )));
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((c, world));
+        }
+        instances.push((node, world));
+    }
+    Ok(instances)
 }
 
 /// A primitive read, in f64 world space, waiting for the model's common origin.

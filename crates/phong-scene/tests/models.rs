@@ -496,6 +496,21 @@ fn gltf_geometry_materials_and_errors() {
             .replace("\"nodes\": [0, 2]", "\"nodes\": [0, 2, 3]"),
     );
     assert!(e.contains("cycle"), "{e}");
+    // A chain of 20 000 nodes, each the child of the one before, the last with the mesh:
+    // read (each node visited once; a path kept per node would make it quadratic).
+    let chain: String = (3..20_003)
+        .map(|i| format!(r#", {{"children": [{}]}}"#, i + 1))
+        .chain([r#", {"mesh": 0}"#.to_string()])
+        .collect();
+    let deep = write(
+        &d,
+        "deep.gltf",
+        gltf_json(&chain, "", false)
+            .replace("\"nodes\": [0, 2]", "\"nodes\": [3]")
+            .as_bytes(),
+    );
+    let parts = load_model(&deep, &mut Vec::new()).unwrap();
+    assert_eq!(parts.len(), 2);
     // An accessor index past the accessors (gltf-json's validation panicked on it).
     let e = fail(
         "accessor.gltf",

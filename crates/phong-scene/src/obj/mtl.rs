@@ -1,0 +1,189 @@
+//! MTL libraries: the names an `mtllib` statement gives, their text checked line by line (so
+//! that errors have a line and column) and made readable by tobj, and their materials as
+//! phong's.
+
+use super::text::{Checker, lines};
+use crate::Error;
+use phong_core::{Color, Material};
+use std::path::{Path, PathBuf};
+
+/// The material libraries an `mtllib` statement names: first the whole text as one name
+/// (tried first by the caller: a name with spaces in it), then each name, names separated by
+/// whitespace except where it is quoted (`"my file.mtl"`) or escaped (`my\ file.mtl`); other
+/// backslashes are path separators (`textures\\a.mtl`).
+pub(super) fn mtl_names(text: &str) -> Vec<PathBuf> {
+    let mut names = Vec::new();
+    let mut whole = String::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = text.trim().chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => quoted = !quoted,
+            '\\' if chars.peek().is_some_and(|n| n.is_whitespace()) => {
+                let n = chars.next().unwrap_or(' ');
+                cur.push(n);
+                whole.push(n);
+            }
+            '\\' => {
+                cur.push('/');
+                whole.push('/');
+            }
+            c if c.is_whitespace() && !quoted => {
+                if !cur.is_empty() {
+                    names.push(PathBuf::from(std::mem::take(&mut cur)));
+                }
+                whole.push(c);
+            }
+            c => {
+                cur.push(c);
+                whole.push(c);
+            }
+        }
+    }
+    if !cur.is_empty() {
+        names.push(PathBuf::from(cur));
+    }
+    let whole = PathBuf::from(whole.trim());
+    if names.len() == 1 {
+        return names;
+    }
+    names.insert(0, whole);
+    names
+}
+
+/// The MTL text as tobj can read it: a colour given as one number (`Kd 0.5`, which the format
+/// allows for grey) written as three, since tobj's reader panics on fewer than three.
+pub(super) fn normalize_mtl(src: &str) -> String {
+    let mut out = String::with_capacity(src.len() + 64);
+    for line in src.split_inclusive('\n') {
+        let content = line.split('#').next().unwrap_or("");
+        let words: Vec<&str> = content.split_whitespace().collect();
+        match words.as_slice() {
+            [kw @ ("Ka" | "Kd" | "Ks" | "Ke"), v] => {
+                out.push_str(&format!("{kw} {v} {v} {v}\n"));
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
+}
+
+/// Checks an MTL file's values; returns the warnings (unsupported `illum`).
+pub(super) fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), Error> {
+    let c = Checker { path, src };
+    let mut maps: Vec<&str> = Vec::new();
+    let mut transparent = 0usize;
+    for (start, line) in lines(src) {
+        let content = line.split('#').next().unwrap_or("");
+        let mut it = content.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let rest: Vec<&str> = it.collect();
+        if (kw.starts_with("map_") || matches!(kw, "bump" | "norm" | "disp" | "decal" | "refl")) && !maps.contains(&kw)
+        {
+            maps.push(kw);
+        }
+        let opacity = match (kw, rest.first().and_then(|x| x.parse::<f32>().ok())) {
+            ("d", Some(d)) => Some(d),
+            ("Tr", Some(t)) => Some(1.0 - t),
+            _ => None,
+        };
+        if opacity.is_some_and(|o| o < 1.0) {
+            transparent += 1;
+        }
+        let num = |i: usize| -> Result<f32, Error> {
+            let f = rest
+                .get(i)
+                .ok_or_else(|| c.err(start, line, 0, kw, "is missing a number".into()))?;
+            f.parse::<f32>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| c.err(start, line, i + 1, kw, format!("{f:?} is not a finite number")))
+        };
+        match kw {
+            "Ka" | "Kd" | "Ks" | "Ke" => {
+                if rest.first() == Some(&"spectral") || rest.first() == Some(&"xyz") {
+                    return Err(c.err(start, line, 1, kw, "only RGB colours are supported".into()));
+                }
+                for i in 0..3 {
+                    // "Kd r" alone means r = g = b.
+                    if i > 0 && rest.len() == 1 {
+                        break;
+                    }
+                    let x = num(i)?;
+                    if x < 0.0 {
+                        return Err(c.err(start, line, i + 1, kw, format!("must be >= 0, got {x}")));
+                    }
+                }
+            }
+            "Ns" => {
+                let x = num(0)?;
+                if x < 0.0 {
+                    return Err(c.err(start, line, 1, kw, format!("shininess must be >= 0, got {x}")));
+                }
+            }
+            "d" => {
+                let x = num(0)?;
+                if !(0.0..=1.0).contains(&x) {
+                    return Err(c.err(start, line, 1, kw, format!("must be in [0, 1], got {x}")));
+                }
+            }
+            "illum" => {
+                let x = num(0)?;
+                if x != x.trunc() || x < 0.0 {
+                    return Err(c.err(start, line, 1, kw, format!("must be an integer >= 0, got {x}")));
+                }
+                if x > 2.0 {
+                    let (l, _) = crate::error::line_col(src, start);
+                    warnings.push(format!(
+                        "{}:{l}: illum {x} is not supported; rendered as illum 2 (Blinn-Phong)",
+                        path.display()
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+    if !maps.is_empty() {
+        warnings.push(format!(
+            "{}: texture maps are not rendered yet ({}): the materials' colours alone are used",
+            path.display(),
+            maps.join(", ")
+        ));
+    }
+    if transparent > 0 {
+        warnings.push(format!(
+            "{}: {transparent} materials are transparent (`d` or `Tr`): drawn opaque (transparency is not rendered)",
+            path.display()
+        ));
+    }
+    Ok(())
+}
+
+pub(super) fn to_material(m: &tobj::Material) -> Material {
+    let def = Material::default();
+    let c = |v: Option<[f32; 3]>, d: Color| v.map(Color::from_array).unwrap_or(d);
+    let kd = c(m.diffuse, def.diffuse());
+    let (ka, ks, ke) = (
+        c(m.ambient, def.ambient()),
+        c(m.specular, def.specular()),
+        c(m.emissive, Color::BLACK),
+    );
+    let ns = m.shininess.unwrap_or(0.0);
+    let built = match m.illumination_model.unwrap_or(2) {
+        0 => Material::new(Color::BLACK, Color::BLACK, Color::BLACK, kd, 0.0),
+        1 => Material::new(ka, kd, Color::BLACK, ke, ns),
+        _ => Material::new(ka, kd, ks, ke, ns),
+    };
+    // Values were checked line by line before tobj parsed them.
+    let built = built.unwrap_or_default();
+    // `d` is the opacity; `Tr`, where there is no `d`, its complement (tinyobjloader's reading).
+    let tr = m
+        .unknown_param
+        .get("Tr")
+        .and_then(|t| t.trim().parse::<f32>().ok())
+        .map(|t| 1.0 - t);
+    built
+        .with_alpha(m.dissolve.or(tr).unwrap_or(1.0).clamp(0.0, 1.0))
+        .unwrap_or(built)
+}
