@@ -158,15 +158,44 @@ pub fn parse_mesh_bytes_with(
     bytes: &[u8],
     resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
 ) -> Result<Vec<ObjPart>, Error> {
-    match model_format(path, bytes)? {
-        ModelFormat::Ply => read_ply(path, bytes),
-        ModelFormat::Stl => read_stl(path, bytes),
-        ModelFormat::Gltf => crate::gltf_model::read_gltf(path, bytes, resource, &mut Vec::new()).map(|m| m.parts),
-        ModelFormat::Obj => Err(model_error(
-            path,
-            "an OBJ is read with its MTL libraries, not here".into(),
-        )),
-    }
+    parse_model_bytes_with(path, bytes, resource).map(|m| m.parts)
+}
+
+/// [`parse_mesh_bytes_with`] with what a glTF file also holds (its camera, lights and
+/// `doubleSided`), as [`load_model_full`] gives for a file.
+pub fn parse_model_bytes_with(
+    path: &Path,
+    bytes: &[u8],
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+) -> Result<LoadedModel, Error> {
+    let format = model_format(path, bytes)?;
+    let parts = match format {
+        ModelFormat::Ply => read_ply(path, bytes)?,
+        ModelFormat::Stl => read_stl(path, bytes)?,
+        ModelFormat::Gltf => {
+            let m = crate::gltf_model::read_gltf(path, bytes, resource, &mut Vec::new())?;
+            return Ok(LoadedModel {
+                parts: m.parts,
+                camera: m.camera,
+                lights: m.lights,
+                double_sided: Some(m.double_sided),
+                format,
+            });
+        }
+        ModelFormat::Obj => {
+            return Err(model_error(
+                path,
+                "an OBJ is read with its MTL libraries, not here".into(),
+            ));
+        }
+    };
+    Ok(LoadedModel {
+        parts,
+        camera: None,
+        lights: Vec::new(),
+        double_sided: None,
+        format,
+    })
 }
 
 /// [`load_model_sources`] without the list of files read.

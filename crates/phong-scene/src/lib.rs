@@ -22,7 +22,7 @@ mod toml_scene;
 pub use error::Error;
 pub use formats::{
     LoadedModel, ModelFormat, load_model, load_model_full, load_model_sources, model_format, parse_mesh_bytes,
-    parse_mesh_bytes_with,
+    parse_mesh_bytes_with, parse_model_bytes_with,
 };
 pub use gltf_model::{FileCamera, FileLight, MAX_GLTF_SHININESS};
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};

@@ -713,8 +713,8 @@ async fn upload(
     if is_obj && let Some(Err(files)) = files {
         let n = name.clone();
         let parsed = tokio::task::spawn_blocking(move || {
-            let parts = crate::models::parse_upload(&n, &files);
-            (parts, files)
+            let model = crate::models::parse_upload_model(&n, &files);
+            (model, files)
         })
         .await
         .map_err(|_| ApiError::new(StatusCode::INTERNAL_SERVER_ERROR, "parsing the upload failed"))?;
@@ -724,12 +724,13 @@ async fn upload(
             .map_err(|_| ApiError::new(StatusCode::SERVICE_UNAVAILABLE, "the upload store failed"))?;
         let u = clients.entry(client.clone()).or_default();
         match parsed {
-            (Ok(parts), files) => {
+            (Ok(model), files) => {
+                info["scene"] = crate::models::model_scene(&name, &model);
+                let parts = std::sync::Arc::new(model.parts);
                 u.remember(&name, &files, &parts);
                 let tris: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
                 info["triangles"] = json!(tris);
                 info["parts"] = json!(parts.len());
-                info["scene"] = crate::models::model_scene(&name, &parts);
             }
             (Err(e), _) => {
                 u.remove(&name);

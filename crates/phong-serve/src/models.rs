@@ -4,7 +4,7 @@
 
 use crate::api::AppState;
 use phong_core::limits::{SERVE_IDLE_SECONDS, SERVE_MAX_UPLOAD_TOTAL, SERVE_MAX_UPLOADS};
-use phong_scene::ObjPart;
+use phong_scene::{LoadedModel, ModelFormat, ObjPart};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -118,9 +118,15 @@ impl Uploads {
 /// A client's uploaded files at one moment (shared, not copied).
 pub struct Files(HashMap<String, Arc<Vec<u8>>>);
 
-/// Parses uploaded OBJ `name` with its MTL libraries from `files`; `Err` is the message for
-/// the scene's `mesh` key (or the upload).
+/// Parses uploaded model `name` (an OBJ with its MTL libraries, a glTF with its buffers, a
+/// PLY, an STL) from `files`; `Err` is the message for the scene's `mesh` key (or the upload).
 pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, String> {
+    parse_upload_model(name, files).map(|m| Arc::new(m.parts))
+}
+
+/// [`parse_upload`] with what a glTF also holds (camera, lights, `doubleSided`), for the
+/// scene of the model alone.
+pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, String> {
     let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
     let lower = name.to_ascii_lowercase();
     if [".ply", ".stl", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
@@ -133,9 +139,7 @@ pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, Stri
                 .map(|f| f.to_vec())
                 .ok_or_else(|| format!("{key} is not uploaded (upload it with the glTF)"))
         };
-        return phong_scene::parse_mesh_bytes_with(Path::new(name), data, &buffer)
-            .map(Arc::new)
-            .map_err(|e| e.to_string());
+        return phong_scene::parse_model_bytes_with(Path::new(name), data, &buffer).map_err(|e| e.to_string());
     }
     let src = std::str::from_utf8(data).map_err(|_| format!("uploaded {name} is not UTF-8 text"))?;
     let read = |mtl: &Path| -> std::io::Result<String> {
@@ -147,9 +151,14 @@ pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, Stri
         String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
     };
     let mut warnings = Vec::new();
-    phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings)
-        .map(Arc::new)
-        .map_err(|e| e.to_string())
+    let parts = phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings).map_err(|e| e.to_string())?;
+    Ok(LoadedModel {
+        parts,
+        camera: None,
+        lights: Vec::new(),
+        double_sided: None,
+        format: ModelFormat::Obj,
+    })
 }
 
 /// Drops the uploads of clients idle for [`SERVE_IDLE_SECONDS`], every minute.
@@ -165,6 +174,6 @@ pub async fn sweep_idle(state: Arc<AppState>) {
 }
 
 /// The page's scene for a model alone: `phong render MODEL`'s with the default view.
-pub fn model_scene(name: &str, parts: &[ObjPart]) -> serde_json::Value {
-    phong_scene::model_scene(name, parts, &phong_scene::ModelOptions::default()).0
+pub fn model_scene(name: &str, model: &LoadedModel) -> serde_json::Value {
+    phong_scene::model_scene_with(name, model, &phong_scene::ModelOptions::default()).0
 }
