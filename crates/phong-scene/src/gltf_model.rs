@@ -520,6 +520,13 @@ fn check_accessor(
     };
     let size = a.size();
     let stride = view.stride().unwrap_or(size);
+    // A stride shorter than an element would make the reader split elements (the crate then
+    // panics: found by the `gltf` fuzz target).
+    if stride < size {
+        return Err(format!(
+            "its buffer view's byteStride {stride} is shorter than an element ({size} bytes)"
+        ));
+    }
     let end = (a.count() as u64 - 1)
         .checked_mul(stride as u64)
         .and_then(|x| x.checked_add((a.offset() + size) as u64))

@@ -526,6 +526,15 @@ fn gltf_geometry_materials_and_errors() {
         ),
     );
     assert!(e.contains("not unsigned integers"), "{e}");
+    // A byteStride shorter than a position (the gltf crate's reader panicked on it).
+    let e = fail(
+        "stride.gltf",
+        gltf_json("", "", false).replace(
+            r#"{"buffer": 0, "byteOffset": 0, "byteLength": 48}"#,
+            r#"{"buffer": 0, "byteOffset": 0, "byteLength": 48, "byteStride": 4}"#,
+        ),
+    );
+    assert!(e.contains("byteStride 4 is shorter than an element (12 bytes)"), "{e}");
     let e = fail("range.gltf", gltf_json("", "", true));
     assert!(e.contains("index 9 is out of range"), "{e}");
     let e = fail(
