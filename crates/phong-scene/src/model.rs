@@ -249,8 +249,9 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         Axis::X => Vec3::Z,
         Axis::NegX => Vec3::Z,
     };
-    let closed = closedness(parts);
-    let detected = if gltf { None } else { detect_front(parts, u, f, closed) };
+    // A glTF says its front and its faces: its edges are not examined.
+    let closed = (!gltf).then(|| closedness(parts));
+    let detected = closed.and_then(|c| detect_front(parts, u, f, c));
     let f = match detected {
         Some((front, why)) => {
             if options.camera.is_none() {
@@ -272,7 +273,7 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
             d
         }
         (None, None) => {
-            let c = closed;
+            let c = closed.unwrap_or(Closed::Unchecked);
             let two = !c.closed_outward();
             notes.push(match (two, c) {
                 (false, _) => {
