@@ -43,6 +43,20 @@ pub struct LoadedModel {
     pub format: ModelFormat,
 }
 
+impl LoadedModel {
+    /// A model whose file says nothing of a camera, lights or which faces are drawn (OBJ, PLY,
+    /// STL).
+    pub fn new(parts: Vec<ObjPart>, format: ModelFormat) -> LoadedModel {
+        LoadedModel {
+            parts,
+            camera: None,
+            lights: Vec::new(),
+            double_sided: None,
+            format,
+        }
+    }
+}
+
 /// The format of model `path` whose bytes are `bytes`; an error for glTF (not read yet) and
 /// for what is none of them.
 pub fn model_format(path: &Path, bytes: &[u8]) -> Result<ModelFormat, Error> {
@@ -106,46 +120,56 @@ pub fn load_model_full(
     let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
     sources.push(path.to_path_buf());
     let format = model_format(path, &bytes)?;
-    let parts = match format {
-        ModelFormat::Obj => {
-            let text = decode_text(path, bytes, warnings);
-            obj_from_text(path, &text, warnings, sources)?
-        }
-        ModelFormat::Ply => read_ply(path, &bytes)?,
-        ModelFormat::Stl => read_stl(path, &bytes)?,
+    if format == ModelFormat::Obj {
+        let text = decode_text(path, bytes, warnings);
+        return Ok(LoadedModel::new(obj_from_text(path, &text, warnings, sources)?, format));
+    }
+    // A glTF's external buffers, beside it (each added to `sources`).
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let read = std::cell::RefCell::new(Vec::new());
+    let resource = |uri: &str| -> Result<Vec<u8>, String> {
+        let p = dir.join(uri);
+        read.borrow_mut().push(p.clone());
+        read_bounded(&p, MAX_MODEL_BYTES, WHAT).map_err(|e| match e {
+            Error::Read { source, .. } => format!("cannot read {}: {source}", p.display()),
+            other => other.to_string(),
+        })
+    };
+    let model = read_bytes(path, &bytes, format, &resource, warnings);
+    sources.extend(read.into_inner());
+    model
+}
+
+/// A PLY, STL or glTF model of `format` from its bytes (`resource` reads a glTF's external
+/// buffers).
+fn read_bytes(
+    path: &Path,
+    bytes: &[u8],
+    format: ModelFormat,
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+    warnings: &mut Vec<String>,
+) -> Result<LoadedModel, Error> {
+    match format {
+        ModelFormat::Ply => Ok(LoadedModel::new(read_ply(path, bytes)?, format)),
+        ModelFormat::Stl => Ok(LoadedModel::new(read_stl(path, bytes)?, format)),
         ModelFormat::Gltf => {
-            let dir = path.parent().unwrap_or(Path::new(""));
-            let read = std::cell::RefCell::new(Vec::new());
-            let resource = |uri: &str| -> Result<Vec<u8>, String> {
-                let p = dir.join(uri);
-                read.borrow_mut().push(p.clone());
-                read_bounded(&p, MAX_MODEL_BYTES, WHAT).map_err(|e| match e {
-                    Error::Read { source, .. } => format!("cannot read {}: {source}", p.display()),
-                    other => other.to_string(),
-                })
-            };
-            let m = crate::gltf_model::read_gltf(path, &bytes, &resource, warnings);
-            sources.extend(read.into_inner());
-            let m = m?;
-            return Ok(LoadedModel {
+            let m = crate::gltf_model::read_gltf(path, bytes, resource, warnings)?;
+            Ok(LoadedModel {
                 parts: m.parts,
                 camera: m.camera,
                 lights: m.lights,
                 double_sided: Some(m.double_sided),
                 format,
-            });
+            })
         }
-    };
-    Ok(LoadedModel {
-        parts,
-        camera: None,
-        lights: Vec::new(),
-        double_sided: None,
-        format,
-    })
+        ModelFormat::Obj => Err(model_error(
+            path,
+            "an OBJ is read with its MTL libraries, not here".into(),
+        )),
+    }
 }
 
-/// A PLY or STL model from its bytes (`path` names it and tells the format as
+/// A PLY, STL or glTF model from its bytes (`path` names it and tells the format as
 /// [`model_format`] does); an OBJ is refused here (its MTL libraries are files: use
 /// [`load_model_sources`] or [`load_obj_text`](crate::load_obj_text)).
 pub fn parse_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
@@ -168,34 +192,7 @@ pub fn parse_model_bytes_with(
     bytes: &[u8],
     resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
 ) -> Result<LoadedModel, Error> {
-    let format = model_format(path, bytes)?;
-    let parts = match format {
-        ModelFormat::Ply => read_ply(path, bytes)?,
-        ModelFormat::Stl => read_stl(path, bytes)?,
-        ModelFormat::Gltf => {
-            let m = crate::gltf_model::read_gltf(path, bytes, resource, &mut Vec::new())?;
-            return Ok(LoadedModel {
-                parts: m.parts,
-                camera: m.camera,
-                lights: m.lights,
-                double_sided: Some(m.double_sided),
-                format,
-            });
-        }
-        ModelFormat::Obj => {
-            return Err(model_error(
-                path,
-                "an OBJ is read with its MTL libraries, not here".into(),
-            ));
-        }
-    };
-    Ok(LoadedModel {
-        parts,
-        camera: None,
-        lights: Vec::new(),
-        double_sided: None,
-        format,
-    })
+    read_bytes(path, bytes, model_format(path, bytes)?, resource, &mut Vec::new())
 }
 
 /// [`load_model_sources`] without the list of files read.

@@ -195,14 +195,7 @@ const FILL: f32 = 0.92;
 ///   above), at the distance where every vertex is inside 92% of the frame, its near and
 ///   far planes from the vertices' depths; perspective, 45°.
 pub fn model_scene(name: &str, parts: &[ObjPart], options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
-    let model = LoadedModel {
-        parts: parts.to_vec(),
-        camera: None,
-        lights: Vec::new(),
-        double_sided: None,
-        format: ModelFormat::Obj,
-    };
-    model_scene_with(name, &model, options)
+    model_scene_with(name, &LoadedModel::new(parts.to_vec(), ModelFormat::Obj), options)
 }
 
 /// [`model_scene`] of a model file read whole: a glTF is y up with its front +z (the
@@ -404,7 +397,8 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
 /// `x` with 6 decimals, so that the scene's text (and the explorer's "Download TOML") is
 /// short: `0.8`, not f32's `0.800000011920929` written as f64.
 fn short(x: f32) -> f64 {
-    (f64::from(x) * 1e6).round() / 1e6
+    // `+ 0.0` writes −0 as 0.
+    (f64::from(x) * 1e6).round() / 1e6 + 0.0
 }
 
 /// [`short`] of each coordinate.

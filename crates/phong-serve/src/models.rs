@@ -152,13 +152,7 @@ pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, Stri
     };
     let mut warnings = Vec::new();
     let parts = phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings).map_err(|e| e.to_string())?;
-    Ok(LoadedModel {
-        parts,
-        camera: None,
-        lights: Vec::new(),
-        double_sided: None,
-        format: ModelFormat::Obj,
-    })
+    Ok(LoadedModel::new(parts, ModelFormat::Obj))
 }
 
 /// Drops the uploads of clients idle for [`SERVE_IDLE_SECONDS`], every minute.
