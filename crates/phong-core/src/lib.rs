@@ -33,27 +33,31 @@ mod error;
 mod image;
 mod light;
 pub mod limits;
+mod maps;
 mod material;
 pub mod mesh;
 pub mod primitives;
 mod scene;
 mod shading;
 pub mod text;
+pub mod texture;
 
 pub use camera::{Camera, Projection, Viewer};
 pub use color::Color;
 pub use error::Error;
 pub use image::{Canvas, Encoding, Image, Image8};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
+pub use maps::{Channel, Maps, Texels, TextureMap, UvTransform};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;
 pub use scene::{
     ImageSettings, Interpolation, Label, Object, Output, Samples, Scene, ShadingSettings, depth_color, normal_color,
 };
 pub use shading::{
-    Lighting, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, lyon,
-    pow_positive, shade, specular_factor,
+    Lighting, Lit, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, light, lyon,
+    pow_positive, shade, shade_textured, specular_factor,
 };
+pub use texture::{Filter, MipFilter, Sampler, Texture, Wrap};
 
 /// The math types phong uses (re-exported from glam).
 pub use glam;

@@ -125,3 +125,10 @@ pub const MAX_IMAGE_FILE_BYTES: u64 = 512 << 20;
 /// Most triangles in one scene, all shapes and meshes together (16M: about 1.5 GiB of meshes
 /// and transformed vertices), checked as each object is read, before its mesh is built.
 pub const MAX_SCENE_TRIANGLES: u64 = 1 << 24;
+
+/// Longest side of a texture, in texels (OpenGL implementations allow 16384 or 32768).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// Most bytes of textures, mipmaps included, in one texture and in one scene: 8 bytes a texel
+/// (16-bit RGBA) with mipmaps is 2 GiB at about 11585² texels (an 8K texture takes 512 MiB).
+pub const MAX_TEXTURE_BYTES: u64 = 2 << 30;

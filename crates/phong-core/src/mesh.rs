@@ -3,17 +3,19 @@
 //! surface's formula).
 
 use crate::Error;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 
-/// An indexed triangle mesh with one normal per vertex. Triangles are
-/// counter-clockwise seen from the side their normals point to.
+/// An indexed triangle mesh with one normal per vertex and, optionally, texture coordinates
+/// per vertex. Triangles are counter-clockwise seen from the side their normals point to.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Mesh {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
+    /// Empty, or one per position.
+    uvs: Vec<Vec2>,
 }
 
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
@@ -51,7 +53,28 @@ impl Mesh {
             positions,
             normals,
             triangles,
+            uvs: Vec::new(),
         })
+    }
+
+    /// The mesh with texture coordinates, one per vertex, finite (`v = 0` is the image's
+    /// bottom, as OBJ's `vt` and OpenGL); an empty vector removes them.
+    pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
+        if !uvs.is_empty() && uvs.len() != self.positions.len() {
+            return Err(Error::OutOfRange {
+                what: "number of texture coordinates",
+                range: "0 or the number of positions",
+                value: uvs.len() as f32,
+            });
+        }
+        if let Some(uv) = uvs.iter().find(|uv| !uv.is_finite()) {
+            return Err(Error::InvalidPosition {
+                what: "texture coordinate",
+                value: [uv.x, uv.y, 0.0],
+            });
+        }
+        self.uvs = uvs;
+        Ok(self)
     }
 
     /// A mesh whose normals are then computed: area-weighted smooth normals over shared vertices.
@@ -72,14 +95,32 @@ impl Mesh {
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
     }
+    /// Texture coordinates per vertex; empty where the mesh has none.
+    pub fn uvs(&self) -> &[Vec2] {
+        &self.uvs
+    }
+    /// Whether the mesh has texture coordinates.
+    pub fn has_uvs(&self) -> bool {
+        !self.uvs.is_empty()
+    }
     /// The three corners of triangle `t`.
     pub fn corners(&self, t: usize) -> [Vec3; 3] {
         self.triangles[t].map(|i| self.positions[i as usize])
     }
 
-    /// Appends `other`'s vertices and triangles.
+    /// Appends `other`'s vertices and triangles. Where only one of the two has texture
+    /// coordinates, the other's vertices get `(0, 0)`.
     pub fn append(&mut self, other: &Mesh) {
         let base = self.positions.len() as u32;
+        if !self.uvs.is_empty() || !other.uvs.is_empty() {
+            self.uvs.resize(self.positions.len(), Vec2::ZERO);
+            if other.uvs.is_empty() {
+                self.uvs
+                    .resize(self.positions.len() + other.positions.len(), Vec2::ZERO);
+            } else {
+                self.uvs.extend_from_slice(&other.uvs);
+            }
+        }
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles
@@ -110,6 +151,7 @@ impl Mesh {
             } else {
                 self.triangles.clone()
             },
+            uvs: self.uvs.clone(),
         }
     }
 
@@ -118,24 +160,35 @@ impl Mesh {
         let mut positions = Vec::with_capacity(self.triangles.len() * 3);
         let mut normals = Vec::with_capacity(self.triangles.len() * 3);
         let mut triangles = Vec::with_capacity(self.triangles.len());
-        for (t, _) in self.triangles.iter().enumerate() {
+        let mut uvs = Vec::new();
+        for (t, corners) in self.triangles.iter().enumerate() {
             let [a, b, c] = self.corners(t);
             let n = facet_normal(a, b, c);
             let i = positions.len() as u32;
             positions.extend([a, b, c]);
             normals.extend([n; 3]);
             triangles.push([i, i + 1, i + 2]);
+            if !self.uvs.is_empty() {
+                uvs.extend(corners.map(|k| self.uvs[k as usize]));
+            }
         }
         Mesh {
             positions,
             normals,
             triangles,
+            uvs,
         }
     }
 
     /// Vertices at the same position merged (exact match), so that normals
-    /// can be averaged across faces that a file gave separate vertices.
+    /// can be averaged across faces that a file gave separate vertices. Texture coordinates
+    /// are dropped (the normals' functions keep them, see [`Mesh::with_smooth_normals`]).
     pub fn welded(&self) -> Mesh {
+        self.weld().0
+    }
+
+    /// [`Mesh::welded`] and, per vertex of `self`, its vertex in the welded mesh.
+    fn weld(&self) -> (Mesh, Vec<u32>) {
         let mut map: FxHashMap<[u32; 3], u32> = FxHashMap::default();
         let mut positions = Vec::new();
         let remap: Vec<u32> = self
@@ -151,19 +204,22 @@ impl Mesh {
             .collect();
         let triangles = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
         let normals = vec![Vec3::ZERO; positions.len()];
-        Mesh {
+        let mesh = Mesh {
             positions,
             normals,
             triangles,
-        }
+            uvs: Vec::new(),
+        };
+        (mesh, remap)
     }
 
     /// Smooth vertex normals (seed 001: "add the facet normals of all facets
     /// incident to a vertex, and normalize"), weighted by facet area: the sum
     /// of the unnormalised cross products `(p2 − p1) × (p3 − p1)`. Vertices
-    /// at the same position are merged first.
+    /// at the same position are merged first; a mesh with texture coordinates keeps its own
+    /// vertices (so seams keep their coordinates), each with its position's normal.
     pub fn with_smooth_normals(&self) -> Mesh {
-        let mut m = self.welded();
+        let (mut m, remap) = self.weld();
         let mut acc = vec![Vec3::ZERO; m.positions.len()];
         for t in &m.triangles {
             let [a, b, c] = t.map(|i| m.positions[i as usize]);
@@ -173,7 +229,15 @@ impl Mesh {
             }
         }
         m.normals = acc.into_iter().map(|n| n.normalize_or_zero()).collect();
-        m
+        if self.uvs.is_empty() {
+            return m;
+        }
+        Mesh {
+            positions: self.positions.clone(),
+            normals: remap.iter().map(|&r| m.normals[r as usize]).collect(),
+            triangles: self.triangles.clone(),
+            uvs: self.uvs.clone(),
+        }
     }
 
     /// Normals smoothed only across edges where the faces meet at less than
@@ -193,7 +257,7 @@ impl Mesh {
     /// [`Mesh::with_crease_normals`], and the work it did (facet comparisons), for the test
     /// that it is linear.
     fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
-        let w = self.welded();
+        let w = self.weld().0;
         let cos_crease = crease_deg.to_radians().cos();
         let facet: Vec<Vec3> = w
             .triangles
@@ -267,11 +331,16 @@ impl Mesh {
         let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
         let mut positions = Vec::new();
         let mut normals = Vec::new();
-        let mut dedup: FxHashMap<(u32, [u32; 3]), u32> = FxHashMap::default();
+        let mut uvs = Vec::new();
+        let mut dedup: FxHashMap<(u32, [u32; 3], [u32; 2]), u32> = FxHashMap::default();
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
             let own = unit[f];
+            let mut corner = 0;
             let tri = t.map(|v| {
+                // A corner keeps its own texture coordinates: vertices split where they differ.
+                let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
+                corner += 1;
                 let n = match &vertex_rule[v as usize] {
                     Rule::Plain => around(v as usize)
                         .iter()
@@ -290,10 +359,15 @@ impl Mesh {
                     }),
                     Rule::Edges(groups) => groups[&(f as u32)],
                 };
-                let key = (v, n.to_array().map(f32::to_bits));
+                let key = (
+                    v,
+                    n.to_array().map(f32::to_bits),
+                    uv.unwrap_or_default().to_array().map(f32::to_bits),
+                );
                 *dedup.entry(key).or_insert_with(|| {
                     positions.push(w.positions[v as usize]);
                     normals.push(n);
+                    uvs.extend(uv);
                     (positions.len() - 1) as u32
                 })
             });
@@ -303,6 +377,7 @@ impl Mesh {
             positions,
             normals,
             triangles,
+            uvs,
         };
         (mesh, work)
     }

@@ -15,19 +15,23 @@
 use crate::Mesh;
 use crate::mesh::facet_normal;
 use core::f32::consts::{PI, TAU};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Builds a `(rows+1) × (cols+1)` vertex grid from `f(u, v) -> (position, normal)`
-/// with `u, v` in [0, 1], and two triangles per quad, each wound counter-clockwise
-/// about its vertices' normals; triangles with zero area (at poles) are dropped.
-fn grid(rows: u32, cols: u32, f: impl Fn(f32, f32) -> (Vec3, Vec3), out: &mut Mesh) {
+/// with `u, v` in [0, 1], texture coordinates `uv(u, v)`, and two triangles per quad, each
+/// wound counter-clockwise about its vertices' normals; triangles with zero area (at poles)
+/// are dropped.
+fn grid(rows: u32, cols: u32, f: impl Fn(f32, f32) -> (Vec3, Vec3), uv: impl Fn(f32, f32) -> Vec2, out: &mut Mesh) {
     let mut positions = Vec::with_capacity(((rows + 1) * (cols + 1)) as usize);
     let mut normals = Vec::with_capacity(positions.capacity());
+    let mut uvs = Vec::with_capacity(positions.capacity());
     for i in 0..=rows {
         for j in 0..=cols {
-            let (p, n) = f(j as f32 / cols as f32, i as f32 / rows as f32);
+            let (u, v) = (j as f32 / cols as f32, i as f32 / rows as f32);
+            let (p, n) = f(u, v);
             positions.push(p);
             normals.push(n.normalize_or_zero());
+            uvs.push(uv(u, v));
         }
     }
     let idx = |i: u32, j: u32| i * (cols + 1) + j;
@@ -46,7 +50,9 @@ fn grid(rows: u32, cols: u32, f: impl Fn(f32, f32) -> (Vec3, Vec3), out: &mut Me
             }
         }
     }
-    let part = Mesh::new(positions, normals, triangles).expect("grid builds a valid mesh");
+    let part = Mesh::new(positions, normals, triangles)
+        .and_then(|m| m.with_uvs(uvs))
+        .expect("grid builds a valid mesh");
     out.append(&part);
 }
 
@@ -66,6 +72,7 @@ pub fn sphere(segments: u32) -> Mesh {
             let n = Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin());
             (n, n)
         },
+        |u, v| Vec2::new(u, 1.0 - v),
         &mut m,
     );
     m
@@ -86,6 +93,7 @@ pub fn torus(segments: u32, radius: f32, tube: f32) -> Mesh {
             let n = Vec3::new(a1.cos() * a2.cos(), a1.cos() * a2.sin(), a1.sin());
             (p, n)
         },
+        Vec2::new,
         &mut m,
     );
     m
@@ -100,6 +108,12 @@ fn disc(s: u32, y: f32, up: bool, m: &mut Mesh) {
         |u, v| {
             let ph = u * TAU;
             (Vec3::new(v * ph.cos(), y, v * ph.sin()), n)
+        },
+        // Seen from outside: x to the right, and −z (top) or +z (bottom) up.
+        |u, v| {
+            let ph = u * TAU;
+            let (x, z) = (v * ph.cos(), v * ph.sin());
+            Vec2::new(0.5 + 0.5 * x, if up { 0.5 - 0.5 * z } else { 0.5 + 0.5 * z })
         },
         m,
     );
@@ -117,6 +131,7 @@ pub fn cylinder(segments: u32) -> Mesh {
             let n = Vec3::new(ph.cos(), 0.0, ph.sin());
             (Vec3::new(n.x, 1.0 - 2.0 * v, n.z), n)
         },
+        |u, v| Vec2::new(u, 1.0 - v),
         &mut m,
     );
     disc(s, 1.0, true, &mut m);
@@ -138,6 +153,7 @@ pub fn cone(segments: u32) -> Mesh {
             let p = Vec3::new(r * ph.cos(), 1.0 - 2.0 * v, r * ph.sin());
             (p, Vec3::new(2.0 * ph.cos(), 1.0, 2.0 * ph.sin()))
         },
+        |u, v| Vec2::new(u, 1.0 - v),
         &mut m,
     );
     disc(s, -1.0, false, &mut m);
@@ -161,6 +177,8 @@ pub fn cube() -> Mesh {
                     p[b] = 2.0 * v - 1.0;
                     (p, n)
                 },
+                // Not mirrored seen from outside: u runs along −a on the negative faces.
+                |u, v| Vec2::new(if sign > 0.0 { u } else { 1.0 - u }, v),
                 &mut m,
             );
         }
@@ -176,6 +194,7 @@ pub fn plane(segments: u32) -> Mesh {
         s,
         s,
         |u, v| (Vec3::new(2.0 * u - 1.0, 0.0, 2.0 * v - 1.0), Vec3::Y),
+        |u, v| Vec2::new(u, 1.0 - v),
         &mut m,
     );
     m
@@ -308,6 +327,7 @@ pub fn teapot(segments: u32) -> Mesh {
                     }
                     (to_world(p), rot(n))
                 },
+                Vec2::new,
                 &mut m,
             );
         }

@@ -22,6 +22,7 @@
 //! shaders are tested against it. It favours clarity and exactness over
 //! speed, takes every decision per call, and never returns NaN or infinity.
 
+use crate::maps::Texels;
 use crate::{Color, Light, Material};
 use core::f32::consts::PI;
 use glam::Vec3;
@@ -301,16 +302,142 @@ pub fn shade(
     lighting: &Lighting,
     options: &ShadingOptions,
 ) -> Shading {
+    let s = material.shininess();
+    let start = material.emission() + material.ambient() * lighting.ambient();
+    let (ambient, diffuse, specular) = accumulate(point, view, material, s, lighting, options, start);
+    let ambient = finite_or_zero(ambient);
+    let diffuse = finite_or_zero(diffuse);
+    let specular = finite_or_zero(specular);
+    let sum = finite_or_zero(ambient + diffuse + specular);
+    Shading {
+        ambient,
+        diffuse,
+        specular,
+        color: if options.clamp { sum.clamp01() } else { sum },
+    }
+}
+
+/// Shades one point of a textured material: [`shade`]'s terms with the material's colours,
+/// then the texels ([`Texels`], 1 where a map is absent) applied as OpenGL's `GL_MODULATE`
+/// with `GL_SEPARATE_SPECULAR_COLOR`, generalised to one map per colour:
+///
+/// ```text
+/// s' = s·T_Ns                                   (the shininess the terms are lit with)
+/// P  = e_m·[no map_Ke] + A·[no map_Ka] + D      (A: every ambient term; D: the diffuse sum)
+/// Q  = e_m⊗T_Ke·[map_Ke] + A⊗T_Ka·[map_Ka]
+/// c  = clamp( clamp(P)⊗T_Kd + Q + clamp(S)⊗T_Ks )     (clamps only with `options.clamp`)
+/// ```
+///
+/// With only `map_Kd` this is OpenGL's fixed function exactly: the primary colour (emission +
+/// ambient + diffuse) clamped, times the texel, plus the clamped specular, clamped. The
+/// specular term is added after the texture, so a dark texel does not darken the highlight.
+/// Without maps (every texel 1) it equals [`shade`] (the terms are non-negative). The terms
+/// reported are `ambient = e_m⊗(T_Ke or T_Kd) + A⊗(T_Ka or T_Kd)`, `diffuse = D⊗T_Kd`,
+/// `specular = S⊗T_Ks`, before any clamp.
+pub fn shade_textured(
+    point: &SurfacePoint,
+    view: &View,
+    material: &Material,
+    texels: &Texels,
+    lighting: &Lighting,
+    options: &ShadingOptions,
+) -> Shading {
+    let split = (texels.emission.is_some(), texels.ambient.is_some());
+    let (lit, [e, a, d, sp]) = light(point, view, material, texels.shininess, split, lighting, options);
+    let td = Color::new(texels.diffuse[0], texels.diffuse[1], texels.diffuse[2]);
+    Shading {
+        ambient: finite_or_zero(e * texels.emission.unwrap_or(td) + a * texels.ambient.unwrap_or(td)),
+        diffuse: finite_or_zero(d * td),
+        specular: finite_or_zero(sp * texels.specular),
+        color: lit.modulate(texels, options.clamp),
+    }
+}
+
+/// A textured point's light before its texels (see [`shade_textured`]): what Gouraud shading
+/// computes at each vertex and interpolates, so that the texels are applied per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Lit {
+    /// `P`, the terms the diffuse map modulates (clamped with `clamp`).
+    pub primary: Color,
+    /// `e_m` where an emission map modulates it, else 0.
+    pub emission: Color,
+    /// `A` where an ambient map modulates it, else 0.
+    pub ambient: Color,
+    /// `S` (clamped with `clamp`).
+    pub specular: Color,
+}
+
+impl Lit {
+    /// The colour with `texels` applied: `clamp(P⊗T_Kd + e⊗T_Ke + A⊗T_Ka + S⊗T_Ks)`.
+    #[inline]
+    pub fn modulate(&self, t: &Texels, clamp: bool) -> Color {
+        let td = Color::new(t.diffuse[0], t.diffuse[1], t.diffuse[2]);
+        let sum = self.primary * td
+            + self.emission * t.emission.unwrap_or(Color::WHITE)
+            + self.ambient * t.ambient.unwrap_or(Color::WHITE)
+            + self.specular * t.specular;
+        let sum = finite_or_zero(sum);
+        if clamp { sum.clamp01() } else { sum }
+    }
+}
+
+/// The light of a textured point (shininess scaled by `shininess`; `split`: whether the
+/// emission and the ambient terms have maps of their own): its [`Lit`] and the untextured
+/// terms `[e_m, A, D, S]`.
+pub fn light(
+    point: &SurfacePoint,
+    view: &View,
+    material: &Material,
+    shininess: f32,
+    split: (bool, bool),
+    lighting: &Lighting,
+    options: &ShadingOptions,
+) -> (Lit, [Color; 4]) {
+    let s = material.shininess() * shininess.max(0.0);
+    let start = material.ambient() * lighting.ambient();
+    let (a, d, sp) = accumulate(point, view, material, s, lighting, options, start);
+    let (a, d, sp) = (finite_or_zero(a), finite_or_zero(d), finite_or_zero(sp));
+    let e = material.emission();
+    let mut lit = Lit {
+        primary: d,
+        specular: sp,
+        ..Lit::default()
+    };
+    if split.0 {
+        lit.emission = e;
+    } else {
+        lit.primary += e;
+    }
+    if split.1 {
+        lit.ambient = a;
+    } else {
+        lit.primary += a;
+    }
+    if options.clamp {
+        lit.primary = lit.primary.clamp01();
+        lit.specular = lit.specular.clamp01();
+    }
+    (lit, [e, a, d, sp])
+}
+
+/// The light sums of [`shade`] with shininess `s`: `(ambient, diffuse, specular)`, the ambient
+/// starting from `ambient` (the emission and global ambient, as the caller splits them).
+fn accumulate(
+    point: &SurfacePoint,
+    view: &View,
+    material: &Material,
+    s: f32,
+    lighting: &Lighting,
+    options: &ShadingOptions,
+    mut ambient: Color,
+) -> (Color, Color, Color) {
     let v = view.at(point.position);
     let mut n = point.normal.normalize_or_zero();
     if options.two_sided && n.dot(v) < 0.0 {
         n = -n;
     }
-    let s = material.shininess();
     let (kd, ks) = options.normalization.factors(s);
     let normalized = options.normalization != Normalization::None;
-
-    let mut ambient = material.emission() + material.ambient() * lighting.ambient();
     let mut diffuse = Color::BLACK;
     let mut specular = Color::BLACK;
 
@@ -342,17 +469,7 @@ pub fn shade(
             specular += material.specular() * lc.specular() * (inc.factor * ks * spec);
         }
     }
-
-    let ambient = finite_or_zero(ambient);
-    let diffuse = finite_or_zero(diffuse);
-    let specular = finite_or_zero(specular);
-    let sum = finite_or_zero(ambient + diffuse + specular);
-    Shading {
-        ambient,
-        diffuse,
-        specular,
-        color: if options.clamp { sum.clamp01() } else { sum },
-    }
+    (ambient, diffuse, specular)
 }
 
 /// NaN becomes 0 and ±infinity the largest finite `f32` of that sign.

@@ -54,6 +54,7 @@ fn scene(lights: Vec<Light>, options: ShadingOptions, material: Material, interp
             mesh: primitives::sphere(96),
             material,
             shading,
+            maps: Default::default(),
         }],
         labels: Vec::new(),
     }

@@ -149,6 +149,7 @@ fn scene_with(
             mesh,
             material: m,
             shading,
+            maps: Default::default(),
         }],
         labels: Vec::new(),
     }

@@ -50,6 +50,7 @@ fn obj(mesh: Mesh, material: Material) -> Object {
             viewer: Viewer::Local,
             output: Output::Color,
         },
+        maps: Default::default(),
     }
 }
 

@@ -8,7 +8,7 @@ use crate::Error;
 use crate::load_model_sources;
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::MAX_SEGMENTS;
-use phong_core::{Material, Mesh, Object, ShadingSettings, primitives};
+use phong_core::{Maps, Material, Mesh, Object, ShadingSettings, primitives};
 use std::collections::BTreeMap;
 use std::path::Path;
 use toml::Spanned;
@@ -134,6 +134,7 @@ pub(super) fn object(
                 mesh: mesh.transformed(&world_from_object),
                 material: material.unwrap_or_default(),
                 shading,
+                maps: Maps::default(),
             }])
         }
         (None, Some(m)) => {
@@ -228,6 +229,7 @@ pub(super) fn object(
                     mesh: mesh.transformed(&world_from_file),
                     material: material.or(p.material).unwrap_or_default(),
                     shading,
+                    maps: Maps::default(),
                 });
             }
             let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();

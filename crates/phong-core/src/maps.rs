@@ -1,0 +1,212 @@
+//! A material's texture maps and what they give at a point (see [`shade_textured`] for the
+//! equation they enter).
+//!
+//! [`shade_textured`]: crate::shade_textured
+
+use crate::texture::{Sampler, Texture};
+use crate::{Color, Material};
+use glam::{Mat2, Vec2};
+use std::sync::Arc;
+
+/// An affine map of texture coordinates, `uv' = linear·uv + offset` (MTL's `-s` and `-o`, a
+/// scene's `uv_scale` and `uv_offset`, glTF's KHR_texture_transform).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    /// The linear part.
+    pub linear: Mat2,
+    /// The offset.
+    pub offset: Vec2,
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        UvTransform {
+            linear: Mat2::IDENTITY,
+            offset: Vec2::ZERO,
+        }
+    }
+}
+
+impl UvTransform {
+    /// Scale, then offset.
+    pub fn scale_offset(scale: Vec2, offset: Vec2) -> UvTransform {
+        UvTransform {
+            linear: Mat2::from_diagonal(scale),
+            offset,
+        }
+    }
+    /// `uv` mapped.
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        self.linear * uv + self.offset
+    }
+    /// This map after `first`: `self(first(uv))`.
+    pub fn after(&self, first: &UvTransform) -> UvTransform {
+        UvTransform {
+            linear: self.linear * first.linear,
+            offset: self.linear * first.offset + self.offset,
+        }
+    }
+}
+
+/// Which channel a scalar map (shininess, alpha) reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    /// Red.
+    R,
+    /// Green.
+    G,
+    /// Blue.
+    B,
+    /// Alpha.
+    A,
+    /// Luminance, `0.2126 R + 0.7152 G + 0.0722 B` (MTL's `-imfchan l`).
+    Luminance,
+}
+
+impl Channel {
+    /// The channel of `rgba`.
+    #[inline]
+    pub fn of(self, rgba: [f32; 4]) -> f32 {
+        match self {
+            Channel::R => rgba[0],
+            Channel::G => rgba[1],
+            Channel::B => rgba[2],
+            Channel::A => rgba[3],
+            Channel::Luminance => 0.2126 * rgba[0] + 0.7152 * rgba[1] + 0.0722 * rgba[2],
+        }
+    }
+}
+
+/// A texture as one map of a material: the image, how it is sampled and where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureMap {
+    /// The image and its mipmaps.
+    pub texture: Arc<Texture>,
+    /// Wrapping and filtering.
+    pub sampler: Sampler,
+    /// Applied to the mesh's coordinates before sampling.
+    pub transform: UvTransform,
+}
+
+impl TextureMap {
+    /// The map with the default sampler (trilinear, repeat) and no transform.
+    pub fn new(texture: Arc<Texture>) -> TextureMap {
+        TextureMap {
+            texture,
+            sampler: Sampler::default(),
+            transform: UvTransform::default(),
+        }
+    }
+
+    /// The filtered texel at mesh coordinates `uv`, whose screen derivatives are `d_dx` and
+    /// `d_dy` (they pass through the transform's linear part into the level of detail).
+    #[inline]
+    pub fn sample(&self, uv: Vec2, d_dx: Vec2, d_dy: Vec2) -> [f32; 4] {
+        let t = &self.transform;
+        let lod = self.texture.lod(t.linear * d_dx, t.linear * d_dy);
+        self.texture.sample(&self.sampler, t.apply(uv), lod)
+    }
+}
+
+/// The texture maps of an object's material. Colour maps hold linear values (a file's sRGB
+/// colours are decoded where it is read).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Maps {
+    /// `map_Kd`: modulates the diffuse colour (and the ambient and emission where they have no
+    /// map of their own, as `GL_MODULATE` does); its alpha multiplies the material's.
+    pub diffuse: Option<TextureMap>,
+    /// `map_Ka`: modulates the ambient terms.
+    pub ambient: Option<TextureMap>,
+    /// `map_Ks`: modulates the specular term.
+    pub specular: Option<TextureMap>,
+    /// `map_Ke`: modulates the emission.
+    pub emission: Option<TextureMap>,
+    /// `map_Ns`: scales the shininess, by one channel.
+    pub shininess: Option<(TextureMap, Channel)>,
+    /// `map_d`: multiplies the alpha, by one channel.
+    pub alpha: Option<(TextureMap, Channel)>,
+    /// The alpha test: a point whose alpha is below it is not drawn (`None`: no test).
+    pub alpha_cutoff: Option<f32>,
+}
+
+/// What an object's maps give at one point: `1` (white, full) where a map is absent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Texels {
+    /// The diffuse map's RGBA.
+    pub diffuse: [f32; 4],
+    /// The ambient map's colour, if there is one.
+    pub ambient: Option<Color>,
+    /// The specular map's colour.
+    pub specular: Color,
+    /// The emission map's colour, if there is one.
+    pub emission: Option<Color>,
+    /// The shininess factor.
+    pub shininess: f32,
+    /// The alpha map's value.
+    pub alpha: f32,
+}
+
+impl Default for Texels {
+    fn default() -> Self {
+        Texels {
+            diffuse: [1.0; 4],
+            ambient: None,
+            specular: Color::WHITE,
+            emission: None,
+            shininess: 1.0,
+            alpha: 1.0,
+        }
+    }
+}
+
+fn rgb(t: [f32; 4]) -> Color {
+    Color::new(t[0], t[1], t[2])
+}
+
+impl Maps {
+    /// Whether no map is set (the alpha test alone is not a map).
+    pub fn is_empty(&self) -> bool {
+        self.diffuse.is_none()
+            && self.ambient.is_none()
+            && self.specular.is_none()
+            && self.emission.is_none()
+            && self.shininess.is_none()
+            && self.alpha.is_none()
+    }
+
+    /// Every map set, for memory accounting and uploads.
+    pub fn each(&self) -> impl Iterator<Item = &TextureMap> {
+        [&self.diffuse, &self.ambient, &self.specular, &self.emission]
+            .into_iter()
+            .flatten()
+            .chain(self.shininess.iter().map(|(m, _)| m))
+            .chain(self.alpha.iter().map(|(m, _)| m))
+    }
+
+    /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy`.
+    pub fn sample(&self, uv: Vec2, d_dx: Vec2, d_dy: Vec2) -> Texels {
+        let at = |m: &TextureMap| m.sample(uv, d_dx, d_dy);
+        Texels {
+            diffuse: self.diffuse.as_ref().map_or([1.0; 4], at),
+            ambient: self.ambient.as_ref().map(|m| rgb(at(m))),
+            specular: self.specular.as_ref().map_or(Color::WHITE, |m| rgb(at(m))),
+            emission: self.emission.as_ref().map(|m| rgb(at(m))),
+            shininess: self.shininess.as_ref().map_or(1.0, |(m, c)| c.of(at(m))),
+            alpha: self.alpha.as_ref().map_or(1.0, |(m, c)| c.of(at(m))),
+        }
+    }
+
+    /// The alpha of a point of `material` with these texels: the material's alpha times the
+    /// diffuse map's and the alpha map's.
+    #[inline]
+    pub fn alpha(material: &Material, t: &Texels) -> f32 {
+        material.alpha() * t.diffuse[3] * t.alpha
+    }
+
+    /// Whether the alpha test discards a point of alpha `alpha`.
+    #[inline]
+    pub fn discards(&self, alpha: f32) -> bool {
+        self.alpha_cutoff.is_some_and(|c| alpha < c)
+    }
+}

@@ -1,0 +1,402 @@
+//! Textures sampled as OpenGL samples them (the OpenGL 4.6 specification, §8.14): mipmaps
+//! built once by 2×2 box filtering, the level of detail `λ = log2 ρ` from the screen-space
+//! derivatives of the texture coordinates, texel centres at half-integers, repeat, clamp and
+//! mirror wrapping, nearest, bilinear and trilinear filtering.
+//!
+//! Texels are kept in OpenGL's order: row 0 is the bottom of the image, so that `v = 0` is its
+//! bottom edge as in OBJ's `vt` and OpenGL (glTF's `v` points down and is flipped by its reader).
+
+use crate::Error;
+use crate::limits::{MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
+use glam::Vec2;
+
+/// How a coordinate outside `[0, 1]` is brought back (`GL_REPEAT`, `GL_CLAMP_TO_EDGE`,
+/// `GL_MIRRORED_REPEAT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// The image repeats.
+    #[default]
+    Repeat,
+    /// The edge texels extend outward.
+    Clamp,
+    /// The image repeats, every other copy mirrored.
+    Mirror,
+}
+
+/// How texels are chosen within one level (`GL_NEAREST`, `GL_LINEAR`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    /// The texel containing the point.
+    Nearest,
+    /// The four nearest texels, weighted bilinearly.
+    Linear,
+}
+
+/// How levels are chosen when minifying: none (level 0), the nearest level, or the two nearest
+/// blended (`GL_*_MIPMAP_NEAREST`, `GL_*_MIPMAP_LINEAR`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MipFilter {
+    /// Level 0 only.
+    None,
+    /// The nearest level.
+    Nearest,
+    /// The two nearest levels, blended by the fraction of `λ`.
+    Linear,
+}
+
+/// A sampler's state, as OpenGL's texture parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    /// Wrapping of `u`.
+    pub wrap_u: Wrap,
+    /// Wrapping of `v`.
+    pub wrap_v: Wrap,
+    /// `GL_TEXTURE_MAG_FILTER`.
+    pub mag: Filter,
+    /// The texel filter of `GL_TEXTURE_MIN_FILTER`.
+    pub min: Filter,
+    /// The level filter of `GL_TEXTURE_MIN_FILTER`.
+    pub mip: MipFilter,
+}
+
+impl Default for Sampler {
+    /// Trilinear with repeat: `GL_LINEAR_MIPMAP_LINEAR`, `GL_LINEAR`, `GL_REPEAT`.
+    fn default() -> Self {
+        Sampler::trilinear(Wrap::Repeat)
+    }
+}
+
+impl Sampler {
+    /// `GL_LINEAR_MIPMAP_LINEAR` minification, `GL_LINEAR` magnification.
+    pub fn trilinear(wrap: Wrap) -> Sampler {
+        Sampler {
+            wrap_u: wrap,
+            wrap_v: wrap,
+            mag: Filter::Linear,
+            min: Filter::Linear,
+            mip: MipFilter::Linear,
+        }
+    }
+    /// `GL_LINEAR` both ways, no mipmaps.
+    pub fn bilinear(wrap: Wrap) -> Sampler {
+        Sampler {
+            mip: MipFilter::None,
+            ..Sampler::trilinear(wrap)
+        }
+    }
+    /// `GL_NEAREST` both ways, no mipmaps.
+    pub fn nearest(wrap: Wrap) -> Sampler {
+        Sampler {
+            wrap_u: wrap,
+            wrap_v: wrap,
+            mag: Filter::Nearest,
+            min: Filter::Nearest,
+            mip: MipFilter::None,
+        }
+    }
+
+    /// The level of detail at which magnification ends (`c` of the specification, §8.14.2).
+    fn switch_point(&self) -> f32 {
+        if self.mag == Filter::Linear && self.min == Filter::Nearest && self.mip != MipFilter::None {
+            0.5
+        } else {
+            0.0
+        }
+    }
+}
+
+/// One mipmap level: `width × height` RGBA texels, 16 bits a channel, bottom row first.
+#[derive(Clone, Debug, PartialEq)]
+struct Level {
+    width: u32,
+    height: u32,
+    texels: Vec<[u16; 4]>,
+}
+
+/// An RGBA texture with its mipmap chain. Channels are linear values in `[0, 1]` stored in 16
+/// bits (an 8-bit source's byte `b` as `257·b`, so it reads back as exactly `b/255`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    levels: Vec<Level>,
+    bits: u8,
+}
+
+impl Texture {
+    /// A texture from `width × height` texels, **top row first** (as image files store them),
+    /// whose source had `bits` (8 or 16) bits a channel. The mipmap chain is built down to 1×1:
+    /// each texel of a level is the mean of the 2×2 block below it (the last row or column of
+    /// an odd size is left out, as Mesa does), rounded to the source's precision as a driver
+    /// storing the source's format does.
+    pub fn new(width: u32, height: u32, top_first: &[[u16; 4]], bits: u8) -> Result<Texture, Error> {
+        if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+            return Err(Error::OutOfRange {
+                what: "texture side",
+                range: "between 1 and 16384 texels",
+                value: width.max(height) as f32,
+            });
+        }
+        let bytes = u64::from(width) * u64::from(height) * 8 * 4 / 3;
+        if bytes > MAX_TEXTURE_BYTES {
+            return Err(Error::OutOfRange {
+                what: "texture size with its mipmaps (bytes)",
+                range: "at most 2 GiB",
+                value: bytes as f32,
+            });
+        }
+        if top_first.len() as u64 != u64::from(width) * u64::from(height) {
+            return Err(Error::OutOfRange {
+                what: "number of texels",
+                range: "width × height",
+                value: top_first.len() as f32,
+            });
+        }
+        let w = width as usize;
+        let texels: Vec<[u16; 4]> = top_first.chunks_exact(w).rev().flatten().copied().collect();
+        let mut levels = vec![Level { width, height, texels }];
+        while let Some(next) = levels.last().and_then(|l| l.halved(bits)) {
+            levels.push(next);
+        }
+        Ok(Texture { levels, bits })
+    }
+
+    /// Width of level 0.
+    pub fn width(&self) -> u32 {
+        self.levels[0].width
+    }
+    /// Height of level 0.
+    pub fn height(&self) -> u32 {
+        self.levels[0].height
+    }
+    /// Bits a channel of the source (8 or 16).
+    pub fn bits(&self) -> u8 {
+        self.bits
+    }
+    /// Number of mipmap levels (level 0 included).
+    pub fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+    /// Level `i`: its size and texels, bottom row first.
+    pub fn level(&self, i: usize) -> (u32, u32, &[[u16; 4]]) {
+        let l = &self.levels[i];
+        (l.width, l.height, &l.texels)
+    }
+    /// Bytes held, every level.
+    pub fn bytes(&self) -> u64 {
+        self.levels.iter().map(|l| l.texels.len() as u64 * 8).sum()
+    }
+    /// Whether any texel of level 0 has alpha below 1.
+    pub fn has_alpha(&self) -> bool {
+        self.levels[0].texels.iter().any(|t| t[3] < u16::MAX)
+    }
+
+    /// Texel `(x, y)` of `level` (bottom row 0) as linear RGBA.
+    #[inline]
+    pub fn texel(&self, level: usize, x: u32, y: u32) -> [f32; 4] {
+        let l = &self.levels[level];
+        let t = l.texels[y as usize * l.width as usize + x as usize];
+        t.map(|c| f32::from(c) / 65535.0)
+    }
+
+    /// The level of detail `λ = log2 ρ` for texture-coordinate derivatives `d(u, v)/dx` and
+    /// `d(u, v)/dy` (per pixel): `ρ = max(|(∂u/∂x·w, ∂v/∂x·h)|, |(∂u/∂y·w, ∂v/∂y·h)|)`, the
+    /// specification's equation 8.7 with `w`, `h` the size of level 0.
+    #[inline]
+    pub fn lod(&self, d_dx: Vec2, d_dy: Vec2) -> f32 {
+        let size = Vec2::new(self.width() as f32, self.height() as f32);
+        let rho = (d_dx * size).length().max((d_dy * size).length());
+        rho.log2()
+    }
+
+    /// The filtered RGBA at `uv` with level of detail `lod` (see [`Texture::lod`]), as OpenGL's
+    /// sampler `s` gives it. A NaN level of detail magnifies.
+    pub fn sample(&self, s: &Sampler, uv: Vec2, lod: f32) -> [f32; 4] {
+        let minify = lod > s.switch_point();
+        if !minify {
+            return self.filter(0, s.mag, s, uv);
+        }
+        let q = (self.levels.len() - 1) as f32;
+        match s.mip {
+            MipFilter::None => self.filter(0, s.min, s, uv),
+            MipFilter::Nearest => {
+                let d = if lod <= 0.5 {
+                    0.0
+                } else {
+                    ((lod + 0.5).ceil() - 1.0).min(q)
+                };
+                self.filter(d as usize, s.min, s, uv)
+            }
+            MipFilter::Linear => {
+                if lod >= q {
+                    return self.filter(q as usize, s.min, s, uv);
+                }
+                let d1 = lod.floor();
+                let t = lod - d1;
+                let a = self.filter(d1 as usize, s.min, s, uv);
+                let b = self.filter(d1 as usize + 1, s.min, s, uv);
+                std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t)
+            }
+        }
+    }
+
+    /// `uv` filtered within one level.
+    #[inline]
+    fn filter(&self, level: usize, f: Filter, s: &Sampler, uv: Vec2) -> [f32; 4] {
+        let l = &self.levels[level];
+        let (w, h) = (l.width as f32, l.height as f32);
+        match f {
+            Filter::Nearest => {
+                let x = wrap(s.wrap_u, (uv.x * w).floor(), l.width);
+                let y = wrap(s.wrap_v, (uv.y * h).floor(), l.height);
+                self.texel(level, x, y)
+            }
+            Filter::Linear => {
+                let (fx, fy) = (uv.x * w - 0.5, uv.y * h - 0.5);
+                let (ix, iy) = (fx.floor(), fy.floor());
+                let (a, b) = (fx - ix, fy - iy);
+                let (x0, x1) = (wrap(s.wrap_u, ix, l.width), wrap(s.wrap_u, ix + 1.0, l.width));
+                let (y0, y1) = (wrap(s.wrap_v, iy, l.height), wrap(s.wrap_v, iy + 1.0, l.height));
+                let t00 = self.texel(level, x0, y0);
+                let t10 = self.texel(level, x1, y0);
+                let t01 = self.texel(level, x0, y1);
+                let t11 = self.texel(level, x1, y1);
+                std::array::from_fn(|i| {
+                    (1.0 - a) * (1.0 - b) * t00[i] + a * (1.0 - b) * t10[i] + (1.0 - a) * b * t01[i] + a * b * t11[i]
+                })
+            }
+        }
+    }
+}
+
+/// Integer texel coordinate `i` (a whole number as `f32`, any size; NaN is 0) wrapped into
+/// `0..n`.
+#[inline]
+fn wrap(mode: Wrap, i: f32, n: u32) -> u32 {
+    let i = i as i64;
+    let n = i64::from(n);
+    let k = match mode {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Mirror => {
+            let p = i.rem_euclid(2 * n);
+            if p < n { p } else { 2 * n - 1 - p }
+        }
+    };
+    k as u32
+}
+
+impl Level {
+    /// The next mipmap level, `None` at 1×1.
+    fn halved(&self, bits: u8) -> Option<Level> {
+        if self.width == 1 && self.height == 1 {
+            return None;
+        }
+        let (width, height) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let sw = self.width as usize;
+        let step = |n: u32| usize::from(n > 1);
+        let (dx, dy) = (step(self.width), step(self.height));
+        let scale = if bits == 8 { 257.0 } else { 1.0 };
+        let mut texels = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height as usize {
+            let (ya, yb) = (y * (1 + dy), y * (1 + dy) + dy);
+            for x in 0..width as usize {
+                let (xa, xb) = (x * (1 + dx), x * (1 + dx) + dx);
+                let at = |x: usize, y: usize| self.texels[y * sw + x];
+                let (a, b, c, d) = (at(xa, ya), at(xb, ya), at(xa, yb), at(xb, yb));
+                texels.push(std::array::from_fn(|i| {
+                    let sum = f64::from(a[i]) + f64::from(b[i]) + f64::from(c[i]) + f64::from(d[i]);
+                    ((sum / 4.0 / scale).round() * scale) as u16
+                }));
+            }
+        }
+        Some(Level { width, height, texels })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grey(v: &[u8], w: u32, h: u32) -> Texture {
+        let t: Vec<[u16; 4]> = v.iter().map(|&b| [u16::from(b) * 257; 4]).collect();
+        Texture::new(w, h, &t, 8).unwrap()
+    }
+
+    #[test]
+    fn mipmaps_are_rounded_box_means_down_to_one_texel() {
+        // 3×2, top row first: [0 10 99; 20 31 99]; bottom-first rows [20 31 99], [0 10 99].
+        let t = grey(&[0, 10, 99, 20, 31, 99], 3, 2);
+        assert_eq!(t.level_count(), 2);
+        let (w, h, l1) = t.level(1);
+        assert_eq!((w, h), (1, 1));
+        // The odd column is left out: (0 + 10 + 20 + 31) / 4 = 15.25 → 15.
+        assert_eq!(l1[0][0], 15 * 257);
+        assert_eq!(t.texel(0, 0, 1)[0], 0.0, "row 1 is the image's top row");
+        assert_eq!(t.texel(0, 1, 0)[0], 31.0 / 255.0);
+    }
+
+    #[test]
+    fn wrap_modes_follow_the_specification() {
+        let n = 4;
+        let r: Vec<u32> = (-5..6).map(|i| wrap(Wrap::Repeat, i as f32, n)).collect();
+        assert_eq!(r, [3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1]);
+        let c: Vec<u32> = (-2..6).map(|i| wrap(Wrap::Clamp, i as f32, n)).collect();
+        assert_eq!(c, [0, 0, 0, 1, 2, 3, 3, 3]);
+        let m: Vec<u32> = (-5..9).map(|i| wrap(Wrap::Mirror, i as f32, n)).collect();
+        assert_eq!(m, [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]);
+        assert_eq!(wrap(Wrap::Repeat, f32::NAN, n), 0);
+        assert!(wrap(Wrap::Mirror, 1e30, n) < n);
+    }
+
+    #[test]
+    fn bilinear_weights_texel_centres_at_half_integers() {
+        // 2×1: left 0, right 255 (bottom row = the only row).
+        let t = grey(&[0, 255], 2, 1);
+        let s = Sampler::bilinear(Wrap::Clamp);
+        // u = 0.25 is the left texel's centre, 0.75 the right one's, 0.5 halfway.
+        assert_eq!(t.sample(&s, Vec2::new(0.25, 0.5), -1.0)[0], 0.0);
+        assert_eq!(t.sample(&s, Vec2::new(0.75, 0.5), -1.0)[0], 1.0);
+        assert!((t.sample(&s, Vec2::new(0.5, 0.5), -1.0)[0] - 0.5).abs() < 1e-6);
+        assert!((t.sample(&s, Vec2::new(0.375, 0.5), -1.0)[0] - 0.25).abs() < 1e-6);
+        // Repeat blends the right edge with the left texel.
+        let r = Sampler::bilinear(Wrap::Repeat);
+        assert!((t.sample(&r, Vec2::new(1.0, 0.5), -1.0)[0] - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn trilinear_blends_levels_by_the_fraction_of_lod() {
+        // 2×2 of 0, 0, 255, 255: level 1 is 128 (127.5 rounded half away from zero).
+        let t = grey(&[0, 0, 255, 255], 2, 2);
+        let s = Sampler::trilinear(Wrap::Clamp);
+        let uv = Vec2::new(0.25, 0.25); // the bottom-left texel's centre: 255 (bottom row)
+        assert_eq!(t.sample(&s, uv, 0.0)[0], 1.0, "λ = 0 magnifies");
+        let l1 = 128.0 / 255.0;
+        assert_eq!(t.sample(&s, uv, 1.0)[0], l1);
+        assert_eq!(t.sample(&s, uv, 7.0)[0], l1, "past the last level");
+        let mid = t.sample(&s, uv, 0.25)[0];
+        assert!((mid - (1.0 + (l1 - 1.0) * 0.25)).abs() < 1e-6, "{mid}");
+        // Nearest-mipmap picks level 1 from λ > 0.5.
+        let n = Sampler {
+            mip: MipFilter::Nearest,
+            ..s
+        };
+        assert_eq!(t.sample(&n, uv, 0.4)[0], 1.0);
+        assert_eq!(t.sample(&n, uv, 0.6)[0], l1);
+    }
+
+    #[test]
+    fn lod_is_log2_of_the_longer_footprint() {
+        let t = grey(&[0; 64 * 32], 64, 32);
+        // One pixel covers 1/16 of u: 4 texels; and 1/8 of v: 4 texels.
+        let lod = t.lod(Vec2::new(1.0 / 16.0, 0.0), Vec2::new(0.0, 1.0 / 8.0));
+        assert!((lod - 2.0).abs() < 1e-6);
+        let lod = t.lod(Vec2::new(1.0 / 64.0, 1.0 / 32.0), Vec2::ZERO);
+        assert!((lod - 0.5).abs() < 1e-6, "ρ = √2: {lod}");
+    }
+
+    #[test]
+    fn sizes_past_the_limits_are_errors() {
+        assert!(Texture::new(0, 1, &[], 8).is_err());
+        assert!(Texture::new(MAX_TEXTURE_SIDE + 1, 1, &[], 8).is_err());
+        assert!(Texture::new(2, 2, &[[0; 4]; 3], 8).is_err());
+    }
+}
