@@ -6,7 +6,7 @@
 //! viewport's sides, the common case, are not clipped at all, and the pixel
 //! coordinates of what is left stay within `G` half-viewports of the centre.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use phong_core::limits::GUARD_BAND;
 
 /// A vertex in clip space with the attributes the rasteriser interpolates.
@@ -18,10 +18,14 @@ pub struct ClipVertex {
     pub world: Vec3,
     /// World-space normal (not renormalised).
     pub normal: Vec3,
-    /// Colour lit at the vertex (Gouraud), else unused.
+    /// Colour lit at the vertex (Gouraud; a textured object's primary colour), else unused.
     pub color: Vec3,
     /// Gouraud with two-sided lighting: the colour lit with the flipped normal, for back faces.
     pub color_back: Vec3,
+    /// A textured object's specular colour lit at the vertex (Gouraud), front and back.
+    pub spec: [Vec3; 2],
+    /// Texture coordinates.
+    pub uv: Vec2,
 }
 
 impl ClipVertex {
@@ -35,6 +39,8 @@ impl ClipVertex {
             normal: self.normal.lerp(b.normal, t),
             color: self.color.lerp(b.color, t),
             color_back: self.color_back.lerp(b.color_back, t),
+            spec: [0, 1].map(|k| self.spec[k].lerp(b.spec[k], t)),
+            uv: self.uv.lerp(b.uv, t),
         }
     }
 }
@@ -157,6 +163,8 @@ mod tests {
             normal: Vec3::Z,
             color: Vec3::new(w, 0.0, 0.0),
             color_back: Vec3::ZERO,
+            spec: [Vec3::ZERO; 2],
+            uv: Vec2::ZERO,
         }
     }
 

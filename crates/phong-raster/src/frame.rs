@@ -28,7 +28,8 @@ pub(crate) enum Mode {
     Phong(Prepared, Term),
     /// Interpolated vertex colours.
     Gouraud,
-    /// One pixel at a time, as the reference path (flat shading, normal and depth outputs).
+    /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
+    /// depth outputs).
     Scalar,
 }
 
@@ -101,6 +102,9 @@ impl<'a> Frame<'a> {
                 let Some(term) = lit_term(o.shading.output) else {
                     return Mode::Scalar;
                 };
+                if o.textured() {
+                    return Mode::Scalar;
+                }
                 match o.shading.interpolation {
                     Interpolation::Phong => Mode::Phong(
                         Prepared::new(&scene.lighting, &o.material, &o.shading.options, view),
@@ -199,7 +203,11 @@ pub(crate) fn render<P: Pixel>(
     scratch: &mut Scratch,
 ) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
-    let path = if options.reference { Path::Reference } else { Path::Fast };
+    let path = if options.reference || alpha_tested(scene) {
+        Path::Reference
+    } else {
+        Path::Fast
+    };
     let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2), scratch);
     let setup = t0.elapsed();
     let t1 = Instant::now();
@@ -219,6 +227,15 @@ pub(crate) fn render<P: Pixel>(
         tile_shade,
         tile_resolve,
     })
+}
+
+/// Whether an object of `scene` has an alpha test: such frames are drawn by the reference
+/// path, whose depth test comes after the shading (the fast path decides visibility first).
+fn alpha_tested(scene: &Scene) -> bool {
+    scene
+        .objects
+        .iter()
+        .any(|o| o.textured() && o.maps.alpha_cutoff.is_some())
 }
 
 /// Diagnostic for coverage tests: for each sample of each pixel (row-major,

@@ -277,6 +277,8 @@ rotation = [0.0, 90.0, 0.0]
                             normal: Vec3::Z,
                             color: Vec3::ZERO,
                             color_back: Vec3::ZERO,
+                            spec: [Vec3::ZERO; 2],
+                            uv: glam::Vec2::ZERO,
                         }
                     })
                 })

@@ -119,6 +119,8 @@ impl Frame<'_> {
                         normal: normals[i],
                         color: lit3[0][k],
                         color_back: lit3[1][k],
+                        spec: [Vec3::ZERO; 2],
+                        uv: glam::Vec2::ZERO,
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {

@@ -1,15 +1,16 @@
 //! The setup of an object for the reference path, or for the fast path's scalar shading (flat,
-//! normal and depth outputs): every vertex in full, lit per vertex (Gouraud) or per triangle
-//! (flat) by `Object::shade`, [`Corners`] kept.
+//! textured, normal and depth outputs): every vertex in full, lit per vertex (Gouraud) or per
+//! triangle (flat) by `Object::shade` (a textured object: its primary and specular colours,
+//! for the texels applied per pixel), [`Corners`] kept.
 
-use super::{Chunk, Corners, SETUP_CHUNK, Tri};
+use super::{Chunk, Corners, Flat, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::frame::Frame;
 use crate::simd::Planes;
 use crate::vertex::Projected;
 use glam::{Mat4, Vec3, Vec4};
 use phong_core::mesh::facet_normal;
-use phong_core::{Interpolation, Object};
+use phong_core::{Color, Interpolation, Lighting, Object, Output, ShadingOptions, SurfacePoint, View, light};
 use rayon::prelude::*;
 
 impl Frame<'_> {
@@ -18,31 +19,39 @@ impl Frame<'_> {
     pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4) -> Vec<Chunk> {
         let scene = self.scene;
         let interpolation = obj.shading.interpolation;
-        let output = obj.shading.output;
         let two_sided = obj.shading.options.two_sided;
         let view = self.views[oi];
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
+        let textured = obj.textured();
+        let uvs = mesh.uvs();
+        let lit = |p: Vec3, n: Vec3| lit_at(obj, &scene.lighting, &view, p, n, textured);
+        let vec3 = |c: Color| Vec3::from(c.to_array());
         let verts: Vec<ClipVertex> = mesh
             .positions()
             .par_iter()
             .zip(mesh.normals().par_iter())
-            .map(|(&p, &n)| ClipVertex {
-                clip: clip_from_world * Vec4::from((p, 1.0)),
-                world: p,
-                normal: n,
-                color: if gouraud {
-                    let s = obj.shade(&scene.lighting, &view, p, n);
-                    Vec3::from(output.term(&s).to_array())
+            .enumerate()
+            .map(|(i, (&p, &n))| {
+                let front = if gouraud {
+                    lit(p, n)
                 } else {
-                    Vec3::ZERO
-                },
-                color_back: if gouraud && two_sided {
-                    let s = obj.shade(&scene.lighting, &view, p, -n);
-                    Vec3::from(output.term(&s).to_array())
+                    (Color::BLACK, Color::BLACK)
+                };
+                let back = if gouraud && two_sided {
+                    lit(p, -n)
                 } else {
-                    Vec3::ZERO
-                },
+                    (Color::BLACK, Color::BLACK)
+                };
+                ClipVertex {
+                    clip: clip_from_world * Vec4::from((p, 1.0)),
+                    world: p,
+                    normal: n,
+                    color: vec3(front.0),
+                    color_back: vec3(back.0),
+                    spec: [vec3(front.1), vec3(back.1)],
+                    uv: uvs.get(i).copied().unwrap_or_default(),
+                }
             })
             .collect();
         // Per vertex, once: its outcode, and its projection where it is inside the clipping
@@ -78,16 +87,12 @@ impl Frame<'_> {
                 }
                 let t = tri.map(|i| verts[i as usize]);
                 // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
-                let flat = (interpolation == Interpolation::Flat).then(|| {
+                let flat = (interpolation == Interpolation::Flat).then(|| -> [Flat; 2] {
                     let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
                     let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                    let front = output.term(&obj.shade(&scene.lighting, &view, centroid, fnorm));
-                    let back = if two_sided {
-                        output.term(&obj.shade(&scene.lighting, &view, centroid, -fnorm))
-                    } else {
-                        front
-                    };
-                    [(front, fnorm), (back, -fnorm)]
+                    let front = lit(centroid, fnorm);
+                    let back = if two_sided { lit(centroid, -fnorm) } else { front };
+                    [(front.0, front.1, fnorm), (back.0, back.1, -fnorm)]
                 });
                 if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
                     let proj = tri.map(|i| projected[i as usize]);
@@ -108,5 +113,30 @@ impl Frame<'_> {
             out
         };
         mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+    }
+}
+
+/// The light at a vertex (Gouraud) or a triangle's centroid (flat), as the object's output
+/// shows it: `(colour, black)`, or for a textured object `(primary, specular)` (phong-core's
+/// `Lit` with every term in the primary colour), the texels applied per pixel. Under Gouraud
+/// and flat shading the ambient, emission and shininess maps have no effect: the light is not
+/// computed per pixel.
+fn lit_at(obj: &Object, lighting: &Lighting, view: &View, p: Vec3, n: Vec3, textured: bool) -> (Color, Color) {
+    let output = obj.shading.output;
+    if !textured {
+        return (output.term(&obj.shade(lighting, view, p, n)), Color::BLACK);
+    }
+    let options = ShadingOptions {
+        two_sided: false,
+        ..obj.shading.options
+    };
+    let point = SurfacePoint { position: p, normal: n };
+    let (lit, [e, a, d, s]) = light(&point, view, &obj.material, 1.0, (false, false), lighting, &options);
+    match output {
+        Output::Color => (lit.primary, lit.specular),
+        Output::Ambient => (e + a, Color::BLACK),
+        Output::Diffuse => (d, Color::BLACK),
+        Output::Specular => (Color::BLACK, s),
+        _ => (Color::BLACK, Color::BLACK),
     }
 }

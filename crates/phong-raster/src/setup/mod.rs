@@ -89,14 +89,19 @@ pub(crate) struct Setup {
     pub front: bool,
 }
 
+/// A flat-shaded triangle's light as seen from one side: colour (a textured object's primary
+/// colour), specular colour (textured objects only), facet normal.
+pub(crate) type Flat = (Color, Color, Vec3);
+
 /// What the scalar shading of a triangle needs besides [`Tri`]: kept only for the reference
 /// path and for objects the fast path shades one pixel at a time.
 pub(crate) struct Corners {
     /// 1/w per vertex.
     pub inv_w: [f32; 3],
     pub v: [ClipVertex; 3],
-    /// Flat: the triangle's colour and facet normal (as seen: flipped on a two-sided back face).
-    pub flat: Option<(Color, Vec3)>,
+    /// Flat: the triangle's colour (a textured object's primary colour), its specular colour
+    /// (textured objects only) and facet normal (as seen: flipped on a two-sided back face).
+    pub flat: Option<Flat>,
 }
 
 /// The triangles one setup task made, with their [`Corners`] (same index) where kept, else
@@ -312,7 +317,7 @@ impl Frame<'_> {
         &self,
         v: [ClipVertex; 3],
         proj: Option<[Projected; 3]>,
-        flat: Option<[(Color, Vec3); 2]>,
+        flat: Option<[Flat; 2]>,
         object: u32,
         full: bool,
     ) -> Option<(Tri, Planes, Option<Corners>)> {

@@ -47,7 +47,10 @@ impl Frame<'_> {
                         continue;
                     }
                     shaded += 1;
-                    let c = self.shade_pixel(ti, px, py);
+                    // Discarded by the alpha test: no colour, no depth.
+                    let Some(c) = self.shade_pixel(ti, px, py) else {
+                        continue;
+                    };
                     for s in 0..ns {
                         if mask & (1 << s) != 0 {
                             depth[base + s] = zs[s];

@@ -10,14 +10,16 @@ use super::visible::FORWARD;
 use super::{Multi, Tile};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
-use crate::frame::{Frame, Mode};
+use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
 use crate::simd::{Planes, group_lanes, shade_batch, shade_group};
 use crate::stats::Marks;
 use crate::target::{Store, fill, resolve};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use phong_core::limits::SUBPIXEL_BITS;
-use phong_core::{Color, Interpolation, Output, depth_color, normal_color};
+use phong_core::{
+    Color, Interpolation, Lit, Maps, Output, ShadingOptions, SurfacePoint, depth_color, normal_color, shade_textured,
+};
 
 /// How many of `ids` from the start equal `k`: 8 compared at a time (a branch-free mask LLVM
 /// vectorises; BENCHMARKS.md, C5).
@@ -130,7 +132,8 @@ impl Frame<'_> {
             let Some(kind) = self.modes[object].batch() else {
                 for &p in pixels {
                     let (r, c) = at(p);
-                    let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32);
+                    // Frames with an alpha test are the reference path's: nothing is discarded here.
+                    let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32).unwrap_or(self.bg);
                     out[r][c] = resolve(std::iter::once(color), 1, self.bg);
                 }
                 continue;
@@ -211,7 +214,7 @@ impl Frame<'_> {
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
             if matches!(self.modes[self.object(ti)], Mode::Scalar) {
                 let (px, py) = at(pixel);
-                colors[k] = self.shade_pixel(ti, px, py);
+                colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.bg);
             } else {
                 batches[self.object(ti)].push(k as u32);
             }
@@ -254,10 +257,36 @@ impl Frame<'_> {
         map3(q, |x| x / sum)
     }
 
+    /// Perspective-correct texture coordinates of triangle `t` at the centre of pixel
+    /// `(px, py)` and their exact screen derivatives `[uv, ∂uv/∂x, ∂uv/∂y]` (per pixel), in
+    /// `f64`: with `q_i = λ_i/w_i`, `uv = Σ q_i uv_i / Σ q_i` and
+    /// `∂uv = (Σ ∂q_i uv_i − uv Σ ∂q_i) / Σ q_i`.
+    fn uv_at(t: &Tri, corners: &Corners, px: u32, py: u32) -> [Vec2; 3] {
+        let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
+        let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
+        let step = f64::from(1u32 << SUBPIXEL_BITS) * t.inv_area;
+        let inv_w = corners.inv_w.map(f64::from);
+        let uv = corners.v.map(|v| v.uv.as_dvec2());
+        let q = each3(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area * inv_w[i]);
+        let qx = each3(|i| t.a(i) as f64 * step * inv_w[i]);
+        let qy = each3(|i| t.b(i) as f64 * step * inv_w[i]);
+        let sum = |w: [f64; 3]| uv[0] * w[0] + uv[1] * w[1] + uv[2] * w[2];
+        let total = q[0] + q[1] + q[2];
+        let at = sum(q) / total;
+        let d = |w: [f64; 3]| (sum(w) - at * (w[0] + w[1] + w[2])) / total;
+        [at.as_vec2(), d(qx).as_vec2(), d(qy).as_vec2()]
+    }
+
     /// The colour of triangle `id` at the centre of pixel `(px, py)`, perspective-correct, by
-    /// phong-core's `Object::shade` (or the vertices' or the triangle's colours it made).
-    pub(crate) fn shade_pixel(&self, id: u32, px: u32, py: u32) -> [f32; 4] {
+    /// phong-core's `Object::shade` (or the vertices' or the triangle's colours it made), or for
+    /// a textured object its texels applied as `shade_textured` does; `None` where the alpha
+    /// test discards the point.
+    pub(crate) fn shade_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
         let (t, corners) = (self.tri(id), self.corners(id));
+        let obj = &self.scene.objects[self.object(id)];
+        if obj.textured() && lit_term(obj.shading.output).is_some() {
+            return self.shade_textured_pixel(id, px, py);
+        }
         let q = Self::weights(t, corners, px, py);
         let v = &corners.v;
         let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
@@ -267,7 +296,7 @@ impl Frame<'_> {
         let c = match output {
             Output::Normal => {
                 let n = match corners.flat {
-                    Some((_, n)) => n,
+                    Some((_, _, n)) => n,
                     None if t.back => -lerp3(|v| v.normal).normalize_or_zero(),
                     None => lerp3(|v| v.normal).normalize_or_zero(),
                 };
@@ -275,7 +304,7 @@ impl Frame<'_> {
             }
             Output::Depth => depth_color(&scene.camera, lerp3(|v| v.world)),
             _ => match (corners.flat, obj.shading.interpolation) {
-                (Some((c, _)), _) => c,
+                (Some((c, _, _)), _) => c,
                 (None, Interpolation::Gouraud) => {
                     let c = if t.back {
                         lerp3(|v| v.color_back)
@@ -292,7 +321,63 @@ impl Frame<'_> {
                 }
             },
         };
-        [c.r, c.g, c.b, 1.0]
+        Some([c.r, c.g, c.b, 1.0])
+    }
+
+    /// [`Frame::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
+    /// pixel's texture coordinates with their exact derivatives, then applied to the light per
+    /// pixel (Phong: `shade_textured`) or to the primary and specular colours made per vertex
+    /// or triangle (Gouraud, flat: OpenGL's `GL_MODULATE` with a separate specular colour).
+    fn shade_textured_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
+        let (t, corners) = (self.tri(id), self.corners(id));
+        let obj = &self.scene.objects[self.object(id)];
+        let [uv, d_dx, d_dy] = Self::uv_at(t, corners, px, py);
+        let texels = obj.maps.sample(uv, d_dx, d_dy);
+        if obj.maps.discards(Maps::alpha(&obj.material, &texels)) {
+            return None;
+        }
+        let q = Self::weights(t, corners, px, py);
+        let v = &corners.v;
+        let lerp3 = |f: &dyn Fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
+        let color = |c: Vec3| Color::new(c.x, c.y, c.z);
+        let clamp = obj.shading.options.clamp;
+        let side = usize::from(t.back);
+        let c = match (corners.flat, obj.shading.interpolation) {
+            (Some((p, s, _)), _) => Lit {
+                primary: p,
+                specular: s,
+                ..Lit::default()
+            }
+            .modulate(&texels, clamp),
+            (None, Interpolation::Gouraud) => {
+                let p = if t.back {
+                    lerp3(&|v| v.color_back)
+                } else {
+                    lerp3(&|v| v.color)
+                };
+                Lit {
+                    primary: color(p),
+                    specular: color(lerp3(&|v| v.spec[side])),
+                    ..Lit::default()
+                }
+                .modulate(&texels, clamp)
+            }
+            _ => {
+                let n = lerp3(&|v| v.normal);
+                let point = SurfacePoint {
+                    position: lerp3(&|v| v.world),
+                    normal: if t.back { -n } else { n },
+                };
+                let options = ShadingOptions {
+                    two_sided: false,
+                    ..obj.shading.options
+                };
+                let view = &self.views[self.object(id)];
+                let s = shade_textured(&point, view, &obj.material, &texels, &self.scene.lighting, &options);
+                obj.shading.output.term(&s)
+            }
+        };
+        Some([c.r, c.g, c.b, 1.0])
     }
 }
 

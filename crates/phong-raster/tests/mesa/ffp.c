@@ -9,8 +9,12 @@
  *   material: ambient[3] diffuse[3] specular[3] emission[3] shininess
  *   NLIGHTS, then per light: position[4] (world; w = 0: direction towards the light)
  *     ambient[3] diffuse[3] specular[3] k0 k1 k2 spot_direction[3] cutoff exponent
- *   NVERTS, then per vertex: position[3] normal[3]
+ *   NVERTS, then per vertex: position[3] normal[3] uv[2]
  *   NTRIS, then per triangle: 3 indices
+ *   TW TH (0 0: no texture), then TW*TH RGBA texels (bytes, bottom row first), wrap (0 repeat,
+ *   1 clamp to edge, 2 mirrored repeat), filter (0 GL_LINEAR_MIPMAP_LINEAR, 1 GL_LINEAR,
+ *   2 GL_NEAREST); a texture is applied with GL_MODULATE and GL_SEPARATE_SPECULAR_COLOR, its
+ *   mipmaps built by the driver (glGenerateMipmap).
  */
 #define GL_GLEXT_PROTOTYPES
 #include <GL/osmesa.h>
@@ -78,16 +82,39 @@ int main(void) {
         glLightf(L, GL_SPOT_EXPONENT, expo);
     }
     int nv = (int)rd();
-    float *v = malloc(sizeof(float) * 6 * (nv > 0 ? nv : 1));
-    rdv(v, 6 * nv);
+    float *v = malloc(sizeof(float) * 8 * (nv > 0 ? nv : 1));
+    rdv(v, 8 * nv);
     int nt = (int)rd();
+    int *tri = malloc(sizeof(int) * 3 * (nt > 0 ? nt : 1));
+    for (int i = 0; i < 3 * nt; i++) tri[i] = (int)rd();
+    int tw = (int)rd(), th = (int)rd();
+    if (tw > 0 && th > 0) {
+        unsigned char *tex = malloc((size_t)tw * th * 4);
+        for (size_t i = 0; i < (size_t)tw * th * 4; i++) tex[i] = (unsigned char)rd();
+        int wrap = (int)rd(), filter = (int)rd();
+        GLenum wraps[3] = {GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT};
+        GLenum mins[3] = {GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR, GL_NEAREST};
+        GLuint id;
+        glGenTextures(1, &id);
+        glBindTexture(GL_TEXTURE_2D, id);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, tw, th, 0, GL_RGBA, GL_UNSIGNED_BYTE, tex);
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wraps[wrap]);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wraps[wrap]);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, mins[filter]);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter == 2 ? GL_NEAREST : GL_LINEAR);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glLightModeli(GL_LIGHT_MODEL_COLOR_CONTROL, GL_SEPARATE_SPECULAR_COLOR);
+        glEnable(GL_TEXTURE_2D);
+    }
     glBegin(GL_TRIANGLES);
-    for (int t = 0; t < nt; t++)
-        for (int k = 0; k < 3; k++) {
-            int i = (int)rd();
-            glNormal3fv(v + 6 * i + 3);
-            glVertex3fv(v + 6 * i);
-        }
+    for (int t = 0; t < 3 * nt; t++) {
+        int i = tri[t];
+        glTexCoord2fv(v + 8 * i + 6);
+        glNormal3fv(v + 8 * i + 3);
+        glVertex3fv(v + 8 * i);
+    }
     glEnd();
     glFinish();
     for (int y = h - 1; y >= 0; y--)
