@@ -788,3 +788,112 @@ fn thread_count_out_of_range_is_an_error() {
     };
     assert!(render(&scene, &options).is_ok());
 }
+
+/// The quad [−1, 1]² at `z`, facing +z, with texture coordinates `((x + 1)/2, (y + 1)/2)`.
+fn textured_quad(z: f32) -> Mesh {
+    let p = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    Mesh::new(
+        p.iter().map(|&(x, y)| Vec3::new(x, y, z)).collect(),
+        vec![Vec3::Z; 4],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap()
+    .with_uvs(
+        p.iter()
+            .map(|&(x, y)| glam::Vec2::new((x + 1.0) / 2.0, (y + 1.0) / 2.0))
+            .collect(),
+    )
+    .unwrap()
+}
+
+/// A 4×4 texture (top row first) of distinct colours; `alpha` per texel.
+fn texture_4x4(alpha: impl Fn(usize, usize) -> u16) -> (Vec<[u16; 4]>, std::sync::Arc<Texture>) {
+    let texels: Vec<[u16; 4]> = (0..16)
+        .map(|i| {
+            let (col, row) = (i % 4, i / 4);
+            [
+                (col as u16 * 60 + 20) * 257,
+                (row as u16 * 60 + 20) * 257,
+                128 * 257,
+                alpha(col, row),
+            ]
+        })
+        .collect();
+    let t = Texture::new(4, 4, &texels, 8).unwrap();
+    (texels, std::sync::Arc::new(t))
+}
+
+/// A diffuse map with nearest filtering on a quad lit head-on (N·L = 1, a white diffuse
+/// material, no ambient): each pixel is its texel, found by hand from the quad's coordinates,
+/// on every CPU path and interpolation.
+#[test]
+fn a_diffuse_map_is_sampled_at_each_pixel() {
+    let n = 64u32;
+    let m = Material::new(Color::BLACK, Color::WHITE, Color::BLACK, Color::BLACK, 1.0).unwrap();
+    let (texels, texture) = texture_4x4(|_, _| 65535);
+    let mut o = obj(textured_quad(0.0), m);
+    let mut map = TextureMap::new(texture);
+    map.sampler = Sampler::nearest(Wrap::Clamp);
+    o.maps.diffuse = Some(map);
+    for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
+        let s = scene(n, n, ortho_camera(2.0), vec![o.clone()], one_light(-Vec3::Z), interp);
+        for path in common::paths() {
+            let img = path.render(&s);
+            for y in 0..n {
+                for x in 0..n {
+                    let (wx, wy) = ortho_world(x, y, n, 2.0);
+                    let (u, v) = ((wx + 1.0) / 2.0, (wy + 1.0) / 2.0);
+                    // Texel column floor(4u); row floor(4v) from the bottom, 3 − it from the top.
+                    let (col, row) = ((u * 4.0) as usize, 3 - (v * 4.0) as usize);
+                    let t = texels[row * 4 + col];
+                    let want = Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
+                    let got = px(&img, x, y);
+                    assert!(
+                        (got - want).abs().max_element() < 1e-6,
+                        "{} {interp:?} ({x}, {y}): {got} vs {want}",
+                        path.name
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The alpha test: where the diffuse map's alpha is below the cutoff, the quad is not drawn
+/// (neither colour nor depth), and the red quad behind it shows.
+#[test]
+fn the_alpha_test_discards_colour_and_depth() {
+    let n = 64u32;
+    let m = Material::new(Color::BLACK, Color::WHITE, Color::BLACK, Color::BLACK, 1.0).unwrap();
+    // The left half of the texture is transparent.
+    let (_, texture) = texture_4x4(|col, _| if col < 2 { 0 } else { 65535 });
+    let mut front = obj(textured_quad(0.0), m);
+    let mut map = TextureMap::new(texture);
+    map.sampler = Sampler::nearest(Wrap::Clamp);
+    front.maps.diffuse = Some(map);
+    front.maps.alpha_cutoff = Some(0.5);
+    let red = Material::new(Color::BLACK, Color::BLACK, Color::BLACK, Color::new(1.0, 0.0, 0.0), 1.0).unwrap();
+    // The front quad is drawn first: a depth write where it is discarded would hide the back one.
+    let back = obj(textured_quad(-0.5), red);
+    let s = scene(
+        n,
+        n,
+        ortho_camera(2.0),
+        vec![front, back],
+        one_light(-Vec3::Z),
+        Interpolation::Phong,
+    );
+    for path in common::paths() {
+        let img = path.render(&s);
+        for y in 0..n {
+            for x in 0..n {
+                let got = px(&img, x, y);
+                if x < n / 2 {
+                    assert_eq!(got, Vec3::new(1.0, 0.0, 0.0), "{} ({x}, {y})", path.name);
+                } else {
+                    assert!(got.y > 0.0 && got.z > 0.0, "{} ({x}, {y}): {got}", path.name);
+                }
+            }
+        }
+    }
+}
