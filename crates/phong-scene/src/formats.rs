@@ -377,6 +377,7 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
         name: part_name(path),
         mesh,
         material: None,
+        maps: phong_core::Maps::default(),
         has_normals,
         origin,
     }])
@@ -403,6 +404,7 @@ fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
         name: part_name(path),
         mesh,
         material: None,
+        maps: phong_core::Maps::default(),
         has_normals: false,
         origin,
     }])

@@ -11,12 +11,19 @@
 //! KHR_materials_pbrSpecularGlossiness: `diffuse`, `specular` as given, `roughness = 1 −
 //! glossiness`. A primitive without a material gets OpenGL's default material (as an OBJ
 //! without MTL), not glTF's metallic default, which would be a black mirror here.
+//!
+//! Textures: the base colour texture (sRGB) is the diffuse map (modulating the diffuse and
+//! ambient colours as the factor does; its alpha multiplies the material's), the emissive
+//! texture (sRGB) the emission map, with their texture coordinate sets, KHR_texture_transform
+//! and samplers; `alphaMode: MASK` is the alpha test at `alphaCutoff`. Texture coordinates are
+//! flipped to OpenGL's (`v = 1 − v`: glTF's `v` runs down the image).
 
 use crate::formats::far_origin;
+use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use crate::{Error, ObjPart};
 use base64::Engine;
-use glam::{DMat3, DMat4, DVec3, Vec3};
-use phong_core::{Color, Material, Mesh};
+use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3};
+use phong_core::{Color, Filter, Maps, Material, Mesh, MipFilter, Sampler, UvTransform, Wrap};
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -120,6 +127,7 @@ pub fn read_gltf(
     let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut textures, mut colours, mut transparent) = (0usize, BTreeSet::new(), 0usize, 0usize);
+    let mut cache = TextureCache::default();
     // Positions in f64 world space for all parts, re-centred together below.
     let mut pending: Vec<Pending> = Vec::new();
     let mut triangles_total: u64 = 0;
@@ -191,6 +199,15 @@ pub fn read_gltf(
                     )));
                 }
             }
+            // The texture coordinate sets the material's textures use (checked like the others).
+            let mat = prim.material();
+            let sets: BTreeSet<u32> = texture_infos(&mat).iter().map(|(_, info)| info.tex_coord()).collect();
+            for &set in &sets {
+                if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
+                    check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Vec2], false)
+                        .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
+                }
+            }
             if prim.get(&::gltf::Semantic::Colors(0)).is_some() {
                 colours += 1;
             }
@@ -255,32 +272,74 @@ pub fn read_gltf(
                 }
                 None => (vec![Vec3::ZERO; n], false),
             };
-            let mat = prim.material();
             model.double_sided |= mat.double_sided();
             let material = mat.index().map(|_| {
                 for (name, t) in [
-                    (
-                        "baseColorTexture",
-                        mat.pbr_metallic_roughness().base_color_texture().is_some(),
-                    ),
                     (
                         "metallicRoughnessTexture",
                         mat.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
                     ),
                     ("normalTexture", mat.normal_texture().is_some()),
                     ("occlusionTexture", mat.occlusion_texture().is_some()),
-                    ("emissiveTexture", mat.emissive_texture().is_some()),
                 ] {
                     if t {
                         textures.insert(name);
                     }
                 }
                 let m = phong_material(&mat);
-                if m.alpha() < 1.0 || mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
+                if m.alpha() < 1.0 || mat.alpha_mode() == ::gltf::material::AlphaMode::Blend {
                     transparent += 1;
                 }
                 m
             });
+            // The textures' coordinates: one set for the mesh (the base colour's, else the
+            // first used), v flipped to OpenGL's.
+            let infos = texture_infos(&mat);
+            let set = infos.first().map(|(_, i)| i.tex_coord());
+            let uvs: Vec<Vec2> = match set.and_then(|s| reader.read_tex_coords(s)) {
+                Some(t) => {
+                    let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
+                    if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
+                        uv
+                    } else {
+                        Vec::new()
+                    }
+                }
+                None => Vec::new(),
+            };
+            let maps = if mat.index().is_some() && !uvs.is_empty() {
+                let requests: Vec<MapRequest> = infos
+                    .iter()
+                    .filter(|(_, info)| Some(info.tex_coord()) == set)
+                    .filter_map(|(slot, info)| texture_request(*slot, info, &buffers, &what))
+                    .collect();
+                if infos.iter().any(|(_, info)| Some(info.tex_coord()) != set) {
+                    warnings.push(format!(
+                        "{}: {what}: textures on a second texture coordinate set are not used",
+                        path.display()
+                    ));
+                }
+                let mut maps = resolve(
+                    &requests,
+                    mat.name().unwrap_or("(unnamed)"),
+                    resource,
+                    &mut cache,
+                    warnings,
+                );
+                if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
+                    maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
+                }
+                maps
+            } else {
+                if !infos.is_empty() {
+                    warnings.push(format!(
+                        "{}: {what}: textures not used: the primitive has no usable TEXCOORD_{}",
+                        path.display(),
+                        set.unwrap_or(0)
+                    ));
+                }
+                Maps::default()
+            };
             let name = format!(
                 "{}:{}",
                 path.file_name()
@@ -296,6 +355,8 @@ pub fn read_gltf(
                 tris,
                 material,
                 has_normals,
+                uvs,
+                maps,
             });
         }
     }
@@ -318,7 +379,7 @@ pub fn read_gltf(
     if !textures.is_empty() {
         let names: Vec<&str> = textures.into_iter().collect();
         warnings.push(format!(
-            "{file}: textures are not rendered yet ({}): the factors alone are used",
+            "{file}: textures not rendered yet ({}): the factors alone are used for them",
             names.join(", ")
         ));
     }
@@ -341,14 +402,19 @@ pub fn read_gltf(
         tris,
         material,
         has_normals,
+        uvs,
+        maps,
     } in pending
     {
         let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
-        let mesh = Mesh::new(positions, normals, tris).map_err(|e| fail(format!("{name}: {e}")))?;
+        let mesh = Mesh::new(positions, normals, tris)
+            .and_then(|m| m.with_uvs(uvs))
+            .map_err(|e| fail(format!("{name}: {e}")))?;
         model.parts.push(ObjPart {
             name,
             mesh,
             material,
+            maps,
             has_normals,
             origin,
         });
@@ -437,6 +503,8 @@ fn node_instances<'a>(
 /// A primitive read, in f64 world space, waiting for the model's common origin.
 struct Pending {
     name: String,
+    uvs: Vec<Vec2>,
+    maps: Maps,
     world_pos: Vec<DVec3>,
     normals: Vec<Vec3>,
     tris: Vec<[u32; 3]>,
@@ -562,4 +630,94 @@ fn percent_decode(s: &str) -> String {
         }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The textures a material uses that phong renders, with their slots: base colour (or
+/// KHR_materials_pbrSpecularGlossiness's diffuse texture), emissive.
+fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<(Slot, ::gltf::texture::Info<'a>)> {
+    let mut out = Vec::new();
+    let diffuse = match mat.pbr_specular_glossiness() {
+        Some(sg) => sg.diffuse_texture(),
+        None => mat.pbr_metallic_roughness().base_color_texture(),
+    };
+    if let Some(t) = diffuse {
+        out.push((Slot::Diffuse, t));
+    }
+    if let Some(t) = mat.emissive_texture() {
+        out.push((Slot::Emission, t));
+    }
+    out
+}
+
+/// A glTF texture as a map request: its image (a buffer view's bytes, a data URI, or a file
+/// read by the loader's reader), sampler and KHR_texture_transform, in OpenGL's coordinates.
+fn texture_request(slot: Slot, info: &::gltf::texture::Info, buffers: &[Vec<u8>], what: &str) -> Option<MapRequest> {
+    let texture = info.texture();
+    let name = format!("image {}", texture.source().index());
+    let source = match texture.source().source() {
+        ::gltf::image::Source::View { view, .. } => {
+            let data = buffers.get(view.buffer().index())?;
+            let end = view.offset().checked_add(view.length())?;
+            Source::Bytes(std::sync::Arc::new(data.get(view.offset()..end)?.to_vec()), name)
+        }
+        ::gltf::image::Source::Uri { uri, .. } => match uri.strip_prefix("data:") {
+            Some(rest) => {
+                let (_, data) = rest.split_once(";base64,")?;
+                let bytes = base64::engine::general_purpose::STANDARD.decode(data).ok()?;
+                Source::Bytes(std::sync::Arc::new(bytes), name)
+            }
+            None => Source::File(percent_decode(uri)),
+        },
+    };
+    let s = texture.sampler();
+    let wrap = |w: ::gltf::texture::WrappingMode| match w {
+        ::gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+    };
+    use ::gltf::texture::{MagFilter, MinFilter};
+    let (min, mip) = match s.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, MipFilter::None),
+        Some(MinFilter::Linear) => (Filter::Linear, MipFilter::None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, MipFilter::Nearest),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, MipFilter::Nearest),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, MipFilter::Linear),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, MipFilter::Linear),
+    };
+    let sampler = Sampler {
+        wrap_u: wrap(s.wrap_s()),
+        wrap_v: wrap(s.wrap_t()),
+        mag: if s.mag_filter() == Some(MagFilter::Nearest) {
+            Filter::Nearest
+        } else {
+            Filter::Linear
+        },
+        min,
+        mip,
+    };
+    // glTF's transform acts on its coordinates (v down); ours are flipped: F·M·F.
+    let flip = UvTransform {
+        linear: Mat2::from_diagonal(Vec2::new(1.0, -1.0)),
+        offset: Vec2::new(0.0, 1.0),
+    };
+    let m = match info.texture_transform() {
+        Some(t) => {
+            let (sin, cos) = t.rotation().sin_cos();
+            let rotation = Mat2::from_cols(Vec2::new(cos, -sin), Vec2::new(sin, cos));
+            UvTransform {
+                linear: rotation * Mat2::from_diagonal(Vec2::from(t.scale())),
+                offset: Vec2::from(t.offset()),
+            }
+        }
+        None => UvTransform::default(),
+    };
+    Some(MapRequest {
+        slot,
+        source,
+        transform: flip.after(&m.after(&flip)),
+        sampler,
+        channel: None,
+        srgb: true,
+        at: what.to_string(),
+    })
 }

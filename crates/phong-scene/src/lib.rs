@@ -17,6 +17,7 @@ mod overrides;
 mod png_out;
 mod polygon;
 mod read;
+mod texture_file;
 mod toml_scene;
 
 pub use error::Error;
@@ -31,6 +32,7 @@ pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
+pub use texture_file::{ReadFile, decode as decode_texture};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_with,
 };

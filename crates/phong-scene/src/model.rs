@@ -625,6 +625,7 @@ mod tests {
             name: "t".into(),
             mesh,
             material: None,
+            maps: Default::default(),
             has_normals: false,
             origin: DVec3::ZERO,
         }

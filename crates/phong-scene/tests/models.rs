@@ -582,7 +582,15 @@ fn shared_gltf_samples() {
         let parts = load_model(&g.join(f), &mut w).unwrap();
         let tris: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
         assert_eq!(tris, 12, "{f}");
-        assert!(w.iter().any(|w| w.contains("baseColorTexture")), "{f}: {w:?}");
+        // The Cesium logo (a 211×211 PNG, external, embedded or in the GLB) is the diffuse map.
+        let map = parts[0]
+            .maps
+            .diffuse
+            .as_ref()
+            .unwrap_or_else(|| panic!("{f}: no diffuse map: {w:?}"));
+        assert_eq!((map.texture.width(), map.texture.height()), (211, 211), "{f}");
+        assert!(parts[0].mesh.has_uvs(), "{f}");
+        assert!(!w.iter().any(|w| w.contains("Texture")), "{f}: {w:?}");
     }
     let engine = load_model(
         &g.join("2CylinderEngine-glTF-Binary/2CylinderEngine.glb"),

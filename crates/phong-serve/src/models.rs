@@ -150,8 +150,18 @@ pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, Stri
         })?;
         String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
     };
+    // Texture images, likewise among the uploads by file name.
+    let image = |name: &str| -> Result<Vec<u8>, String> {
+        let key = name.rsplit(['/', '\\']).next().unwrap_or(name);
+        files
+            .0
+            .get(key)
+            .map(|f| f.to_vec())
+            .ok_or_else(|| format!("{key} is not uploaded (upload it with the OBJ)"))
+    };
     let mut warnings = Vec::new();
-    let parts = phong_scene::load_obj_text(Path::new(name), src, &read, &mut warnings).map_err(|e| e.to_string())?;
+    let parts =
+        phong_scene::load_obj_text(Path::new(name), src, &read, &image, &mut warnings).map_err(|e| e.to_string())?;
     Ok(LoadedModel::new(parts, ModelFormat::Obj))
 }
 

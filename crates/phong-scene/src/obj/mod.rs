@@ -10,6 +10,8 @@
 //! `illum` 0 → a constant colour `Kd` (as emission, nothing lit), 1 →
 //! Lambert (no specular), 2 → Blinn-Phong; other models are rendered as 2
 //! with a warning. Missing `Ka`/`Kd`/`Ks` take OpenGL's default material's values.
+//! Texture maps (`map_Kd`, `map_Ka`, `map_Ks`, `map_Ke`, `map_Ns`, `map_d`) with their `-o`,
+//! `-s`, `-clamp` and `-imfchan` options: see `texture_file.rs`.
 
 //!
 //! The preparation of the OBJ's text is in `text.rs`, the MTL libraries in `mtl.rs`.
@@ -18,9 +20,10 @@ mod mtl;
 mod text;
 
 use crate::Error;
-use glam::{DVec3, Vec3};
+use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, resolve};
+use glam::{DVec3, Vec2, Vec3};
 use mtl::{check_mtl, mtl_names, normalize_mtl, to_material};
-use phong_core::{Material, Mesh};
+use phong_core::{Maps, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -35,6 +38,8 @@ pub struct ObjPart {
     pub mesh: Mesh,
     /// Its MTL material, if any.
     pub material: Option<Material>,
+    /// Its material's texture maps (none where it has none, or none could be read).
+    pub maps: Maps,
     /// True when the file gave normals for every vertex of this part.
     pub has_normals: bool,
     /// The point the positions are relative to, in the file's coordinates: a model far from
@@ -142,6 +147,22 @@ pub(crate) fn obj_from_text(
             })?;
             Ok(decode_text(&p, bytes, &mut latin1.borrow_mut()))
         },
+        &|name| {
+            // As written, else the file name beside the OBJ (a path from another machine).
+            let p = dir.join(name);
+            let base = Path::new(name).file_name().map(|b| dir.join(b));
+            let found = match base {
+                Some(b) if !p.exists() && b.exists() => b,
+                _ => p,
+            };
+            read_mtl.borrow_mut().push(found.clone());
+            crate::read_bounded(&found, phong_core::limits::MAX_IMAGE_FILE_BYTES, "texture image").map_err(
+                |e| match e {
+                    Error::Read { source, .. } => format!("cannot read {}: {source}", found.display()),
+                    other => other.to_string(),
+                },
+            )
+        },
         warnings,
     );
     warnings.extend(latin1.into_inner());
@@ -150,11 +171,14 @@ pub(crate) fn obj_from_text(
 }
 
 /// [`load_obj`] of an OBJ's text `src` (named `path` in messages), its MTL libraries read by
-/// `read_mtl` (given the name the `mtllib` line gives).
+/// `read_mtl` (given the name the `mtllib` line gives) and their texture images by
+/// `read_texture` (given the name relative to the OBJ's folder: the MTL's folder joined with
+/// the name the statement gives).
 pub fn load_obj_text(
     path: &Path,
     src: &str,
     read_mtl: &dyn Fn(&Path) -> std::io::Result<String>,
+    read_texture: &ReadFile,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ObjPart>, Error> {
     let prepared = prepare_obj(path, src)?;
@@ -162,6 +186,7 @@ pub fn load_obj_text(
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
     let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
+    let map_requests: std::cell::RefCell<Vec<(String, MapRequest)>> = Default::default();
     let opts = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
@@ -195,10 +220,20 @@ pub fn load_obj_text(
             let p: PathBuf = dir.join(lib);
             match result {
                 Ok(t) => {
-                    if let Err(e) = check_mtl(&p, &t, &mut mtl_warnings.borrow_mut()) {
+                    let mut requests = Vec::new();
+                    if let Err(e) = check_mtl(&p, &t, &mut mtl_warnings.borrow_mut(), &mut requests) {
                         *mtl_error.borrow_mut() = Some(e);
                         return Err(tobj::LoadError::MaterialParseError);
                     }
+                    // Texture names are relative to the library's folder; backslashes are
+                    // separators.
+                    let lib_dir = lib.parent().unwrap_or(Path::new(""));
+                    for (_, r) in &mut requests {
+                        if let Source::File(f) = &mut r.source {
+                            *f = lib_dir.join(f.replace('\\', "/")).to_string_lossy().into_owned();
+                        }
+                    }
+                    map_requests.borrow_mut().extend(requests);
                     text.push_str(&normalize_mtl(&t));
                     text.push('\n');
                     found = true;
@@ -254,8 +289,22 @@ pub fn load_obj_text(
             format!("malformed OBJ: {e} (tobj does not say where; the first `{kw}` statement is shown)"),
         )
     })?;
-    let materials: Vec<tobj::Material> = materials.unwrap_or_default();
-    let materials: Vec<Material> = materials.iter().map(to_material).collect();
+    let tobj_materials: Vec<tobj::Material> = materials.unwrap_or_default();
+    let materials: Vec<Material> = tobj_materials.iter().map(to_material).collect();
+    // Each material's maps, its images read once for the whole file.
+    let requests = map_requests.into_inner();
+    let mut cache = TextureCache::default();
+    let maps: Vec<Maps> = tobj_materials
+        .iter()
+        .map(|m| {
+            let mine: Vec<MapRequest> = requests
+                .iter()
+                .filter(|(name, _)| *name == m.name)
+                .map(|(_, r)| r.clone())
+                .collect();
+            resolve(&mine, &m.name, read_texture, &mut cache, warnings)
+        })
+        .collect();
     let file = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -281,15 +330,27 @@ pub fn load_obj_text(
             vec![Vec3::ZERO; positions.len()]
         };
         let tris = polygons_to_triangles(&positions, &m.indices, &m.face_arities);
+        let n = positions.len();
+        // One texture coordinate per vertex where the file gives them (tobj's single index).
+        let uvs: Vec<Vec2> = if m.texcoords.len() == 2 * n {
+            m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])).collect()
+        } else {
+            Vec::new()
+        };
         let mesh = Mesh::new(positions, normals, tris)
+            .and_then(|mesh| mesh.with_uvs(uvs))
             .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
-        parts.push(ObjPart {
-            name: format!("{file}:{}", model.name),
-            mesh,
-            material: m.material_id.and_then(|i| materials.get(i).copied()),
-            has_normals,
-            origin: prepared.origin,
-        });
+        parts.push((
+            ObjPart {
+                name: format!("{file}:{}", model.name),
+                mesh,
+                material: m.material_id.and_then(|i| materials.get(i).copied()),
+                maps: m.material_id.and_then(|i| maps.get(i).cloned()).unwrap_or_default(),
+                has_normals,
+                origin: prepared.origin,
+            },
+            m.material_id,
+        ));
     }
     if parts.is_empty() {
         return Err(Error::at(
@@ -312,19 +373,9 @@ pub fn load_obj_text(
     }
     // Merge parts that share a material within the same group name.
     let mut merged: Vec<ObjPart> = Vec::new();
-    let mut index: HashMap<(String, Option<[u32; 4]>), usize> = HashMap::new();
-    for p in parts {
-        let key = (
-            p.name.clone(),
-            p.material.map(|m| {
-                [
-                    m.diffuse().r.to_bits(),
-                    m.diffuse().g.to_bits(),
-                    m.specular().r.to_bits(),
-                    m.shininess().to_bits(),
-                ]
-            }),
-        );
+    let mut index: HashMap<(String, Option<usize>), usize> = HashMap::new();
+    for (p, id) in parts {
+        let key = (p.name.clone(), id);
         match index.get(&key) {
             Some(&i) if merged[i].has_normals == p.has_normals => merged[i].mesh.append(&p.mesh),
             _ => {

@@ -4,6 +4,7 @@
 
 use super::text::{Checker, lines};
 use crate::Error;
+use crate::texture_file::{MapRequest, parse_mtl_map};
 use phong_core::{Color, Material};
 use std::path::{Path, PathBuf};
 
@@ -69,19 +70,44 @@ pub(super) fn normalize_mtl(src: &str) -> String {
     out
 }
 
-/// Checks an MTL file's values; returns the warnings (unsupported `illum`).
-pub(super) fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> Result<(), Error> {
+/// Checks an MTL file's values; adds the warnings (unsupported `illum`, texture statements and
+/// options not used) and each material's texture map statements (`(material, request)`).
+pub(super) fn check_mtl(
+    path: &Path,
+    src: &str,
+    warnings: &mut Vec<String>,
+    maps: &mut Vec<(String, MapRequest)>,
+) -> Result<(), Error> {
     let c = Checker { path, src };
-    let mut maps: Vec<&str> = Vec::new();
+    let mut unused: Vec<&str> = Vec::new();
     let mut transparent = 0usize;
+    let mut current = String::new();
     for (start, line) in lines(src) {
         let content = line.split('#').next().unwrap_or("");
         let mut it = content.split_whitespace();
         let Some(kw) = it.next() else { continue };
         let rest: Vec<&str> = it.collect();
-        if (kw.starts_with("map_") || matches!(kw, "bump" | "norm" | "disp" | "decal" | "refl")) && !maps.contains(&kw)
-        {
-            maps.push(kw);
+        if kw == "newmtl" {
+            current = rest.join(" ");
+        }
+        let is_map = kw.starts_with("map_") || matches!(kw, "bump" | "norm" | "disp" | "decal" | "refl");
+        if is_map {
+            let (l, _) = crate::error::line_col(src, start);
+            match parse_mtl_map(kw, &rest) {
+                Ok(Some((mut request, options))) => {
+                    request.at = format!("{}:{l}", path.display());
+                    for o in options {
+                        warnings.push(format!("{}: {kw} option {o} is not used", request.at));
+                    }
+                    maps.push((current.clone(), request));
+                }
+                Ok(None) => {
+                    if !unused.contains(&kw) {
+                        unused.push(kw);
+                    }
+                }
+                Err(why) => warnings.push(format!("{}:{l}: {kw} {why}: not used", path.display())),
+            }
         }
         let opacity = match (kw, rest.first().and_then(|x| x.parse::<f32>().ok())) {
             ("d", Some(d)) => Some(d),
@@ -144,11 +170,11 @@ pub(super) fn check_mtl(path: &Path, src: &str, warnings: &mut Vec<String>) -> R
             _ => {}
         }
     }
-    if !maps.is_empty() {
+    if !unused.is_empty() {
         warnings.push(format!(
-            "{}: texture maps are not rendered yet ({}): the materials' colours alone are used",
+            "{}: texture statements not used: {}",
             path.display(),
-            maps.join(", ")
+            unused.join(", ")
         ));
     }
     if transparent > 0 {

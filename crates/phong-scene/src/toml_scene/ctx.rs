@@ -20,6 +20,8 @@ pub(crate) struct Ctx<'a> {
     /// Where `mesh = "..."` names come from: `None` reads files beside the scene; `Some`
     /// looks them up in memory (the server's uploads) and never opens a file.
     pub meshes: Option<&'a MeshLookup<'a>>,
+    /// Texture images read so far (a file named by several materials is read once).
+    pub textures: crate::texture_file::TextureCache,
 }
 
 /// Resolves a `mesh` name to its parts without touching the file system (the error is the

@@ -73,6 +73,7 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         sources: Vec::new(),
         triangles: std::cell::Cell::new(0),
         meshes,
+        textures: Default::default(),
     };
     let scene = build(&mut ctx, raw)?;
     Ok(Loaded {

@@ -2,13 +2,13 @@
 
 use super::choices::SHAPES;
 use super::ctx::{Ctx, S};
-use super::material::{lookup_material, material};
+use super::material::{Mat, lookup_material, material};
 use super::raw::{MaterialRef, RawMaterial, RawObject, Scale};
 use crate::Error;
 use crate::load_model_sources;
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::MAX_SEGMENTS;
-use phong_core::{Maps, Material, Mesh, Object, ShadingSettings, primitives};
+use phong_core::{Maps, Mesh, Object, ShadingSettings, primitives};
 use std::collections::BTreeMap;
 use std::path::Path;
 use toml::Spanned;
@@ -16,7 +16,7 @@ use toml::Spanned;
 pub(super) fn object(
     ctx: &mut Ctx,
     o: &S<RawObject>,
-    named: &BTreeMap<String, Material>,
+    named: &BTreeMap<String, Mat>,
     shading: ShadingSettings,
 ) -> Result<Vec<Object>, Error> {
     let span = o.span();
@@ -28,6 +28,9 @@ pub(super) fn object(
             MaterialRef::Inline(p) => {
                 let sp = |v: &Option<Vec<f32>>| v.clone().map(|v| Spanned::new(m.span(), v));
                 let spf = |v: Option<f32>| v.map(|v| Spanned::new(m.span(), v));
+                fn at<T>(span: std::ops::Range<usize>, v: Option<T>) -> Option<S<T>> {
+                    v.map(|v| Spanned::new(span, v))
+                }
                 let raw = RawMaterial {
                     base: p.base.clone().map(|b| Spanned::new(m.span(), b)),
                     paint: sp(&p.paint),
@@ -37,6 +40,21 @@ pub(super) fn object(
                     emission: sp(&p.emission),
                     shininess: spf(p.shininess),
                     alpha: spf(p.alpha),
+                    diffuse_map: at(m.span(), p.diffuse_map.clone()),
+                    ambient_map: at(m.span(), p.ambient_map.clone()),
+                    specular_map: at(m.span(), p.specular_map.clone()),
+                    emission_map: at(m.span(), p.emission_map.clone()),
+                    shininess_map: at(m.span(), p.shininess_map.clone()),
+                    alpha_map: at(m.span(), p.alpha_map.clone()),
+                    normal_map: at(m.span(), p.normal_map.clone()),
+                    bump_map: at(m.span(), p.bump_map.clone()),
+                    bump_scale: at(m.span(), p.bump_scale.clone()),
+                    uv_scale: at(m.span(), p.uv_scale.clone()),
+                    uv_offset: at(m.span(), p.uv_offset.clone()),
+                    wrap: at(m.span(), p.wrap.clone()),
+                    filter: at(m.span(), p.filter.clone()),
+                    encoding: at(m.span(), p.encoding.clone()),
+                    alpha_cutoff: at(m.span(), p.alpha_cutoff.clone()),
                 };
                 material(ctx, &raw, "material", named)?
             }
@@ -129,12 +147,13 @@ pub(super) fn object(
                 return ctx.err(&f.span(), "fit", "only a mesh has `fit`; a shape is already unit-sized");
             }
             let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
+            let (material, maps) = material.unwrap_or_default();
             Ok(vec![Object {
                 name: kind.to_string(),
                 mesh: mesh.transformed(&world_from_object),
-                material: material.unwrap_or_default(),
+                material,
                 shading,
-                maps: Maps::default(),
+                maps,
             }])
         }
         (None, Some(m)) => {
@@ -186,12 +205,11 @@ pub(super) fn object(
                         .iter()
                         .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
                         .collect();
-                    p.mesh =
-                        Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec()).map_err(|e| {
-                            Error::Model {
-                                path: ctx.path.to_path_buf(),
-                                message: format!("{}: {e}", p.name),
-                            }
+                    p.mesh = Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec())
+                        .and_then(|m| m.with_uvs(p.mesh.uvs().to_vec()))
+                        .map_err(|e| Error::Model {
+                            path: ctx.path.to_path_buf(),
+                            message: format!("{}: {e}", p.name),
                         })?;
                 }
                 // File normals where every vertex has a usable one; else, or where `"file"`
@@ -224,12 +242,23 @@ pub(super) fn object(
                     "angle" => p.mesh.with_crease_normals(crease),
                     _ => p.mesh,
                 };
+                // The scene's material replaces the file's, maps and all.
+                let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
+                let maps = if !maps.is_empty() && !mesh.has_uvs() {
+                    warnings.push(format!(
+                        "{}: its material has texture maps but the model has no texture coordinates: maps not used",
+                        p.name
+                    ));
+                    Maps::default()
+                } else {
+                    maps
+                };
                 out.push(Object {
                     name: p.name,
                     mesh: mesh.transformed(&world_from_file),
-                    material: material.or(p.material).unwrap_or_default(),
+                    material,
                     shading,
-                    maps: Maps::default(),
+                    maps,
                 });
             }
             let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();

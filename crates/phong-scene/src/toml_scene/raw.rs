@@ -99,6 +99,21 @@ pub(crate) struct RawMaterial {
     pub emission: Option<S<Vec<f32>>>,
     pub shininess: Option<S<f32>>,
     pub alpha: Option<S<f32>>,
+    pub diffuse_map: Option<S<String>>,
+    pub ambient_map: Option<S<String>>,
+    pub specular_map: Option<S<String>>,
+    pub emission_map: Option<S<String>>,
+    pub shininess_map: Option<S<String>>,
+    pub alpha_map: Option<S<String>>,
+    pub normal_map: Option<S<String>>,
+    pub bump_map: Option<S<String>>,
+    pub bump_scale: Option<S<f32>>,
+    pub uv_scale: Option<S<Vec<f32>>>,
+    pub uv_offset: Option<S<Vec<f32>>>,
+    pub wrap: Option<S<String>>,
+    pub filter: Option<S<String>>,
+    pub encoding: Option<S<String>>,
+    pub alpha_cutoff: Option<S<f32>>,
 }
 
 /// An inline material table: the same keys, without per-key spans (serde's
@@ -114,6 +129,21 @@ pub(crate) struct PlainMaterial {
     pub emission: Option<Vec<f32>>,
     pub shininess: Option<f32>,
     pub alpha: Option<f32>,
+    pub diffuse_map: Option<String>,
+    pub ambient_map: Option<String>,
+    pub specular_map: Option<String>,
+    pub emission_map: Option<String>,
+    pub shininess_map: Option<String>,
+    pub alpha_map: Option<String>,
+    pub normal_map: Option<String>,
+    pub bump_map: Option<String>,
+    pub bump_scale: Option<f32>,
+    pub uv_scale: Option<Vec<f32>>,
+    pub uv_offset: Option<Vec<f32>>,
+    pub wrap: Option<String>,
+    pub filter: Option<String>,
+    pub encoding: Option<String>,
+    pub alpha_cutoff: Option<f32>,
 }
 
 #[derive(Deserialize)]

@@ -1,0 +1,353 @@
+//! Texture maps as files name them: images decoded (the `image` crate: PNG, JPEG, TGA, BMP;
+//! 8 and 16 bits, grey, grey and alpha, RGB, RGBA, palette), MTL map statements and their
+//! options, and a material's requests turned into phong-core's [`Maps`].
+//!
+//! A map whose image is missing or cannot be decoded is a warning naming the material, the
+//! file and why; the material is drawn without it (as three.js does).
+
+use phong_core::limits::{MAX_IMAGE_FILE_BYTES, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
+use phong_core::{Channel, Maps, Sampler, Texture, TextureMap, UvTransform, Wrap};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Which map of a material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// `map_Kd`, `diffuse_map`, glTF's base colour texture.
+    Diffuse,
+    /// `map_Ka`, `ambient_map`.
+    Ambient,
+    /// `map_Ks`, `specular_map`.
+    Specular,
+    /// `map_Ke`, `emission_map`, glTF's emissive texture.
+    Emission,
+    /// `map_Ns`, `shininess_map`.
+    Shininess,
+    /// `map_d`, `alpha_map`.
+    Alpha,
+    /// `bump`, `map_Bump`, `bump_map`: a height map.
+    Bump,
+    /// `norm`, `normal_map`, glTF's normal texture: a tangent-space normal map.
+    Normal,
+}
+
+impl Slot {
+    /// Colour maps are decoded from sRGB where the material asks; data maps never are.
+    fn is_colour(self) -> bool {
+        matches!(self, Slot::Diffuse | Slot::Ambient | Slot::Specular | Slot::Emission)
+    }
+}
+
+/// Where a texture's bytes come from.
+#[derive(Clone, Debug)]
+pub enum Source {
+    /// A file name as the MTL, scene or glTF gives it, read by the loader's reader.
+    File(String),
+    /// Bytes embedded in the model (a glTF data URI or buffer view), named for messages.
+    Bytes(Arc<Vec<u8>>, String),
+}
+
+impl Source {
+    fn name(&self) -> &str {
+        match self {
+            Source::File(f) => f,
+            Source::Bytes(_, name) => name,
+        }
+    }
+}
+
+/// A map a material asks for, before its image is read.
+#[derive(Clone, Debug)]
+pub struct MapRequest {
+    /// Which map.
+    pub slot: Slot,
+    /// The image.
+    pub source: Source,
+    /// Applied to the mesh's coordinates.
+    pub transform: UvTransform,
+    /// Sampler (wrap and filters).
+    pub sampler: Sampler,
+    /// The channel of a scalar map (`None`: the default, see [`resolve`]).
+    pub channel: Option<Channel>,
+    /// Decode a colour map from sRGB.
+    pub srgb: bool,
+    /// Where the request is, for messages (`file.mtl:12`, `scene.toml: materials.brick`).
+    pub at: String,
+}
+
+/// Decoded textures by (name, sRGB), so that a file named by several materials is read once.
+#[derive(Default)]
+pub struct TextureCache {
+    done: HashMap<(String, bool), Result<Arc<Texture>, String>>,
+}
+
+/// Reads a file named by a map (the name as written; the reader resolves it).
+pub type ReadFile<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
+
+impl TextureCache {
+    fn load(&mut self, source: &Source, srgb: bool, read: &ReadFile) -> Result<Arc<Texture>, String> {
+        let key = (source.name().to_string(), srgb);
+        if let Some(r) = self.done.get(&key) {
+            return r.clone();
+        }
+        let r = match source {
+            Source::File(f) => read(f).and_then(|b| decode(&b, srgb)),
+            Source::Bytes(b, _) => decode(b, srgb),
+        }
+        .map(Arc::new);
+        self.done.insert(key, r.clone());
+        r
+    }
+}
+
+/// Decodes an image into a texture: 8-bit sources keep 8 bits (read back as `b/255`), 16-bit
+/// and float sources 16; with `srgb` the colour channels are decoded to linear (in 16 bits),
+/// alpha never is.
+pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
+    if bytes.len() as u64 > MAX_IMAGE_FILE_BYTES {
+        return Err(format!("larger than {} MiB", MAX_IMAGE_FILE_BYTES >> 20));
+    }
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(MAX_TEXTURE_BYTES);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| e.to_string())?;
+    let bits = match img.color() {
+        image::ColorType::L8 | image::ColorType::La8 | image::ColorType::Rgb8 | image::ColorType::Rgba8 => 8,
+        _ => 16,
+    };
+    let (w, h) = (img.width(), img.height());
+    let rgba = img.into_rgba16();
+    let lut: Option<Vec<u16>> = srgb.then(|| {
+        (0..=u16::MAX)
+            .map(|v| {
+                let c = f64::from(v) / 65535.0;
+                let l = if c <= 0.04045 {
+                    c / 12.92
+                } else {
+                    ((c + 0.055) / 1.055).powf(2.4)
+                };
+                (l * 65535.0).round() as u16
+            })
+            .collect()
+    });
+    let texels: Vec<[u16; 4]> = rgba
+        .pixels()
+        .map(|p| match &lut {
+            Some(l) => [l[p[0] as usize], l[p[1] as usize], l[p[2] as usize], p[3]],
+            None => p.0,
+        })
+        .collect();
+    Texture::new(w, h, &texels, if srgb { 16 } else { bits }).map_err(|e| e.to_string())
+}
+
+/// A material's maps from its requests, images read by `read` through `cache`; every request
+/// that cannot be used is a warning (material `name`), and the material goes without it.
+///
+/// A scalar map without a channel reads alpha where its image has any (`map_d` as most files
+/// mean it), else luminance (MTL's default). An alpha map turns on the alpha test at 0.5.
+pub fn resolve(
+    requests: &[MapRequest],
+    name: &str,
+    read: &ReadFile,
+    cache: &mut TextureCache,
+    warnings: &mut Vec<String>,
+) -> Maps {
+    let mut maps = Maps::default();
+    for r in requests {
+        if matches!(r.slot, Slot::Bump | Slot::Normal) {
+            warnings.push(format!(
+                "{}: material {name}: {} map {} is not used (bump and normal maps are not rendered yet)",
+                r.at,
+                if r.slot == Slot::Bump { "bump" } else { "normal" },
+                r.source.name()
+            ));
+            continue;
+        }
+        let texture = match cache.load(&r.source, r.srgb && r.slot.is_colour(), read) {
+            Ok(t) => t,
+            Err(why) => {
+                warnings.push(format!(
+                    "{}: material {name}: texture {} not used: {why}",
+                    r.at,
+                    r.source.name()
+                ));
+                continue;
+            }
+        };
+        let channel = r.channel.unwrap_or(if texture.has_alpha() {
+            Channel::A
+        } else {
+            Channel::Luminance
+        });
+        let map = TextureMap {
+            texture,
+            sampler: r.sampler,
+            transform: r.transform,
+        };
+        match r.slot {
+            Slot::Diffuse => maps.diffuse = Some(map),
+            Slot::Ambient => maps.ambient = Some(map),
+            Slot::Specular => maps.specular = Some(map),
+            Slot::Emission => maps.emission = Some(map),
+            Slot::Shininess => maps.shininess = Some((map, channel)),
+            Slot::Alpha => {
+                maps.alpha = Some((map, channel));
+                maps.alpha_cutoff.get_or_insert(0.5);
+            }
+            Slot::Bump | Slot::Normal => {}
+        }
+    }
+    maps
+}
+
+/// An MTL texture statement (`map_Kd -s 2 2 -clamp on wood.png`): its slot, the request's
+/// transform, wrap and channel from the options, and the file name (the words after the
+/// options, spaces kept). Options that are read but not used are returned as warnings;
+/// `None` for a statement phong does not use (`disp`, `decal`, `refl`).
+pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<String>)>, String> {
+    let slot = match kw {
+        "map_Kd" => Slot::Diffuse,
+        "map_Ka" => Slot::Ambient,
+        "map_Ks" => Slot::Specular,
+        "map_Ke" => Slot::Emission,
+        "map_Ns" => Slot::Shininess,
+        "map_d" => Slot::Alpha,
+        "bump" | "map_Bump" | "map_bump" => Slot::Bump,
+        "norm" | "map_Kn" => Slot::Normal,
+        _ => return Ok(None),
+    };
+    let mut unused = Vec::new();
+    let (mut scale, mut offset) = ([1.0f32; 2], [0.0f32; 2]);
+    let mut wrap = Wrap::Repeat;
+    let mut channel = None;
+    let mut i = 0;
+    let num = |s: &str| s.parse::<f32>().ok().filter(|x| x.is_finite());
+    while i < args.len() && args[i].starts_with('-') && num(args[i]).is_none() {
+        let opt = args[i];
+        i += 1;
+        // Options of up to three numbers take those that follow.
+        let mut numbers = Vec::new();
+        let take = |i: &mut usize, max: usize, numbers: &mut Vec<f32>| {
+            while numbers.len() < max && *i < args.len() && num(args[*i]).is_some() {
+                numbers.push(num(args[*i]).unwrap_or(0.0));
+                *i += 1;
+            }
+        };
+        match opt {
+            "-o" | "-s" | "-t" => {
+                take(&mut i, 3, &mut numbers);
+                if numbers.is_empty() {
+                    return Err(format!("{opt} needs numbers"));
+                }
+                let uv = [numbers[0], *numbers.get(1).unwrap_or(&numbers[0])];
+                match opt {
+                    "-o" => offset = uv,
+                    "-s" => scale = uv,
+                    _ => unused.push(format!("{opt} (turbulence)")),
+                }
+            }
+            "-clamp" => {
+                let v = args.get(i).copied().unwrap_or("");
+                i += 1;
+                wrap = match v {
+                    "on" => Wrap::Clamp,
+                    "off" => Wrap::Repeat,
+                    _ => return Err(format!("-clamp takes on or off, got {v:?}")),
+                };
+            }
+            "-imfchan" => {
+                let v = args.get(i).copied().unwrap_or("");
+                i += 1;
+                channel = Some(match v {
+                    "r" => Channel::R,
+                    "g" => Channel::G,
+                    "b" => Channel::B,
+                    "l" | "m" | "z" => Channel::Luminance,
+                    _ => return Err(format!("-imfchan takes r, g, b, m, l or z, got {v:?}")),
+                });
+                if !matches!(slot, Slot::Shininess | Slot::Alpha | Slot::Bump) {
+                    unused.push(format!("-imfchan {v} (a colour map uses every channel)"));
+                }
+            }
+            "-bm" => {
+                take(&mut i, 1, &mut numbers);
+                unused.push("-bm (bump maps are not rendered yet)".into());
+            }
+            "-mm" => {
+                take(&mut i, 2, &mut numbers);
+                unused.push("-mm".into());
+            }
+            "-boost" | "-texres" => {
+                take(&mut i, 1, &mut numbers);
+                unused.push(opt.to_string());
+            }
+            "-blendu" | "-blendv" | "-cc" | "-type" => {
+                i += 1;
+                unused.push(opt.to_string());
+            }
+            _ => unused.push(format!("{opt} (unknown option)")),
+        }
+    }
+    let file = args[i.min(args.len())..].join(" ");
+    if file.is_empty() {
+        return Err("names no file".into());
+    }
+    let request = MapRequest {
+        slot,
+        source: Source::File(file),
+        transform: UvTransform::scale_offset(scale.into(), offset.into()),
+        sampler: Sampler::trilinear(wrap),
+        channel,
+        srgb: false,
+        at: String::new(),
+    };
+    Ok(Some((request, unused)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mtl_options_are_read_and_the_unused_named() {
+        let (r, unused) = parse_mtl_map("map_Kd", &["-s", "2", "3", "-o", "0.5", "-clamp", "on", "my wood.png"])
+            .unwrap()
+            .unwrap();
+        assert_eq!(r.slot, Slot::Diffuse);
+        assert!(matches!(&r.source, Source::File(f) if f == "my wood.png"));
+        assert_eq!(r.transform.apply(glam::Vec2::new(1.0, 1.0)), glam::Vec2::new(2.5, 3.5));
+        assert_eq!(r.sampler.wrap_u, Wrap::Clamp);
+        assert!(unused.is_empty());
+        let (r, unused) = parse_mtl_map("map_Bump", &["-bm", "0.5", "-blendu", "off", "b.png"])
+            .unwrap()
+            .unwrap();
+        assert_eq!(r.slot, Slot::Bump);
+        assert_eq!(unused.len(), 2);
+        let (r, _) = parse_mtl_map("map_d", &["-imfchan", "r", "a.png"]).unwrap().unwrap();
+        assert_eq!(r.channel, Some(Channel::R));
+        assert!(parse_mtl_map("map_Kd", &["-clamp", "maybe", "a.png"]).is_err());
+        assert!(parse_mtl_map("map_Kd", &["-s", "2"]).is_err());
+        assert!(parse_mtl_map("refl", &["a.png"]).unwrap().is_none());
+    }
+
+    #[test]
+    fn images_decode_at_their_depth() {
+        let mut png = Vec::new();
+        let img = image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([x as u8 * 100, y as u8 * 200, 7]));
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let t = decode(&png, false).unwrap();
+        assert_eq!((t.width(), t.height(), t.bits()), (3, 2, 8));
+        // Row 0 is the image's bottom row (y = 1 in the file).
+        assert_eq!(t.texel(0, 2, 0), [200.0 / 255.0, 200.0 / 255.0, 7.0 / 255.0, 1.0]);
+        let s = decode(&png, true).unwrap();
+        let (r, expected) = (s.texel(0, 2, 0)[0], ((200.0f64 / 255.0 + 0.055) / 1.055).powf(2.4));
+        assert!((f64::from(r) - expected).abs() < 1e-4, "{r} vs {expected}");
+        assert!(decode(b"not an image", false).is_err());
+    }
+}
