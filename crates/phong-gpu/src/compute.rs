@@ -100,6 +100,12 @@ impl Gpu {
         if !self.device.features().contains(needed) {
             return Some(format!("the adapter {} has no 64-bit atomics", self.info.name));
         }
+        if let Some(o) = scene.objects.iter().find(|o| o.textured()) {
+            return Some(format!(
+                "object {} is textured (textures are sampled by the render pipeline)",
+                o.name
+            ));
+        }
         // Its storage buffers: the visibility buffer, and per vertex its record, projection and
         // colours (flat objects' vertices de-indexed, three per triangle).
         let max = self.max_storage_bytes();

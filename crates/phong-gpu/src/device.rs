@@ -110,9 +110,10 @@ impl Gpu {
                 storage_entry(2, true, both),
             ],
         });
+        let maps_layout = crate::textures::maps_layout(&device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("phong"),
-            bind_group_layouts: &[Some(&layout)],
+            bind_group_layouts: &[Some(&layout), Some(&maps_layout)],
             immediate_size: 0,
         });
         Ok(Gpu {
@@ -122,6 +123,7 @@ impl Gpu {
             limits,
             module,
             layout,
+            maps_layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
             kernels: std::sync::OnceLock::new(),

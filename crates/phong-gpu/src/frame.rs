@@ -31,6 +31,7 @@ impl Gpu {
                 vb,
                 ib,
                 bind,
+                maps,
                 msaa_view,
                 depth_view,
                 draws,
@@ -80,6 +81,7 @@ impl Gpu {
                         continue;
                     }
                     pass.set_pipeline(&pipelines[usize::from(*cull)]);
+                    pass.set_bind_group(1, &maps[i], &[]);
                     pass.draw_indexed(range.clone(), 0, i as u32..i as u32 + 1);
                 }
             }

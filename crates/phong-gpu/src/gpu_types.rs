@@ -137,6 +137,24 @@ pub struct GpuVertex {
     pub normal: [f32; 3],
     /// Flat shading: the triangle's centroid.
     pub centroid: [f32; 3],
+    /// Texture coordinates (0 where the mesh has none).
+    pub uv: [f32; 2],
+}
+
+/// WGSL `Maps` (render.wgsl): an object's texture maps, bound with its textures.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, Default)]
+pub struct GpuMaps {
+    /// Whether the diffuse, ambient, specular and emission maps are set.
+    pub present: [u32; 4],
+    /// Whether the shininess and alpha maps are set; their channels (R, G, B, A, luminance).
+    pub scalar: [u32; 4],
+    /// x: the alpha cutoff; y: 1 with an alpha test; z: 1 for a textured object; w: the
+    /// material's alpha.
+    pub cutoff: [f32; 4],
+    /// Per map (diffuse, ambient, specular, emission, shininess, alpha): its transform's linear
+    /// part by columns, then its offset.
+    pub transforms: [[f32; 4]; 12],
 }
 
 /// WGSL `Case` (compute tests).

@@ -37,9 +37,10 @@ mod gpu_types;
 mod harness;
 mod pipeline;
 mod readback;
+mod textures;
 mod upload;
 
-pub use gpu_types::{GpuCase, GpuFrame, GpuGlobals, GpuLight, GpuObject, GpuRaster, GpuVertex};
+pub use gpu_types::{GpuCase, GpuFrame, GpuGlobals, GpuLight, GpuMaps, GpuObject, GpuRaster, GpuVertex};
 
 use compute::{ComputeStage, Kernels};
 use phong_core::{Image, Scene};
@@ -192,6 +193,8 @@ pub(crate) enum Drawing {
         vb: wgpu::Buffer,
         ib: wgpu::Buffer,
         bind: wgpu::BindGroup,
+        /// Per object: its maps and textures (group 1).
+        maps: Vec<wgpu::BindGroup>,
         msaa_view: Option<wgpu::TextureView>,
         depth_view: wgpu::TextureView,
         /// Each object's index range and whether back faces are culled.
@@ -230,6 +233,8 @@ pub struct Gpu {
     pub(crate) limits: wgpu::Limits,
     pub(crate) module: wgpu::ShaderModule,
     pub(crate) layout: wgpu::BindGroupLayout,
+    /// Group 1 of the pipeline: an object's maps and textures.
+    pub(crate) maps_layout: wgpu::BindGroupLayout,
     pub(crate) pipeline_layout: wgpu::PipelineLayout,
     pub(crate) pipelines: Mutex<HashMap<(u32, bool), wgpu::RenderPipeline>>,
     pub(crate) kernels: std::sync::OnceLock<Result<Kernels, String>>,

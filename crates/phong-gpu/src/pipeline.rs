@@ -6,7 +6,7 @@ use crate::{COLOR_FORMAT, DEPTH_FORMAT, Drawing, Gpu, GpuVertex};
 
 impl Gpu {
     /// The pipeline's buffers, bind group and targets for `upload`.
-    pub(crate) fn prepare_pipeline(&self, upload: Upload) -> Drawing {
+    pub(crate) fn prepare_pipeline(&self, upload: Upload, scene_maps: Vec<(phong_core::Maps, f32)>) -> Drawing {
         let Upload {
             width,
             height,
@@ -24,6 +24,7 @@ impl Gpu {
             layout: &self.layout,
             entries: &entries(&[&frame, &lights, &objects]),
         });
+        let maps = self.map_bind_groups(&scene_maps);
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let n = samples.count();
         let msaa = (n > 1).then(|| self.texture("msaa", (width, height), COLOR_FORMAT, n, attachment));
@@ -32,6 +33,7 @@ impl Gpu {
             vb,
             ib,
             bind,
+            maps,
             msaa_view: msaa.as_ref().map(|t| t.create_view(&Default::default())),
             depth_view: depth.create_view(&Default::default()),
             draws: geometry.draws,
@@ -45,7 +47,8 @@ impl Gpu {
         cache
             .entry((samples, cull))
             .or_insert_with(|| {
-                let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+                let attributes =
+                    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2];
                 self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some("phong"),
                     layout: Some(&self.pipeline_layout),

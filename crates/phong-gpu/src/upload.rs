@@ -56,27 +56,33 @@ impl Geometry {
             let m = &o.mesh;
             let base = g.vertices.len();
             let first = g.indices.len() as u32;
+            let uv = |k: u32| m.uvs().get(k as usize).map_or([0.0; 2], |u| u.to_array());
             if o.shading.interpolation == Interpolation::Flat {
-                for (t, _) in m.triangles().iter().enumerate() {
+                for (t, corners) in m.triangles().iter().enumerate() {
                     let [a, b, c] = m.corners(t);
                     let n = facet_normal(a, b, c).to_array();
                     let centroid = ((a + b + c) / 3.0).to_array();
-                    for p in [a, b, c] {
+                    for (p, k) in [a, b, c].into_iter().zip(corners) {
                         g.indices.push(g.vertices.len() as u32);
                         g.vertices.push(GpuVertex {
                             position: p.to_array(),
                             normal: n,
                             centroid,
+                            uv: uv(*k),
                         });
                     }
                 }
             } else {
-                g.vertices
-                    .extend(m.positions().iter().zip(m.normals()).map(|(p, n)| GpuVertex {
-                        position: p.to_array(),
-                        normal: n.to_array(),
-                        centroid: p.to_array(),
-                    }));
+                g.vertices.extend(
+                    (0u32..)
+                        .zip(m.positions().iter().zip(m.normals()))
+                        .map(|(k, (p, n))| GpuVertex {
+                            position: p.to_array(),
+                            normal: n.to_array(),
+                            centroid: p.to_array(),
+                            uv: uv(k),
+                        }),
+                );
                 g.indices
                     .extend(m.triangles().iter().flatten().map(|&k| k + base as u32));
             }
@@ -252,7 +258,19 @@ impl Gpu {
         let drawing: Drawing = if compute {
             self.prepare_compute(upload, &resolved_view)?
         } else {
-            self.prepare_pipeline(upload)
+            let maps = scene
+                .objects
+                .iter()
+                .map(|o| {
+                    let maps = if o.textured() {
+                        o.maps.clone()
+                    } else {
+                        Default::default()
+                    };
+                    (maps, o.material.alpha())
+                })
+                .collect();
+            self.prepare_pipeline(upload, maps)
         };
         self.check(scopes, "preparing the frame")?;
         Ok(Prepared {

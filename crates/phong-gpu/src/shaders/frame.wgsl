@@ -27,6 +27,13 @@ struct VsOut {
     // Two-sided lighting, as OpenGL: colours lit with the flipped normal, for back faces.
     @location(5) color_back: vec3<f32>,
     @location(6) @interpolate(flat) flat_back: vec3<f32>,
+    // Textured objects (render.wgsl): texture coordinates, and Gouraud's and flat shading's
+    // specular colours, added after the texture (front, back).
+    @location(7) uv: vec2<f32>,
+    @location(8) spec: vec3<f32>,
+    @location(9) spec_back: vec3<f32>,
+    @location(10) @interpolate(flat) flat_spec: vec3<f32>,
+    @location(11) @interpolate(flat) flat_spec_back: vec3<f32>,
 }
 
 // The object's options with the per-point two-sided flip off: the renderer flips by polygon

@@ -48,13 +48,13 @@ pub(super) fn object(
                     alpha_map: at(m.span(), p.alpha_map.clone()),
                     normal_map: at(m.span(), p.normal_map.clone()),
                     bump_map: at(m.span(), p.bump_map.clone()),
-                    bump_scale: at(m.span(), p.bump_scale.clone()),
+                    bump_scale: at(m.span(), p.bump_scale),
                     uv_scale: at(m.span(), p.uv_scale.clone()),
                     uv_offset: at(m.span(), p.uv_offset.clone()),
                     wrap: at(m.span(), p.wrap.clone()),
                     filter: at(m.span(), p.filter.clone()),
                     encoding: at(m.span(), p.encoding.clone()),
-                    alpha_cutoff: at(m.span(), p.alpha_cutoff.clone()),
+                    alpha_cutoff: at(m.span(), p.alpha_cutoff),
                 };
                 material(ctx, &raw, "material", named)?
             }

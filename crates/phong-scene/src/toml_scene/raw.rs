@@ -150,7 +150,7 @@ pub(crate) struct PlainMaterial {
 #[serde(untagged)]
 pub(crate) enum MaterialRef {
     Name(String),
-    Inline(PlainMaterial),
+    Inline(Box<PlainMaterial>),
 }
 
 #[derive(Deserialize)]
