@@ -229,7 +229,7 @@ impl Texture {
                 if lod >= q {
                     return self.filter(q as usize, s.min, s, uv);
                 }
-                let d1 = lod.floor();
+                let d1 = floor(lod);
                 let t = lod - d1;
                 let a = self.filter(d1 as usize, s.min, s, uv);
                 let b = self.filter(d1 as usize + 1, s.min, s, uv);
@@ -245,16 +245,16 @@ impl Texture {
         let (w, h) = (l.width as f32, l.height as f32);
         match f {
             Filter::Nearest => {
-                let x = wrap(s.wrap_u, (uv.x * w).floor(), l.width);
-                let y = wrap(s.wrap_v, (uv.y * h).floor(), l.height);
+                let x = wrap(s.wrap_u, floor(uv.x * w), l.width);
+                let y = wrap(s.wrap_v, floor(uv.y * h), l.height);
                 self.texel(level, x, y)
             }
             Filter::Linear => {
                 let (fx, fy) = (uv.x * w - 0.5, uv.y * h - 0.5);
-                let (ix, iy) = (fx.floor(), fy.floor());
+                let (ix, iy) = (floor(fx), floor(fy));
                 let (a, b) = (fx - ix, fy - iy);
-                let (x0, x1) = (wrap(s.wrap_u, ix, l.width), wrap(s.wrap_u, ix + 1.0, l.width));
-                let (y0, y1) = (wrap(s.wrap_v, iy, l.height), wrap(s.wrap_v, iy + 1.0, l.height));
+                let (x0, x1) = wrap_pair(s.wrap_u, ix, l.width);
+                let (y0, y1) = wrap_pair(s.wrap_v, iy, l.height);
                 let t00 = self.texel(level, x0, y0);
                 let t10 = self.texel(level, x1, y0);
                 let t01 = self.texel(level, x0, y1);
@@ -267,10 +267,47 @@ impl Texture {
     }
 }
 
+/// `x.floor()` without a call to libm's `floorf` (x86-64's baseline has no rounding
+/// instruction): by truncation where `x` is exact in `i32`, else `floor`.
+#[inline(always)]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    } else {
+        x.floor()
+    }
+}
+
+/// `wrap(i)` and `wrap(i + 1)`: the two texels a bilinear filter reads along one axis.
+#[inline(always)]
+fn wrap_pair(mode: Wrap, i: f32, n: u32) -> (u32, u32) {
+    let a = wrap(mode, i, n);
+    match mode {
+        Wrap::Repeat => (a, if a + 1 == n { 0 } else { a + 1 }),
+        _ => (a, wrap(mode, i + 1.0, n)),
+    }
+}
+
 /// Integer texel coordinate `i` (a whole number as `f32`, any size; NaN is 0) wrapped into
 /// `0..n`.
-#[inline]
+#[inline(always)]
 fn wrap(mode: Wrap, i: f32, n: u32) -> u32 {
+    let nf = n as f32;
+    // Inside the image, or a few copies away (exact in f32 below 2^23): no integer division.
+    if (0.0..nf).contains(&i) {
+        return i as u32;
+    }
+    if mode == Wrap::Repeat && i.abs() < 8_388_608.0 {
+        // Whole numbers, exact in f32; the quotient's rounding can leave `r` one period out.
+        let mut r = i - nf * floor(i / nf);
+        if r < 0.0 {
+            r += nf;
+        } else if r >= nf {
+            r -= nf;
+        }
+        return (r as u32).min(n - 1);
+    }
     let i = i as i64;
     let n = i64::from(n);
     let k = match mode {
@@ -344,6 +381,19 @@ mod tests {
         let m: Vec<u32> = (-5..9).map(|i| wrap(Wrap::Mirror, i as f32, n)).collect();
         assert_eq!(m, [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]);
         assert_eq!(wrap(Wrap::Repeat, f32::NAN, n), 0);
+        // The f32 shortcut against integer arithmetic, near and far, every size.
+        let mut x = 12345u64;
+        for _ in 0..200_000 {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let n = 1 + (x >> 33) as u32 % 5000;
+            let i = ((x >> 7) % 40_000_000) as i64 - 20_000_000;
+            // The coordinate as the sampler has it (f32: past 2^24, every other integer).
+            let i = i as f32 as i64;
+            let want = i.rem_euclid(i64::from(n)) as u32;
+            assert_eq!(wrap(Wrap::Repeat, i as f32, n), want, "{i} mod {n}");
+            let (a, b) = wrap_pair(Wrap::Repeat, i as f32, n);
+            assert_eq!((a, b), (want, (want + 1) % n), "{i} mod {n}");
+        }
         assert!(wrap(Wrap::Mirror, 1e30, n) < n);
     }
 

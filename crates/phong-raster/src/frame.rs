@@ -28,6 +28,11 @@ pub(crate) enum Mode {
     Phong(Prepared, Term),
     /// Interpolated vertex colours.
     Gouraud,
+    /// A textured object's colour with one sample a pixel, Phong-interpolated: its light by
+    /// the vector kernel (`shade_batch_lit`), its maps sampled per pixel from the planes of its
+    /// texture coordinates (the ambient, emission and shininess maps, which change the light,
+    /// are [`Mode::Scalar`]'s).
+    Textured(Prepared),
     /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
     /// depth outputs).
     Scalar,
@@ -39,7 +44,7 @@ impl Mode {
         match self {
             Mode::Phong(prep, term) => Some(Batch::Phong(prep, *term)),
             Mode::Gouraud => Some(Batch::Gouraud),
-            Mode::Scalar => None,
+            Mode::Textured(_) | Mode::Scalar => None,
         }
     }
 }
@@ -103,6 +108,16 @@ impl<'a> Frame<'a> {
                     return Mode::Scalar;
                 };
                 if o.textured() {
+                    let m = &o.maps;
+                    let per_pixel_light = m.ambient.is_some() || m.emission.is_some() || m.shininess.is_some();
+                    let one_sample = scene.image.samples == phong_core::Samples::One;
+                    if o.shading.interpolation == Interpolation::Phong
+                        && term == Term::Color
+                        && one_sample
+                        && !per_pixel_light
+                    {
+                        return Mode::Textured(Prepared::new(&scene.lighting, &o.material, &o.shading.options, view));
+                    }
                     return Mode::Scalar;
                 }
                 match o.shading.interpolation {
@@ -177,6 +192,12 @@ impl<'a> Frame<'a> {
     #[inline]
     pub fn planes(&self, id: u32) -> &Planes {
         &self.tris[(id >> ID_INDEX_BITS) as usize].planes[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The planes of a textured triangle's texture coordinates ([`Mode::Textured`]).
+    #[inline]
+    pub fn uv_planes(&self, id: u32) -> &Planes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].uv[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
     }
 
     /// The [`Corners`] of triangle `id` (kept for the reference path and scalar-shaded objects).

@@ -259,8 +259,20 @@ position = [0.0, 0.3, -0.3]
 rotation = [0.0, 90.0, 0.0]
 "#
         );
-        let scene = phong_scene::parse_scene(&src, Path::new("clipped.toml")).unwrap().scene;
+        let mut scene = phong_scene::parse_scene(&src, Path::new("clipped.toml")).unwrap().scene;
         assert_fast_matches_reference(&scene, interpolation);
+        // Textured (a 4×4 texture repeated, trilinear): the clipped triangles' texture
+        // coordinates come from the clipped vertices.
+        let texels: Vec<[u16; 4]> = (0..16u16)
+            .map(|i| [i * 4000, 65535 - i * 3000, (i % 3) * 20000, 65535])
+            .collect();
+        let texture = std::sync::Arc::new(Texture::new(4, 4, &texels, 16).unwrap());
+        for o in &mut scene.objects {
+            let mut map = TextureMap::new(texture.clone());
+            map.transform = UvTransform::scale_offset(glam::Vec2::splat(50.0), glam::Vec2::ZERO);
+            o.maps.diffuse = Some(map);
+        }
+        assert_fast_matches_reference(&scene, &format!("{interpolation}, textured"));
         // Clipping happened: some triangles are clipped into polygons.
         let aspect = scene.image.width as f32 / scene.image.height as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);

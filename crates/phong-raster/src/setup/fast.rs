@@ -7,7 +7,7 @@
 //! (a sphere's back half is culled); the triangles wait as [`Pending`] until their colours
 //! exist.
 
-use super::{Chunk, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations};
+use super::{Chunk, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, uv_planes};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
 use crate::frame::{Frame, Mode, lit_term};
@@ -42,6 +42,9 @@ impl Frame<'_> {
             .zip(positions.par_chunks(SETUP_CHUNK))
             .for_each(|(out, ps)| fast_vertices(self.isa, clip_from_world, (self.w, self.h), ps, out));
         let gouraud = matches!(self.modes[oi], Mode::Gouraud);
+        let textured = matches!(self.modes[oi], Mode::Textured(_));
+        let uvs = mesh.uvs();
+        let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
         let lighting = gouraud.then(|| VertexLighting {
             isa: self.isa,
             prepared: Prepared::new(
@@ -98,6 +101,9 @@ impl Frame<'_> {
                             });
                         } else {
                             out.planes.push(phong_planes(&s, tri));
+                            if textured {
+                                out.uv.push(uv_planes(&s, each3(|k| uv_of(tri[s.order[k]]))));
+                            }
                         }
                         out.tris.push(s.tri);
                     }
@@ -120,15 +126,16 @@ impl Frame<'_> {
                         color: lit3[0][k],
                         color_back: lit3[1][k],
                         spec: [Vec3::ZERO; 2],
-                        uv: glam::Vec2::ZERO,
+                        uv: uv_of(tri[k]),
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {
-                    if let Some((tri, p, _)) = self.setup(t, None, None, oi as u32, false) {
+                    if let Some((tri, p, _, uv)) = self.setup(t, None, None, oi as u32, false) {
                         if gouraud {
                             out.clipped.push((out.tris.len() as u32, p));
                         } else {
                             out.planes.push(p);
+                            out.uv.extend(uv);
                         }
                         out.tris.push(tri);
                     }

@@ -74,8 +74,8 @@ impl Frame<'_> {
                 tris: Vec::with_capacity(chunk.len()),
                 ..Chunk::default()
             };
-            let mut push = |r: Option<(Tri, Planes, Option<Corners>)>| {
-                if let Some((t, _, c)) = r {
+            let mut push = |r: Option<(Tri, Planes, Option<Corners>, Option<Planes>)>| {
+                if let Some((t, _, c, _)) = r {
                     out.tris.push(t);
                     out.corners.extend(c);
                 }

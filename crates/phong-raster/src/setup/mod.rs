@@ -120,6 +120,9 @@ pub(crate) struct Chunk {
     /// Gouraud: the planes of clipped triangles, by slot (the others' are in `pending`
     /// until their vertices are lit).
     pub clipped: Vec<(u32, Planes)>,
+    /// Textured objects ([`Mode::Textured`]): the planes of the texture coordinates (`u/w`,
+    /// `v/w` in `attr[0]`, `attr[1]`), same index.
+    pub uv: Vec<Planes>,
     /// `(tile, index)` for each tile each triangle is binned into, in triangle order (see
     /// `Frame::bin_chunks`).
     pub binned: Vec<(u32, u32)>,
@@ -136,6 +139,7 @@ impl Chunk {
 
     /// Empties the chunk, keeping its memory.
     pub fn clear(&mut self) {
+        self.uv.clear();
         self.tris.clear();
         self.planes.clear();
         self.corners.clear();
@@ -263,6 +267,14 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
 }
 
 /// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
+/// The planes of texture coordinates `uv` (per set-up vertex) of triangle `s`: `u/w` and
+/// `v/w` in `attr[0]` and `attr[1]`.
+#[inline]
+pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3]) -> Planes {
+    let attrs = [uv.map(|t| Vec3::new(t.x, t.y, 0.0)), [Vec3::ZERO; 3]];
+    plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, true)
+}
+
 /// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with vertex 0 snapped at `origin` (1/256
 /// pixel) and twice its area `area`: the barycentric `λ_i` is `E_i / area`, so
 /// `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and `q = q_0` at vertex 0.
@@ -312,7 +324,8 @@ impl Frame<'_> {
     }
 
     /// Projects (unless `proj` is given), snaps, culls and sets up one triangle of clip-space
-    /// vertices; with `full`, its [`Corners`] for scalar shading, else its fast-path [`Planes`].
+    /// vertices; with `full`, its [`Corners`] for scalar shading, else its fast-path [`Planes`]
+    /// (and a textured object's [`uv_planes`]).
     pub(crate) fn setup(
         &self,
         v: [ClipVertex; 3],
@@ -320,7 +333,7 @@ impl Frame<'_> {
         flat: Option<[Flat; 2]>,
         object: u32,
         full: bool,
-    ) -> Option<(Tri, Planes, Option<Corners>)> {
+    ) -> Option<(Tri, Planes, Option<Corners>, Option<Planes>)> {
         let proj = proj.unwrap_or_else(|| v.map(|v| self.project(v.clip)));
         let s = self.setup_edges(proj, self.scene.objects[object as usize].shading.options.two_sided)?;
         let v = s.order.map(|k| v[k]);
@@ -330,11 +343,13 @@ impl Frame<'_> {
                 v,
                 flat: flat.map(|f| f[usize::from(!s.front)]),
             };
-            return Some((s.tri, Planes::default(), Some(corners)));
+            return Some((s.tri, Planes::default(), Some(corners), None));
         }
-        let planes = match self.modes[object as usize] {
+        let mode = &self.modes[object as usize];
+        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv)));
+        let planes = match mode {
             Mode::Scalar => Planes::default(),
-            Mode::Phong(..) => {
+            Mode::Phong(..) | Mode::Textured(_) => {
                 let sign = if s.front { 1.0 } else { -1.0 };
                 let attrs = [v.map(|v| v.world), v.map(|v| v.normal * sign)];
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
@@ -344,7 +359,7 @@ impl Frame<'_> {
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
             }
         };
-        Some((s.tri, planes, None))
+        Some((s.tri, planes, None, uv))
     }
 }
 

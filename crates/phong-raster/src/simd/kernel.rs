@@ -569,6 +569,65 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     }
 }
 
+/// [`shade_batch`] for a textured object (Phong, its colour): `out(i, primary, specular)`
+/// takes phong-core's `Lit` of each pixel with every term in the primary colour: emission,
+/// ambient and diffuse summed, and the specular apart, each clamped where the options clamp;
+/// the caller applies the texels.
+#[inline(always)]
+pub(crate) fn shade_batch_lit<'p, V: Vf32>(
+    prep: &Prepared,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    mut out: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    let mut start = 0;
+    while start < n {
+        let m = (n - start).min(V::N);
+        let mut xs = V::A::default();
+        let mut ys = V::A::default();
+        let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
+        for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
+            let (x, y, p) = lane(start + i.min(m - 1));
+            xs.as_mut()[i] = x;
+            ys.as_mut()[i] = y;
+            *plane = p;
+        }
+        let q = interpolate::<V>(&planes[..V::N], 6, V::from_array(xs), V::from_array(ys));
+        let pos = V3 {
+            x: q[0],
+            y: q[1],
+            z: q[2],
+        };
+        let nrm = V3 {
+            x: q[3],
+            y: q[4],
+            z: q[5],
+        };
+        let t = shade(prep, pos, nrm);
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        // Plain loops, not closures: a closure is not compiled with the caller's AVX2.
+        let mut primary = [V::A::default(); 3];
+        let mut specular = [V::A::default(); 3];
+        for c in 0..3 {
+            let (mut p, mut s) = (t.ambient[c].add(t.diffuse[c]), t.specular[c]);
+            if prep.options.clamp {
+                p = p.max(zero).min(one);
+                s = s.max(zero).min(one);
+            }
+            primary[c] = p.to_array();
+            specular[c] = s.to_array();
+        }
+        for i in 0..m {
+            out(
+                start + i,
+                [0, 1, 2].map(|c| primary[c].as_ref()[i]),
+                [0, 1, 2].map(|c| specular[c].as_ref()[i]),
+            );
+        }
+        start += m;
+    }
+}
+
 /// Shades the pixels of one triangle, [`V::N`](Vf32::N) at a time, with its `planes`
 /// broadcast to every lane (no per-lane gathering of coefficients): `pixels` are packed
 /// `row << 16 | column` relative to `(x0, y0)`, the pixel whose centre is `(x0 + ½, y0 + ½)`;

@@ -78,6 +78,37 @@ pub fn shade8(isa: Isa, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; 
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
+fn shade_batch_lit_avx2<'p>(
+    prep: &Prepared,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    kernel::shade_batch_lit::<vector::Avx2x2>(prep, n, lane, out)
+}
+
+/// Interpolates and lights `n` pixels of a textured object, 8 at a time: `out(i, primary,
+/// specular)` takes each pixel's light before its texels (see `kernel::shade_batch_lit`).
+#[inline]
+pub fn shade_batch_lit<'p>(
+    isa: Isa,
+    prep: &Prepared,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        unsafe { shade_batch_lit_avx2(prep, n, lane, out) };
+        return;
+    }
+    let _ = isa;
+    kernel::shade_batch_lit::<vector::Portable>(prep, n, lane, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
 fn shade_batch_avx2<'p>(
     batch: Batch,
     n: usize,

@@ -12,7 +12,7 @@ use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
-use crate::simd::{Planes, group_lanes, shade_batch, shade_group};
+use crate::simd::{Planes, group_lanes, shade_batch, shade_batch_lit, shade_group};
 use crate::stats::Marks;
 use crate::target::{Store, fill, resolve};
 use glam::{Vec2, Vec3};
@@ -119,8 +119,10 @@ impl Frame<'_> {
             }
             next[k as usize] += len;
         }
-        // Per object, the pixels left over from whole vectors, with their triangles.
+        // Per object, the pixels left over from whole vectors, with their triangles; and the
+        // pixels of textured objects.
         let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
+        let mut textured: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
         let group = group_lanes(self.isa);
         for (k, &id) in bin.iter().enumerate() {
@@ -129,6 +131,10 @@ impl Frame<'_> {
                 continue;
             }
             let object = self.object(id);
+            if let Mode::Textured(_) = self.modes[object] {
+                textured[object].extend(pixels.iter().map(|&p| (p, id)));
+                continue;
+            }
             let Some(kind) = self.modes[object].batch() else {
                 for &p in pixels {
                     let (r, c) = at(p);
@@ -165,8 +171,58 @@ impl Frame<'_> {
                 out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
             },
         );
+        for (object, items) in textured.iter().enumerate() {
+            let Mode::Textured(prep) = &self.modes[object] else {
+                continue;
+            };
+            self.shade_textured_batch(object, prep, items, x0, y0, |(p, _), rgb| {
+                let (r, c) = at(p);
+                out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+            });
+        }
         tile.clock.add(marks);
         u64::from(shaded)
+    }
+
+    /// Shades a textured object's pixels `items` (`(row << 16 | column, triangle id)` in the
+    /// tile at `(x0, y0)`): their light by the vector kernel, then per pixel the texture
+    /// coordinates and their exact derivatives from the triangle's planes, the maps sampled and
+    /// applied as phong-core's `Lit::modulate`.
+    fn shade_textured_batch(
+        &self,
+        object: usize,
+        prep: &crate::simd::Prepared,
+        items: &[(u32, u32)],
+        x0: u32,
+        y0: u32,
+        mut out: impl FnMut((u32, u32), [f32; 3]),
+    ) {
+        let obj = &self.scene.objects[object];
+        let clamp = obj.shading.options.clamp;
+        let centre = |p: u32| ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
+        shade_batch_lit(
+            self.isa,
+            prep,
+            items.len(),
+            |i| {
+                let (p, id) = items[i];
+                let (x, y) = centre(p);
+                (x, y, self.planes(id))
+            },
+            |i, primary, specular| {
+                let (p, id) = items[i];
+                let (x, y) = centre(p);
+                let [uv, d_dx, d_dy] = uv_from_planes(self.uv_planes(id), x, y);
+                let texels = obj.maps.sample(uv, d_dx, d_dy);
+                let lit = Lit {
+                    primary: Color::new(primary[0], primary[1], primary[2]),
+                    specular: Color::new(specular[0], specular[1], specular[2]),
+                    ..Lit::default()
+                };
+                let c = lit.modulate(&texels, clamp);
+                out(items[i], [c.r, c.g, c.b]);
+            },
+        );
     }
 
     /// The shading of a tile of several samples a pixel after visibility (`ids`: per sample,
@@ -257,7 +313,8 @@ impl Frame<'_> {
         map3(q, |x| x / sum)
     }
 
-    /// Perspective-correct texture coordinates of triangle `t` at the centre of pixel
+    /// (See [`uv_from_planes`] for the fast path's.) Perspective-correct texture coordinates of
+    /// triangle `t` at the centre of pixel
     /// `(px, py)` and their exact screen derivatives `[uv, ∂uv/∂x, ∂uv/∂y]` (per pixel), in
     /// `f64`: with `q_i = λ_i/w_i`, `uv = Σ q_i uv_i / Σ q_i` and
     /// `∂uv = (Σ ∂q_i uv_i − uv Σ ∂q_i) / Σ q_i`.
@@ -379,6 +436,20 @@ impl Frame<'_> {
         };
         Some([c.r, c.g, c.b, 1.0])
     }
+}
+
+/// Texture coordinates at pixel centre `(x, y)` from a triangle's planes of `u/w`, `v/w` and
+/// `1/w`, and their screen derivatives: with `q = 1/w`, `u = q_u/q` and `∂u/∂x = (∂q_u/∂x −
+/// u·∂q/∂x)/q` (the planes' gradients are constant).
+#[inline]
+fn uv_from_planes(p: &Planes, x: f32, y: f32) -> [Vec2; 3] {
+    let (dx, dy) = (x - p.origin[0], y - p.origin[1]);
+    let eval = |k: [f32; 3]| k[0] + k[1] * dx + k[2] * dy;
+    let q = eval(p.inv_w);
+    let (qu, qv) = (eval(p.attr[0]), eval(p.attr[1]));
+    let uv = Vec2::new(qu / q, qv / q);
+    let d = |g: usize| Vec2::new(p.attr[0][g] - uv.x * p.inv_w[g], p.attr[1][g] - uv.y * p.inv_w[g]) / q;
+    [uv, d(1), d(2)]
 }
 
 #[cfg(test)]
