@@ -4,7 +4,7 @@
 
 use crate::{
     Camera, Color, Encoding, Error, Lighting, Maps, Material, Mesh, Shading, ShadingOptions, SurfacePoint, View,
-    Viewer, shade, shade_textured,
+    Viewer, light, shade, shade_textured,
 };
 use glam::{Vec2, Vec3};
 
@@ -213,6 +213,34 @@ impl Object {
             lighting,
             &options,
         )
+    }
+
+    /// The light at a vertex (Gouraud) or a triangle's centroid (flat), as the object's output
+    /// shows it: `(colour, black)`, or for a textured object `(primary, specular)` ([`Lit`]
+    /// with every term in the primary colour), the texels applied per pixel by
+    /// [`Lit::modulate`]. Under Gouraud and flat shading the ambient, emission and shininess
+    /// maps have no effect: the light is not computed per pixel.
+    ///
+    /// [`Lit`]: crate::Lit
+    /// [`Lit::modulate`]: crate::Lit::modulate
+    pub fn vertex_light(&self, lighting: &Lighting, view: &View, p: Vec3, n: Vec3) -> (Color, Color) {
+        let output = self.shading.output;
+        if !self.textured() {
+            return (output.term(&self.shade(lighting, view, p, n)), Color::BLACK);
+        }
+        let options = ShadingOptions {
+            two_sided: false,
+            ..self.shading.options
+        };
+        let point = SurfacePoint { position: p, normal: n };
+        let (lit, [e, a, d, s]) = light(&point, view, &self.material, 1.0, (false, false), lighting, &options);
+        match output {
+            Output::Color => (lit.primary, lit.specular),
+            Output::Ambient => (e + a, Color::BLACK),
+            Output::Diffuse => (d, Color::BLACK),
+            Output::Specular => (Color::BLACK, s),
+            _ => (Color::BLACK, Color::BLACK),
+        }
     }
 
     /// Whether the object is drawn with its maps: it has some, and texture coordinates.

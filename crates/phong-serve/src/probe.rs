@@ -6,13 +6,16 @@
 //! are culled unless the object is two-sided; a two-sided back face is lit with its normals
 //! flipped, as the renderers do. The lighting is then [`shade`] itself: once for the pixel's
 //! value, and once per light alone (unclamped, without emission or global ambient) for the
-//! per-light terms.
+//! per-light terms. A textured object's maps are sampled at the hit's texture coordinates
+//! (their screen derivatives by central differences of rays on the triangle's plane)
+//! and applied by [`shade_textured`] (per-pixel shading) or `Lit::modulate` (Gouraud, flat),
+//! as the renderers do.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use phong_core::mesh::facet_normal;
 use phong_core::{
-    Color, Interpolation, Light, Lighting, Material, Object, Output, Scene, Shading, ShadingOptions, SpecularModel,
-    SurfacePoint, View, depth_color, normal_color, shade, specular_factor,
+    Color, Interpolation, Light, Lighting, Lit, Maps, Material, Object, Output, Scene, Shading, ShadingOptions,
+    SpecularModel, SurfacePoint, Texels, View, depth_color, normal_color, shade, shade_textured, specular_factor,
 };
 use serde::Serialize;
 
@@ -84,6 +87,28 @@ pub struct Hit {
     pub color: [f32; 3],
     /// Gouraud: the three vertices' lit values, which the pixel interpolates.
     pub vertices: Vec<VertexValue>,
+    /// A textured object: the texture coordinates and what the maps give there.
+    pub texture: Option<TextureValue>,
+}
+
+/// What a textured object's maps give at the probed point.
+#[derive(Debug, Serialize)]
+pub struct TextureValue {
+    /// Texture coordinates.
+    pub uv: [f32; 2],
+    /// Their derivatives along the image's x and y, per pixel (the level of detail comes from
+    /// them).
+    pub uv_dx: [f32; 2],
+    /// See `uv_dx`.
+    pub uv_dy: [f32; 2],
+    /// The diffuse map's RGBA (1 without one).
+    pub diffuse: [f32; 4],
+    /// The specular map's colour (1 without one).
+    pub specular: [f32; 3],
+    /// The point's alpha (material, diffuse map, alpha map).
+    pub alpha: f32,
+    /// Whether the alpha test discards the point.
+    pub discarded: bool,
 }
 
 /// The material's numbers.
@@ -170,14 +195,35 @@ fn output_name(o: Output) -> &'static str {
 
 /// The nearest front-facing (or two-sided) triangle along the ray through pixel `(x, y)`'s
 /// centre: object, triangle, barycentrics, back face.
-fn trace(scene: &Scene, x: u32, y: u32) -> Option<(usize, usize, [f64; 3], bool)> {
+/// The ray through window point `(x, y)` (pixels): its start on the near plane and its
+/// direction to the far plane.
+fn ray(scene: &Scene, x: f64, y: f64) -> (DVec3, DVec3) {
     let (w, h) = (scene.image.width, scene.image.height);
     let m = scene.camera.clip_from_world(w as f32 / h as f32).as_dmat4().inverse();
-    let ndc_x = 2.0 * (f64::from(x) + 0.5) / f64::from(w) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(h);
+    let ndc_x = 2.0 * x / f64::from(w) - 1.0;
+    let ndc_y = 1.0 - 2.0 * y / f64::from(h);
     let near = m.project_point3(DVec3::new(ndc_x, ndc_y, -1.0));
     let far = m.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));
-    let dir = far - near;
+    (near, far - near)
+}
+
+/// Barycentrics of the ray `(near, dir)`'s hit on the plane of triangle `[a, b, c]` (inside the
+/// triangle or not); `None` where the ray runs along the plane.
+fn plane_barycentrics((near, dir): (DVec3, DVec3), [a, b, c]: [DVec3; 3]) -> Option<[f64; 3]> {
+    let (e1, e2) = (b - a, c - a);
+    let pv = dir.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let s = near - a;
+    let u = s.dot(pv) / det;
+    let v = dir.dot(s.cross(e1)) / det;
+    Some([1.0 - u - v, u, v])
+}
+
+fn trace(scene: &Scene, x: u32, y: u32) -> Option<(usize, usize, [f64; 3], bool)> {
+    let (near, dir) = ray(scene, f64::from(x) + 0.5, f64::from(y) + 0.5);
     let mut best: Option<(f64, usize, usize, [f64; 3], bool)> = None;
     for (oi, obj) in scene.objects.iter().enumerate() {
         let two_sided = obj.shading.options.two_sided;
@@ -251,23 +297,80 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         Interpolation::Flat => ((ps[0] + ps[1] + ps[2]) / 3.0, facet_normal(ps[0], ps[1], ps[2]) * flip),
         _ => (lerp(ps), lerp(ns) * flip),
     };
-    let at = obj.shade(&scene.lighting, &view, position, normal);
+    let lit_output = !matches!(output, Output::Normal | Output::Depth);
+    let texture = (obj.textured() && lit_output).then(|| {
+        let uv_at = |bary: [f64; 3]| {
+            let uvs = tri.map(|i| mesh.uvs()[i as usize].as_dvec2());
+            (uvs[0] * bary[0] + uvs[1] * bary[1] + uvs[2] * bary[2]).as_vec2()
+        };
+        let corners = ps.map(|p| p.as_dvec3());
+        let (fx, fy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+        let uv = uv_at(bary);
+        // The derivatives as the renderer's (exact at the centre), by central differences
+        // over 1/16 pixel on the triangle's plane.
+        let h = 1.0 / 16.0;
+        let at = |dx: f64, dy: f64| {
+            plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| {
+                let uvs = tri.map(|i| mesh.uvs()[i as usize].as_dvec2());
+                uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
+            })
+        };
+        let derivative = |dx: f64, dy: f64| match (at(dx * h, dy * h), at(-dx * h, -dy * h)) {
+            (Some(a), Some(b)) => ((a - b) / (2.0 * h)).as_vec2(),
+            _ => Vec2::ZERO,
+        };
+        let (d_dx, d_dy) = (derivative(1.0, 0.0), derivative(0.0, 1.0));
+        (uv, d_dx, d_dy, obj.maps.sample(uv, d_dx, d_dy))
+    });
+    let texels = texture.map(|t| t.3);
+    let options = ShadingOptions {
+        two_sided: false,
+        ..obj.shading.options
+    };
+    let at = match &texels {
+        Some(t) => shade_textured(
+            &SurfacePoint { position, normal },
+            &view,
+            &obj.material,
+            t,
+            &scene.lighting,
+            &options,
+        ),
+        None => obj.shade(&scene.lighting, &view, position, normal),
+    };
+    // Gouraud and flat textured: the light made per vertex or triangle, the texels per pixel.
+    let modulate = |(p, s): (Color, Color), t: &Texels| {
+        Lit {
+            primary: p,
+            specular: s,
+            ..Lit::default()
+        }
+        .modulate(t, options.clamp)
+    };
     let mut vertices = Vec::new();
     let value = match output {
         // Flat: the facet normal as it is; else the interpolated one, renormalised (as drawn).
         Output::Normal if interpolation == Interpolation::Flat => normal_color(normal),
         Output::Normal => normal_color(normal.normalize_or_zero()),
         Output::Depth => depth_color(&scene.camera, lerp(ps)),
+        _ if interpolation == Interpolation::Flat && texels.is_some() => {
+            let t = texels.as_ref().expect("textured");
+            modulate(obj.vertex_light(&scene.lighting, &view, position, normal), t)
+        }
         _ if interpolation == Interpolation::Gouraud => {
-            let mut c = Color::BLACK;
+            let (mut c, mut spec) = (Color::BLACK, Color::BLACK);
             for k in 0..3 {
-                let v = output.term(&obj.shade(&scene.lighting, &view, ps[k], ns[k] * flip));
+                let (v, s) = obj.vertex_light(&scene.lighting, &view, ps[k], ns[k] * flip);
                 vertices.push(VertexValue {
                     position: v3(ps[k]),
                     normal: v3(ns[k] * flip),
                     value: c3(v),
                 });
                 c += v * b[k];
+                spec += s * b[k];
+            }
+            if let Some(t) = &texels {
+                c = modulate((c, spec), t);
             }
             notes.push(
                 "Gouraud: the pixel interpolates the vertices' values; the terms below are the lighting at the \
@@ -280,6 +383,32 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     };
     let value = c3(value);
     let hit = hit_terms(scene, obj, &view, position, normal, &at);
+    let texture = texture.map(|(uv, d_dx, d_dy, t)| {
+        let alpha = Maps::alpha(&obj.material, &t);
+        let discarded = obj.maps.discards(alpha);
+        notes.push(format!(
+            "textured: uv ({:.4}, {:.4}); diffuse texel ({:.3}, {:.3}, {:.3}), alpha {alpha:.3}{}",
+            uv.x,
+            uv.y,
+            t.diffuse[0],
+            t.diffuse[1],
+            t.diffuse[2],
+            if discarded {
+                ": discarded by the alpha test (the renderer shows what is behind)"
+            } else {
+                ""
+            }
+        ));
+        TextureValue {
+            uv: uv.to_array(),
+            uv_dx: d_dx.to_array(),
+            uv_dy: d_dy.to_array(),
+            diffuse: t.diffuse,
+            specular: c3(t.specular),
+            alpha,
+            discarded,
+        }
+    });
     Probe {
         x,
         y,
@@ -296,6 +425,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
             },
             output: output_name(output),
             vertices,
+            texture,
             ..hit
         }),
         value,
@@ -406,5 +536,6 @@ fn hit_terms(scene: &Scene, obj: &Object, view: &View, position: Vec3, normal: V
         sum: c3(sum),
         color: c3(at.color),
         vertices: Vec::new(),
+        texture: None,
     }
 }

@@ -690,3 +690,78 @@ async fn ply_stl_and_gltf_uploads() {
     let bg = px[..3].to_vec();
     assert!(px.chunks(3).filter(|p| *p != &bg[..]).count() > 20);
 }
+
+/// A textured scene (a sphere and a floor with a diffuse and a specular map, each
+/// interpolation): the probe's value is the rendered pixel, within 1/255, bilinear and
+/// trilinear (the probe's derivatives are central differences of rays, the renderer's exact).
+#[test]
+fn the_probe_samples_textures_as_the_renderer() {
+    use phong_core::glam::{Mat4, Quat, Vec2, Vec3};
+    use phong_core::*;
+    let texels: Vec<[u16; 4]> = (0..64u32)
+        .map(|i| {
+            let v = |k: u32| ((i * k + 17) % 256) as u16 * 257;
+            [v(37), v(91), v(53), 65535]
+        })
+        .collect();
+    let texture = std::sync::Arc::new(Texture::new(8, 8, &texels, 8).unwrap());
+    let sphere = primitives::sphere(32).transformed(&Mat4::from_translation(Vec3::new(0.0, 0.3, 0.0)));
+    let floor = primitives::plane(4).transformed(&Mat4::from_scale_rotation_translation(
+        Vec3::splat(2.5),
+        Quat::IDENTITY,
+        Vec3::new(0.0, -0.8, 0.0),
+    ));
+    let base = phong_scene::parse_scene(
+        "[image]\nwidth = 97\nheight = 61\n[camera]\nposition = [1.5, 1.2, 3.5]\n[[light]]\ntype = \"point\"\nposition = [2.0, 2.0, 2.0]\n[[object]]\nshape = \"cube\"\n",
+        std::path::Path::new("probe.toml"),
+    )
+    .unwrap()
+    .scene;
+    for (sampler, repeat, tolerance) in [
+        (Sampler::bilinear(Wrap::Repeat), 1.0, 1),
+        (Sampler::trilinear(Wrap::Repeat), 6.0, 1),
+    ] {
+        for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
+            let mut scene = base.clone();
+            let template = scene.objects[0].clone();
+            scene.objects = [sphere.clone(), floor.clone()]
+                .into_iter()
+                .map(|mesh| {
+                    let map = |t: &std::sync::Arc<Texture>| TextureMap {
+                        texture: t.clone(),
+                        sampler,
+                        transform: UvTransform::scale_offset(Vec2::splat(repeat), Vec2::ZERO),
+                    };
+                    let mut o = template.clone();
+                    o.mesh = mesh;
+                    o.material = Material::named("pearl").unwrap();
+                    o.shading.interpolation = interp;
+                    o.maps = Maps {
+                        diffuse: Some(map(&texture)),
+                        specular: Some(map(&texture)),
+                        ..Maps::default()
+                    };
+                    o
+                })
+                .collect();
+            let image = phong_raster::render(&scene, &Default::default()).unwrap();
+            let bytes = image.to_bytes(scene.image.encoding, false);
+            let mut textured = 0;
+            for k in 0..120u32 {
+                let (x, y) = ((k * 37) % 97, (k * 23) % 61);
+                let p = phong_serve::probe::probe(&scene, x, y);
+                let i = ((y * 97 + x) * 3) as usize;
+                for c in 0..3 {
+                    let d = (i64::from(bytes[i + c]) - i64::from(p.value8[c])).abs();
+                    assert!(
+                        d <= tolerance,
+                        "{interp:?} {:?} ({x}, {y}) channel {c}: off by {d}",
+                        sampler.mip
+                    );
+                }
+                textured += usize::from(p.hit.as_ref().is_some_and(|h| h.texture.is_some()));
+            }
+            assert!(textured > 40, "{interp:?}: {textured} textured hits");
+        }
+    }
+}

@@ -10,7 +10,7 @@ use crate::simd::Planes;
 use crate::vertex::Projected;
 use glam::{Mat4, Vec3, Vec4};
 use phong_core::mesh::facet_normal;
-use phong_core::{Color, Interpolation, Lighting, Object, Output, ShadingOptions, SurfacePoint, View, light};
+use phong_core::{Color, Interpolation, Object};
 use rayon::prelude::*;
 
 impl Frame<'_> {
@@ -23,9 +23,8 @@ impl Frame<'_> {
         let view = self.views[oi];
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
-        let textured = obj.textured();
         let uvs = mesh.uvs();
-        let lit = |p: Vec3, n: Vec3| lit_at(obj, &scene.lighting, &view, p, n, textured);
+        let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
         let vec3 = |c: Color| Vec3::from(c.to_array());
         let verts: Vec<ClipVertex> = mesh
             .positions()
@@ -113,30 +112,5 @@ impl Frame<'_> {
             out
         };
         mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
-    }
-}
-
-/// The light at a vertex (Gouraud) or a triangle's centroid (flat), as the object's output
-/// shows it: `(colour, black)`, or for a textured object `(primary, specular)` (phong-core's
-/// `Lit` with every term in the primary colour), the texels applied per pixel. Under Gouraud
-/// and flat shading the ambient, emission and shininess maps have no effect: the light is not
-/// computed per pixel.
-fn lit_at(obj: &Object, lighting: &Lighting, view: &View, p: Vec3, n: Vec3, textured: bool) -> (Color, Color) {
-    let output = obj.shading.output;
-    if !textured {
-        return (output.term(&obj.shade(lighting, view, p, n)), Color::BLACK);
-    }
-    let options = ShadingOptions {
-        two_sided: false,
-        ..obj.shading.options
-    };
-    let point = SurfacePoint { position: p, normal: n };
-    let (lit, [e, a, d, s]) = light(&point, view, &obj.material, 1.0, (false, false), lighting, &options);
-    match output {
-        Output::Color => (lit.primary, lit.specular),
-        Output::Ambient => (e + a, Color::BLACK),
-        Output::Diffuse => (d, Color::BLACK),
-        Output::Specular => (Color::BLACK, s),
-        _ => (Color::BLACK, Color::BLACK),
     }
 }
