@@ -320,13 +320,41 @@ fn shared_models_match_their_golden_images() {
         ("tinyobjloader/models/cornell_box.obj", "cornell_box"),
         ("assimp/OBJ/concave_polygon.obj", "concave_polygon"),
         ("assimp/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb", "engine"),
+        // Textured: an OBJ whose MTL names JPEG maps, a glTF with an external PNG, and
+        // KHR_texture_transform's test (each arrow should point at a green check).
+        ("assimp/OBJ/spider.obj", "spider"),
+        ("assimp/glTF2/BoxTextured-glTF/BoxTextured.gltf", "box_textured"),
+        (
+            "assimp/glTF2/textureTransform/TextureTransformTest.gltf",
+            "texture_transform",
+        ),
+        // Spot with its texture, by a scene (the OBJ has no MTL): written below.
+        ("spot_textured.toml", "spot_textured"),
     ] {
+        let model = if model.ends_with(".toml") {
+            let scene = dir.path().join(model);
+            let spot = shared.join("spot");
+            std::fs::write(
+                &scene,
+                format!(
+                    "[camera]\nposition = [0.0, 0.4, 2.6]\nfov = 45.0\n\
+                     [[object]]\nmesh = {:?}\nfit = true\nrotation = [0.0, 150.0, 0.0]\n\
+                     material = {{ diffuse = [1.0, 1.0, 1.0], ambient = [1.0, 1.0, 1.0], diffuse_map = {:?} }}\n",
+                    spot.join("spot_triangulated.obj"),
+                    spot.join("spot_texture.png")
+                ),
+            )
+            .unwrap();
+            scene.to_string_lossy().into_owned()
+        } else {
+            shared.join(model).to_string_lossy().into_owned()
+        };
         let out = dir.path().join(format!("{name}.png"));
         let o = phong(
             dir.path(),
             &[
                 "render",
-                shared.join(model).to_str().unwrap(),
+                &model,
                 "-o",
                 out.to_str().unwrap(),
                 "--width",
@@ -336,6 +364,7 @@ fn shared_models_match_their_golden_images() {
             ],
         );
         assert!(o.status.success(), "{name}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("not used"), "{name}: {}", stderr(&o));
         let want = golden.join(format!("{name}.png"));
         if bless {
             std::fs::create_dir_all(&golden).unwrap();
@@ -352,4 +381,94 @@ fn shared_models_match_their_golden_images() {
             .unwrap_or(0);
         assert!(worst <= 1, "{name}: differs from its golden image by up to {worst}/255");
     }
+}
+
+/// Writes a `w × h` RGB PNG of one colour.
+fn write_png(path: &Path, (w, h): (u32, u32), rgb: [u8; 3]) {
+    let f = std::fs::File::create(path).unwrap();
+    let mut e = png::Encoder::new(std::io::BufWriter::new(f), w, h);
+    e.set_color(png::ColorType::Rgb);
+    e.set_depth(png::BitDepth::Eight);
+    let data: Vec<u8> = (0..w * h).flat_map(|_| rgb).collect();
+    e.write_header().unwrap().write_image_data(&data).unwrap();
+}
+
+/// Texture maps that cannot be used are warnings naming the material, the file and why, and
+/// the material renders without them; a bad sampler key is an error at its line; MTL options
+/// that are not used are warnings at their line; a red map makes a white material red.
+#[test]
+fn texture_problems_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_png(&d.join("red.png"), (4, 4), [255, 0, 0]);
+    std::fs::write(d.join("bad.png"), "not an image").unwrap();
+    let scene = |material: &str| {
+        format!(
+            "[image]\nwidth = 40\nheight = 30\n[camera]\nposition = [0.0, 0.0, 3.0]\n\
+             [[object]]\nshape = \"plane\"\nrotation = [90.0, 0.0, 0.0]\nmaterial = \"m\"\n\
+             [materials.m]\ndiffuse = [1.0, 1.0, 1.0]\nambient = [1.0, 1.0, 1.0]\n{material}\n"
+        )
+    };
+    let render = |name: &str, text: &str| {
+        std::fs::write(d.join(name), text).unwrap();
+        let o = phong(d, &["render", name, "-o", "out.png"]);
+        let centre = read_png(&d.join("out.png"));
+        (o, centre)
+    };
+    for (file, why) in [("missing.png", "cannot read"), ("bad.png", "texture bad.png not used")] {
+        let (o, _) = render("s.toml", &scene(&format!("diffuse_map = \"{file}\"")));
+        assert!(o.status.success(), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("material m") && e.contains(file) && e.contains(why), "{e}");
+    }
+    let (o, (w, h, ch, px)) = render("s.toml", &scene("diffuse_map = \"red.png\""));
+    assert!(o.status.success() && stderr(&o).is_empty(), "{}", stderr(&o));
+    let c = &px[((h / 2 * w + w / 2) as usize) * ch..][..3];
+    assert!(c[0] > 100 && c[1] == 0 && c[2] == 0, "{c:?}");
+    std::fs::write(d.join("s.toml"), scene("diffuse_map = \"red.png\"\nwrap = \"spiral\"")).unwrap();
+    let o = phong(d, &["render", "s.toml", "-o", "out.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("s.toml:14:8: `wrap`: unknown wrap"),
+        "{}",
+        stderr(&o)
+    );
+    // An OBJ whose MTL gives options phong does not use, and a map on a model without
+    // texture coordinates.
+    std::fs::write(
+        d.join("q.mtl"),
+        "newmtl red\nKd 1 1 1\nmap_Kd -bm 0.5 -zz red.png\nmap_Ks -s 2 2 missing.png\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("q.obj"),
+        "mtllib q.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .unwrap();
+    let o = phong(
+        d,
+        &["render", "q.obj", "-o", "q.png", "--width", "40", "--height", "30"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("q.mtl:3: map_Kd option -bm"), "{e}");
+    assert!(e.contains("q.mtl:3: map_Kd option -zz (unknown option)"), "{e}");
+    assert!(
+        e.contains("q.mtl:4: material red: texture") && e.contains("missing.png"),
+        "{e}"
+    );
+    let (w, h, ch, px) = read_png(&d.join("q.png"));
+    let c = &px[((h / 2 * w + w / 2) as usize) * ch..][..3];
+    assert!(c[0] > 50 && c[1] == 0 && c[2] == 0, "the map applies: {c:?}");
+    std::fs::write(
+        d.join("n.obj"),
+        "mtllib q.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nusemtl red\nf 1 2 3\n",
+    )
+    .unwrap();
+    let o = phong(
+        d,
+        &["render", "n.obj", "-o", "n.png", "--width", "40", "--height", "30"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no texture coordinates"), "{}", stderr(&o));
 }
