@@ -206,6 +206,16 @@ impl RunArgs {
             for n in &loaded.notes {
                 eprintln!("phong: {n}");
             }
+            let t = &loaded.textures;
+            if t.images > 0 {
+                eprintln!(
+                    "phong: textures: {} images, {:.1} MiB with mipmaps; decode={:.1}ms mipmaps={:.1}ms",
+                    t.images,
+                    t.bytes as f64 / f64::from(1u32 << 20),
+                    t.decode.as_secs_f64() * 1e3,
+                    t.mipmaps.as_secs_f64() * 1e3
+                );
+            }
         }
         let mut scene = loaded.scene;
         if let Some(w) = self.width {

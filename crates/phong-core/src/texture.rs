@@ -8,7 +8,7 @@
 
 use crate::Error;
 use crate::limits::{MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
-use glam::Vec2;
+use glam::{Vec2, Vec4};
 
 /// How a coordinate outside `[0, 1]` is brought back (`GL_REPEAT`, `GL_CLAMP_TO_EDGE`,
 /// `GL_MIRRORED_REPEAT`).
@@ -105,96 +105,196 @@ impl Sampler {
     }
 }
 
-/// One mipmap level: `width × height` RGBA texels, 16 bits a channel, bottom row first.
-#[derive(Clone, Debug, PartialEq)]
-struct Level {
-    width: u32,
-    height: u32,
-    texels: Vec<[u16; 4]>,
+/// A texel's storage: 8 or 16 bits a channel.
+pub trait Texel: Copy + Send + Sync + std::fmt::Debug + PartialEq + 'static {
+    /// The channels as values in `[0, 1]` (`c / 255` or `c / 65535`, correctly rounded).
+    fn rgba(self) -> [f32; 4];
+    /// The rounded mean of four texels (a mipmap's box filter).
+    fn mean(t: [Self; 4]) -> Self;
+    /// Whether alpha is below its maximum.
+    fn translucent(self) -> bool;
 }
 
-/// An RGBA texture with its mipmap chain. Channels are linear values in `[0, 1]` stored in 16
-/// bits (an 8-bit source's byte `b` as `257·b`, so it reads back as exactly `b/255`).
+impl Texel for [u8; 4] {
+    #[inline(always)]
+    fn rgba(self) -> [f32; 4] {
+        self.map(|c| f32::from(c) / 255.0)
+    }
+    #[inline(always)]
+    fn mean(t: [Self; 4]) -> Self {
+        std::array::from_fn(|i| {
+            ((u16::from(t[0][i]) + u16::from(t[1][i]) + u16::from(t[2][i]) + u16::from(t[3][i]) + 2) / 4) as u8
+        })
+    }
+    fn translucent(self) -> bool {
+        self[3] < u8::MAX
+    }
+}
+
+impl Texel for [u16; 4] {
+    #[inline(always)]
+    fn rgba(self) -> [f32; 4] {
+        self.map(|c| f32::from(c) / 65535.0)
+    }
+    #[inline(always)]
+    fn mean(t: [Self; 4]) -> Self {
+        std::array::from_fn(|i| {
+            ((u32::from(t[0][i]) + u32::from(t[1][i]) + u32::from(t[2][i]) + u32::from(t[3][i]) + 2) / 4) as u16
+        })
+    }
+    fn translucent(self) -> bool {
+        self[3] < u16::MAX
+    }
+}
+
+/// One mipmap level: `width × height` RGBA texels, bottom row first.
+#[derive(Clone, Debug, PartialEq)]
+struct Level<T> {
+    width: u32,
+    height: u32,
+    texels: Vec<T>,
+}
+
+/// A mipmap chain of 8- or 16-bit texels.
+#[derive(Clone, Debug, PartialEq)]
+enum Chain {
+    Eight(Vec<Level<[u8; 4]>>),
+    Sixteen(Vec<Level<[u16; 4]>>),
+}
+
+/// An RGBA texture with its mipmap chain. Channels are linear values in `[0, 1]`, stored in 8
+/// bits (an 8-bit source: byte `b` reads back as exactly `b/255`, as an `RGBA8` texture) or 16.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
-    levels: Vec<Level>,
-    bits: u8,
+    chain: Chain,
+}
+
+/// Checks a texture's size and its texel count.
+fn check_size(width: u32, height: u32, texels: usize, bytes_per_texel: u64) -> Result<(), Error> {
+    if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+        return Err(Error::OutOfRange {
+            what: "texture side",
+            range: "between 1 and 16384 texels",
+            value: width.max(height) as f32,
+        });
+    }
+    let bytes = u64::from(width) * u64::from(height) * bytes_per_texel * 4 / 3;
+    if bytes > MAX_TEXTURE_BYTES {
+        return Err(Error::OutOfRange {
+            what: "texture size with its mipmaps (bytes)",
+            range: "at most 2 GiB",
+            value: bytes as f32,
+        });
+    }
+    if texels as u64 != u64::from(width) * u64::from(height) {
+        return Err(Error::OutOfRange {
+            what: "number of texels",
+            range: "width × height",
+            value: texels as f32,
+        });
+    }
+    Ok(())
+}
+
+/// Level 0 from rows top first, then the chain down to 1×1.
+fn chain<T: Texel>(width: u32, top_first: &[T]) -> Vec<Level<T>> {
+    let height = (top_first.len() / width as usize) as u32;
+    let mut texels: Vec<T> = Vec::with_capacity(top_first.len());
+    for row in top_first.chunks_exact(width as usize).rev() {
+        texels.extend_from_slice(row);
+    }
+    let mut levels = vec![Level { width, height, texels }];
+    while let Some(next) = levels.last().and_then(Level::halved) {
+        levels.push(next);
+    }
+    levels
+}
+
+/// Calls `$body` with `$l` bound to the chain's levels, whichever their storage.
+macro_rules! with_levels {
+    ($self:expr, $l:ident => $body:expr) => {
+        match &$self.chain {
+            Chain::Eight($l) => $body,
+            Chain::Sixteen($l) => $body,
+        }
+    };
 }
 
 impl Texture {
-    /// A texture from `width × height` texels, **top row first** (as image files store them),
-    /// whose source had `bits` (8 or 16) bits a channel. The mipmap chain is built down to 1×1:
-    /// each texel of a level is the mean of the 2×2 block below it (the last row or column of
-    /// an odd size is left out, as Mesa does), rounded to the source's precision as a driver
-    /// storing the source's format does.
+    /// A texture from `width × height` texels of 16 bits a channel, **top row first** (as image
+    /// files store them), whose source had `bits` (8 or 16) bits a channel: with 8, each value
+    /// is taken as the byte `round(v / 257)` and stored in 8 bits. The mipmap chain is built
+    /// down to 1×1: each texel of a level is the mean of the 2×2 block below it (the last row
+    /// or column of an odd size is left out, as Mesa does), rounded to the storage's precision
+    /// as a driver storing the source's format does.
     pub fn new(width: u32, height: u32, top_first: &[[u16; 4]], bits: u8) -> Result<Texture, Error> {
-        if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
-            return Err(Error::OutOfRange {
-                what: "texture side",
-                range: "between 1 and 16384 texels",
-                value: width.max(height) as f32,
-            });
+        if bits == 8 {
+            let bytes: Vec<[u8; 4]> = top_first
+                .iter()
+                .map(|t| t.map(|c| ((u32::from(c) + 128) / 257) as u8))
+                .collect();
+            return Texture::from_rgba8(width, height, &bytes);
         }
-        let bytes = u64::from(width) * u64::from(height) * 8 * 4 / 3;
-        if bytes > MAX_TEXTURE_BYTES {
-            return Err(Error::OutOfRange {
-                what: "texture size with its mipmaps (bytes)",
-                range: "at most 2 GiB",
-                value: bytes as f32,
-            });
-        }
-        if top_first.len() as u64 != u64::from(width) * u64::from(height) {
-            return Err(Error::OutOfRange {
-                what: "number of texels",
-                range: "width × height",
-                value: top_first.len() as f32,
-            });
-        }
-        let w = width as usize;
-        let texels: Vec<[u16; 4]> = top_first.chunks_exact(w).rev().flatten().copied().collect();
-        let mut levels = vec![Level { width, height, texels }];
-        while let Some(next) = levels.last().and_then(|l| l.halved(bits)) {
-            levels.push(next);
-        }
-        Ok(Texture { levels, bits })
+        check_size(width, height, top_first.len(), 8)?;
+        Ok(Texture {
+            chain: Chain::Sixteen(chain(width, top_first)),
+        })
+    }
+
+    /// A texture from 8-bit texels, top row first (see [`Texture::new`]).
+    pub fn from_rgba8(width: u32, height: u32, top_first: &[[u8; 4]]) -> Result<Texture, Error> {
+        check_size(width, height, top_first.len(), 4)?;
+        Ok(Texture {
+            chain: Chain::Eight(chain(width, top_first)),
+        })
     }
 
     /// Width of level 0.
     pub fn width(&self) -> u32 {
-        self.levels[0].width
+        with_levels!(self, l => l[0].width)
     }
     /// Height of level 0.
     pub fn height(&self) -> u32 {
-        self.levels[0].height
+        with_levels!(self, l => l[0].height)
     }
-    /// Bits a channel of the source (8 or 16).
+    /// Bits a channel (8 or 16).
     pub fn bits(&self) -> u8 {
-        self.bits
+        match self.chain {
+            Chain::Eight(_) => 8,
+            Chain::Sixteen(_) => 16,
+        }
     }
     /// Number of mipmap levels (level 0 included).
     pub fn level_count(&self) -> usize {
-        self.levels.len()
+        with_levels!(self, l => l.len())
     }
-    /// Level `i`: its size and texels, bottom row first.
-    pub fn level(&self, i: usize) -> (u32, u32, &[[u16; 4]]) {
-        let l = &self.levels[i];
-        (l.width, l.height, &l.texels)
+    /// Level `i` of an 8-bit texture: its size and texels, bottom row first.
+    pub fn level8(&self, i: usize) -> Option<(u32, u32, &[[u8; 4]])> {
+        match &self.chain {
+            Chain::Eight(l) => Some((l[i].width, l[i].height, &l[i].texels)),
+            Chain::Sixteen(_) => None,
+        }
+    }
+    /// Level `i` of a 16-bit texture: its size and texels, bottom row first.
+    pub fn level16(&self, i: usize) -> Option<(u32, u32, &[[u16; 4]])> {
+        match &self.chain {
+            Chain::Sixteen(l) => Some((l[i].width, l[i].height, &l[i].texels)),
+            Chain::Eight(_) => None,
+        }
     }
     /// Bytes held, every level.
     pub fn bytes(&self) -> u64 {
-        self.levels.iter().map(|l| l.texels.len() as u64 * 8).sum()
+        with_levels!(self, l => l.iter().map(|l| (l.texels.len() * size_of_val(&l.texels[0])) as u64).sum())
     }
     /// Whether any texel of level 0 has alpha below 1.
     pub fn has_alpha(&self) -> bool {
-        self.levels[0].texels.iter().any(|t| t[3] < u16::MAX)
+        with_levels!(self, l => l[0].texels.iter().any(|t| t.translucent()))
     }
 
     /// Texel `(x, y)` of `level` (bottom row 0) as linear RGBA.
     #[inline]
     pub fn texel(&self, level: usize, x: u32, y: u32) -> [f32; 4] {
-        let l = &self.levels[level];
-        let t = l.texels[y as usize * l.width as usize + x as usize];
-        t.map(|c| f32::from(c) / 65535.0)
+        with_levels!(self, l => l[level].texel(x, y))
     }
 
     /// The level of detail `λ = log2 ρ` for texture-coordinate derivatives `d(u, v)/dx` and
@@ -203,8 +303,9 @@ impl Texture {
     #[inline]
     pub fn lod(&self, d_dx: Vec2, d_dy: Vec2) -> f32 {
         let size = Vec2::new(self.width() as f32, self.height() as f32);
-        let rho = (d_dx * size).length().max((d_dy * size).length());
-        rho.log2()
+        // log2 ρ = ½ log2 ρ²: no square roots.
+        let rho2 = (d_dx * size).length_squared().max((d_dy * size).length_squared());
+        0.5 * rho2.log2()
     }
 
     /// The filtered RGBA at `uv` with level of detail `lod` (see [`Texture::lod`]), as OpenGL's
@@ -214,7 +315,7 @@ impl Texture {
         if !minify {
             return self.filter(0, s.mag, s, uv);
         }
-        let q = (self.levels.len() - 1) as f32;
+        let q = (self.level_count() - 1) as f32;
         match s.mip {
             MipFilter::None => self.filter(0, s.min, s, uv),
             MipFilter::Nearest => {
@@ -241,29 +342,72 @@ impl Texture {
     /// `uv` filtered within one level.
     #[inline]
     fn filter(&self, level: usize, f: Filter, s: &Sampler, uv: Vec2) -> [f32; 4] {
-        let l = &self.levels[level];
-        let (w, h) = (l.width as f32, l.height as f32);
+        with_levels!(self, l => l[level].filter(f, s, uv))
+    }
+}
+
+impl<T: Texel> Level<T> {
+    #[inline(always)]
+    fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.texels[y as usize * self.width as usize + x as usize].rgba()
+    }
+
+    #[inline(always)]
+    fn texel4(&self, x: u32, y: u32) -> Vec4 {
+        Vec4::from_array(self.texel(x, y))
+    }
+
+    /// `uv` filtered within this level.
+    #[inline(always)]
+    fn filter(&self, f: Filter, s: &Sampler, uv: Vec2) -> [f32; 4] {
+        let (w, h) = (self.width as f32, self.height as f32);
         match f {
             Filter::Nearest => {
-                let x = wrap(s.wrap_u, floor(uv.x * w), l.width);
-                let y = wrap(s.wrap_v, floor(uv.y * h), l.height);
-                self.texel(level, x, y)
+                let x = wrap(s.wrap_u, floor(uv.x * w), self.width);
+                let y = wrap(s.wrap_v, floor(uv.y * h), self.height);
+                self.texel(x, y)
             }
             Filter::Linear => {
                 let (fx, fy) = (uv.x * w - 0.5, uv.y * h - 0.5);
                 let (ix, iy) = (floor(fx), floor(fy));
                 let (a, b) = (fx - ix, fy - iy);
-                let (x0, x1) = wrap_pair(s.wrap_u, ix, l.width);
-                let (y0, y1) = wrap_pair(s.wrap_v, iy, l.height);
-                let t00 = self.texel(level, x0, y0);
-                let t10 = self.texel(level, x1, y0);
-                let t01 = self.texel(level, x0, y1);
-                let t11 = self.texel(level, x1, y1);
-                std::array::from_fn(|i| {
-                    (1.0 - a) * (1.0 - b) * t00[i] + a * (1.0 - b) * t10[i] + (1.0 - a) * b * t01[i] + a * b * t11[i]
-                })
+                let (x0, x1) = wrap_pair(s.wrap_u, ix, self.width);
+                let (y0, y1) = wrap_pair(s.wrap_v, iy, self.height);
+                // Four lanes at once (glam's SSE vectors): the same products and sums per channel.
+                let t00 = self.texel4(x0, y0);
+                let t10 = self.texel4(x1, y0);
+                let t01 = self.texel4(x0, y1);
+                let t11 = self.texel4(x1, y1);
+                let (w00, w10) = ((1.0 - a) * (1.0 - b), a * (1.0 - b));
+                let (w01, w11) = ((1.0 - a) * b, a * b);
+                (t00 * w00 + t10 * w10 + t01 * w01 + t11 * w11).to_array()
             }
         }
+    }
+
+    /// The next mipmap level, `None` at 1×1.
+    fn halved(&self) -> Option<Level<T>> {
+        if self.width == 1 && self.height == 1 {
+            return None;
+        }
+        let (width, height) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let sw = self.width as usize;
+        let step = |n: u32| usize::from(n > 1);
+        let (dx, dy) = (step(self.width), step(self.height));
+        let mut texels = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height as usize {
+            let (ya, yb) = (y * (1 + dy), y * (1 + dy) + dy);
+            let (a, b) = (&self.texels[ya * sw..][..sw], &self.texels[yb * sw..][..sw]);
+            if dx == 1 {
+                // Pairs of columns (an odd last column is left out).
+                for (p, q) in a.chunks_exact(2).zip(b.chunks_exact(2)) {
+                    texels.push(T::mean([p[0], p[1], q[0], q[1]]));
+                }
+            } else {
+                texels.extend(a.iter().zip(b).map(|(&p, &q)| T::mean([p, p, q, q])));
+            }
+        }
+        Some(Level { width, height, texels })
     }
 }
 
@@ -321,34 +465,6 @@ fn wrap(mode: Wrap, i: f32, n: u32) -> u32 {
     k as u32
 }
 
-impl Level {
-    /// The next mipmap level, `None` at 1×1.
-    fn halved(&self, bits: u8) -> Option<Level> {
-        if self.width == 1 && self.height == 1 {
-            return None;
-        }
-        let (width, height) = ((self.width / 2).max(1), (self.height / 2).max(1));
-        let sw = self.width as usize;
-        let step = |n: u32| usize::from(n > 1);
-        let (dx, dy) = (step(self.width), step(self.height));
-        let scale = if bits == 8 { 257.0 } else { 1.0 };
-        let mut texels = Vec::with_capacity(width as usize * height as usize);
-        for y in 0..height as usize {
-            let (ya, yb) = (y * (1 + dy), y * (1 + dy) + dy);
-            for x in 0..width as usize {
-                let (xa, xb) = (x * (1 + dx), x * (1 + dx) + dx);
-                let at = |x: usize, y: usize| self.texels[y * sw + x];
-                let (a, b, c, d) = (at(xa, ya), at(xb, ya), at(xa, yb), at(xb, yb));
-                texels.push(std::array::from_fn(|i| {
-                    let sum = f64::from(a[i]) + f64::from(b[i]) + f64::from(c[i]) + f64::from(d[i]);
-                    ((sum / 4.0 / scale).round() * scale) as u16
-                }));
-            }
-        }
-        Some(Level { width, height, texels })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -363,10 +479,10 @@ mod tests {
         // 3×2, top row first: [0 10 99; 20 31 99]; bottom-first rows [20 31 99], [0 10 99].
         let t = grey(&[0, 10, 99, 20, 31, 99], 3, 2);
         assert_eq!(t.level_count(), 2);
-        let (w, h, l1) = t.level(1);
+        let (w, h, l1) = t.level8(1).unwrap();
         assert_eq!((w, h), (1, 1));
         // The odd column is left out: (0 + 10 + 20 + 31) / 4 = 15.25 → 15.
-        assert_eq!(l1[0][0], 15 * 257);
+        assert_eq!(l1[0][0], 15);
         assert_eq!(t.texel(0, 0, 1)[0], 0.0, "row 1 is the image's top row");
         assert_eq!(t.texel(0, 1, 0)[0], 31.0 / 255.0);
     }

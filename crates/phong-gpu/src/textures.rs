@@ -100,16 +100,19 @@ impl Gpu {
             view_formats: &[],
         });
         for level in 0..t.level_count() {
-            let (w, h, texels) = t.level(level);
             // Rows bottom first, as the CPU keeps them: v = 0 is row 0 on both.
-            let bytes: Vec<u8> = if eight {
-                texels.iter().flat_map(|p| p.map(|c| (c / 257) as u8)).collect()
-            } else {
-                texels
-                    .iter()
-                    .flat_map(|p| p.map(|c| half::f16::from_f32(f32::from(c) / 65535.0)))
-                    .flat_map(|h| h.to_le_bytes())
-                    .collect()
+            let (w, h, bytes): (u32, u32, Vec<u8>) = match (t.level8(level), t.level16(level)) {
+                (Some((w, h, texels)), _) => (w, h, texels.as_flattened().to_vec()),
+                (None, Some((w, h, texels))) => (
+                    w,
+                    h,
+                    texels
+                        .iter()
+                        .flat_map(|p| p.map(|c| half::f16::from_f32(f32::from(c) / 65535.0)))
+                        .flat_map(|h| h.to_le_bytes())
+                        .collect(),
+                ),
+                (None, None) => continue,
             };
             self.queue.write_texture(
                 wgpu::TexelCopyTextureInfo {

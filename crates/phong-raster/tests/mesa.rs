@@ -105,10 +105,10 @@ fn mesa(exe: &PathBuf, scene: &Scene) -> Vec<u8> {
     match &o.maps.diffuse {
         None => writeln!(s, "0 0").unwrap(),
         Some(map) => {
-            let (tw, th, texels) = map.texture.level(0);
+            let (tw, th, texels) = map.texture.level8(0).expect("an 8-bit texture");
             writeln!(s, "{tw} {th}").unwrap();
             for t in texels {
-                writeln!(s, "{} {} {} {}", t[0] / 257, t[1] / 257, t[2] / 257, t[3] / 257).unwrap();
+                writeln!(s, "{} {} {} {}", t[0], t[1], t[2], t[3]).unwrap();
             }
             let wrap = match map.sampler.wrap_u {
                 Wrap::Repeat => 0,

@@ -32,7 +32,7 @@ pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
-pub use texture_file::{ReadFile, decode as decode_texture};
+pub use texture_file::{ReadFile, TextureStats, decode as decode_texture};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_with,
 };
@@ -52,6 +52,8 @@ pub struct Loaded {
     /// What was decided for the user's information (`-v`): a model alone's up axis, culling,
     /// re-centring.
     pub notes: Vec<String>,
+    /// The texture images read, and what they cost (`-v`).
+    pub textures: TextureStats,
 }
 
 /// Loads a scene file (`.toml`) or a model (`.obj`, `.ply`, `.stl`, framed by a default camera
@@ -74,6 +76,13 @@ pub fn is_model_path(path: &Path) -> bool {
 
 /// [`load`], a model alone viewed as `options` says (a scene file ignores them).
 pub fn load_with(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
+    texture_file::take_stats();
+    let mut loaded = load_without_stats(path, options)?;
+    loaded.textures = texture_file::take_stats();
+    Ok(loaded)
+}
+
+fn load_without_stats(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     if is_model_path(path) {
         model::scene_for_model(path, options)
     } else {

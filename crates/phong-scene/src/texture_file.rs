@@ -7,8 +7,35 @@
 
 use phong_core::limits::{MAX_IMAGE_FILE_BYTES, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
 use phong_core::{Channel, Maps, Sampler, Texture, TextureMap, UvTransform, Wrap};
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What reading texture images cost: images decoded, bytes held with their mipmaps, and the
+/// time decoding and building mipmaps (for `-v`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TextureStats {
+    /// Images decoded.
+    pub images: usize,
+    /// Bytes of their textures, mipmaps included.
+    pub bytes: u64,
+    /// Reading and decoding the files.
+    pub decode: Duration,
+    /// Building the mipmap chains.
+    pub mipmaps: Duration,
+}
+
+thread_local! {
+    /// This thread's texture reading since [`take_stats`]: loading a scene is one call on one
+    /// thread, and its loaders (scene keys, OBJ, glTF) each keep their own cache.
+    static STATS: Cell<TextureStats> = Cell::new(TextureStats::default());
+}
+
+/// The texture reading done on this thread since the last call, and a fresh count.
+pub fn take_stats() -> TextureStats {
+    STATS.with(|s| s.replace(TextureStats::default()))
+}
 
 /// Which map of a material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,20 +117,42 @@ impl TextureCache {
         if let Some(r) = self.done.get(&key) {
             return r.clone();
         }
-        let r = match source {
-            Source::File(f) => read(f).and_then(|b| decode(&b, srgb)),
-            Source::Bytes(b, _) => decode(b, srgb),
-        }
-        .map(Arc::new);
+        let start = Instant::now();
+        let bytes = match source {
+            Source::File(f) => read(f),
+            Source::Bytes(b, _) => Ok(b.to_vec()),
+        };
+        let r = bytes.and_then(|b| decode_timed(&b, srgb, start)).map(Arc::new);
         self.done.insert(key, r.clone());
         r
     }
+}
+
+/// [`decode`], its time added to this thread's [`TextureStats`] (`start`: when reading began).
+fn decode_timed(bytes: &[u8], srgb: bool, start: Instant) -> Result<Texture, String> {
+    let mut mipmaps = Duration::ZERO;
+    let t = decode_with(bytes, srgb, &mut mipmaps)?;
+    STATS.with(|s| {
+        let mut v = s.get();
+        v.images += 1;
+        v.bytes += t.bytes();
+        v.decode += start.elapsed().saturating_sub(mipmaps);
+        v.mipmaps += mipmaps;
+        s.set(v);
+    });
+    Ok(t)
 }
 
 /// Decodes an image into a texture: 8-bit sources keep 8 bits (read back as `b/255`), 16-bit
 /// and float sources 16; with `srgb` the colour channels are decoded to linear (in 16 bits),
 /// alpha never is.
 pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
+    let mut mipmaps = Duration::ZERO;
+    decode_with(bytes, srgb, &mut mipmaps)
+}
+
+/// [`decode`], the time spent building mipmaps added to `mipmaps`.
+fn decode_with(bytes: &[u8], srgb: bool, mipmaps: &mut Duration) -> Result<Texture, String> {
     if bytes.len() as u64 > MAX_IMAGE_FILE_BYTES {
         return Err(format!("larger than {} MiB", MAX_IMAGE_FILE_BYTES >> 20));
     }
@@ -121,6 +170,14 @@ pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
         _ => 16,
     };
     let (w, h) = (img.width(), img.height());
+    if bits == 8 && !srgb {
+        let rgba = img.into_rgba8();
+        let texels: &[[u8; 4]] = rgba.as_raw().as_chunks().0;
+        let start = Instant::now();
+        let t = Texture::from_rgba8(w, h, texels).map_err(|e| e.to_string());
+        *mipmaps += start.elapsed();
+        return t;
+    }
     let rgba = img.into_rgba16();
     let lut: Option<Vec<u16>> = srgb.then(|| {
         (0..=u16::MAX)
@@ -142,7 +199,10 @@ pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
             None => p.0,
         })
         .collect();
-    Texture::new(w, h, &texels, if srgb { 16 } else { bits }).map_err(|e| e.to_string())
+    let start = Instant::now();
+    let t = Texture::new(w, h, &texels, if srgb { 16 } else { bits }).map_err(|e| e.to_string());
+    *mipmaps += start.elapsed();
+    t
 }
 
 /// A material's maps from its requests, images read by `read` through `cache`; every request

@@ -81,6 +81,7 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         warnings: ctx.warnings,
         sources: ctx.sources,
         notes: Vec::new(),
+        textures: Default::default(),
     })
 }
 
