@@ -664,11 +664,12 @@ fn valid_upload_name(name: &str) -> Result<(), ApiError> {
     }
     if !matches!(
         ext.as_deref(),
-        Some("obj" | "mtl" | "ply" | "stl" | "gltf" | "glb" | "bin")
+        Some("obj" | "mtl" | "ply" | "stl" | "gltf" | "glb" | "bin" | "png" | "jpg" | "jpeg" | "tga" | "bmp")
     ) {
         return Err(ApiError::at(
             "name",
-            "uploads are models (Wavefront .obj with their .mtl libraries, .gltf with their .bin buffers, .glb, .ply, .stl)",
+            "uploads are models (Wavefront .obj with their .mtl libraries, .gltf with their .bin buffers, .glb, .ply, .stl) \
+             and their texture images (.png, .jpg, .jpeg, .tga, .bmp)",
         ));
     }
     Ok(())

@@ -281,8 +281,8 @@ async fn uploads_are_per_client_in_memory_and_capped() {
     assert_eq!(refused(&r).1, "object[0].mesh");
     let list = call(&st, "GET", "/api/models", "a", Body::empty()).await.json();
     assert_eq!(list["uploads"], json!(["t.mtl", "t.obj"]));
-    // Names: no paths, only .obj and .mtl.
-    for name in ["..%2Fx.obj", "x.png", ".hidden.obj", "a%2Fb.obj"] {
+    // Names: no paths; models, their libraries and buffers, and images only.
+    for name in ["..%2Fx.obj", "x.exe", ".hidden.obj", "a%2Fb.obj"] {
         let r = put("a", name, "v 0 0 0").await;
         assert_eq!(refused(&r).0, 400, "{name}");
     }
@@ -764,4 +764,33 @@ fn the_probe_samples_textures_as_the_renderer() {
             assert!(textured > 40, "{interp:?}: {textured} textured hits");
         }
     }
+}
+
+/// An OBJ uploaded with its MTL and the PNG its `map_Kd` names: the page's scene renders it
+/// textured (a green map on a white material, lit head-on, makes the quad green).
+#[tokio::test]
+async fn uploaded_textures_are_used() {
+    let st = state();
+    let green = phong_core::Image::new(2, 2, [0.0, 1.0, 0.0, 1.0]).expect("image");
+    let png = phong_scene::encode_png(&green, phong_core::Encoding::Linear).expect("png");
+    let put = |name: &str, body: Vec<u8>| {
+        let (st, uri) = (st.clone(), format!("/api/models/{name}"));
+        async move { call(&st, "PUT", &uri, "a", body).await }
+    };
+    assert_eq!(put("g.png", png).await.status, StatusCode::CREATED);
+    let mtl = "newmtl m\nKd 1 1 1\nKa 0 0 0\nmap_Kd textures\\g.png\n";
+    assert_eq!(put("q.mtl", mtl.into()).await.status, StatusCode::CREATED);
+    let obj = "mtllib q.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n";
+    let r = put("q.obj", obj.into()).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.json());
+    let scene = json!({"image": {"width": 32, "height": 32},
+        "camera": {"position": [0, 0, 3]},
+        "light": [{"type": "directional", "direction": [0, 0, -1]}],
+        "shading": {"ambient": [0, 0, 0]},
+        "object": [{"mesh": "q.obj"}]});
+    let r = call(&st, "POST", "/api/render", "a", scene.to_string()).await;
+    assert_eq!(r.status, StatusCode::OK);
+    let (_, _, px) = decode(&r.body);
+    let c = (16 * 32 + 16) * 3;
+    assert_eq!(&px[c..c + 3], &[0, 255, 0]);
 }

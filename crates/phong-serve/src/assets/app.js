@@ -923,8 +923,9 @@ async function downloadPng() {
 }
 
 async function loadFiles(files) {
-  // MTL libraries and glTF buffers first, so that the model finds them when it is parsed.
-  const aside = (f) => (/\.(mtl|bin)$/i.test(f.name) ? -1 : 0);
+  // MTL libraries, glTF buffers and texture images first, so that the model finds them when it
+  // is parsed.
+  const aside = (f) => (/\.(mtl|bin|png|jpe?g|tga|bmp)$/i.test(f.name) ? -1 : 0);
   files.sort((a, b) => aside(a) - aside(b));
   let objInfo = null;
   for (const f of files) {
