@@ -7,6 +7,12 @@
  *
  *   harness fill|sphere SEGMENTS gouraud|phong LIGHTS WIDTH HEIGHT FRAMES [out.ppm]
  *
+ * With TEXTURE=file.ppm (a binary P6 PPM) in the environment, the object has that diffuse map,
+ * repeated 4 x 3 times on the fill quad and 4 x 2 times round the sphere, mipmapped by the
+ * driver (glGenerateMipmap), sampled GL_LINEAR_MIPMAP_LINEAR and applied as GL_MODULATE with a
+ * separate specular colour (the fixed function's, or the same in the Phong shader): the
+ * textured benchmark scenes' *_textured files.
+ *
  * Build and run: see BENCHMARKS.md (benches/llvmpipe/run.sh).
  */
 #define GL_GLEXT_PROTOTYPES
@@ -58,6 +64,51 @@ static const char *FS =
     "    c += att * term; }\n"
     "  gl_FragColor = vec4(clamp(c, 0.0, 1.0), 1.0);\n"
     "}\n";
+/* The same with a diffuse map: the primary colour clamped, times the texel, plus the clamped
+ * specular (GL_MODULATE with GL_SEPARATE_SPECULAR_COLOR). */
+static const char *VS_TEX =
+    "#version 120\n"
+    "varying vec3 p; varying vec3 n;\n"
+    "void main() { p = vec3(gl_ModelViewMatrix * gl_Vertex); n = gl_NormalMatrix * gl_Normal;\n"
+    "  gl_TexCoord[0] = gl_MultiTexCoord0; gl_Position = ftransform(); }\n";
+static const char *FS_TEX =
+    "uniform sampler2D map; varying vec3 p; varying vec3 n;\n"
+    "void main() {\n"
+    "  vec3 N = normalize(n); vec3 V = normalize(-p);\n"
+    "  vec3 c = gl_FrontMaterial.emission.rgb + gl_FrontMaterial.ambient.rgb * gl_LightModel.ambient.rgb;\n"
+    "  vec3 s = vec3(0.0);\n"
+    "  for (int i = 0; i < NLIGHTS; i++) {\n"
+    "    vec3 d = gl_LightSource[i].position.xyz - p; float dist = length(d); vec3 L = d / dist;\n"
+    "    float att = 1.0 / (gl_LightSource[i].constantAttenuation + dist * (gl_LightSource[i].linearAttenuation\n"
+    "                + dist * gl_LightSource[i].quadraticAttenuation));\n"
+    "    float ndl = dot(N, L);\n"
+    "    c += att * gl_FrontMaterial.ambient.rgb * gl_LightSource[i].ambient.rgb;\n"
+    "    if (ndl > 0.0) {\n"
+    "      c += att * ndl * gl_FrontMaterial.diffuse.rgb * gl_LightSource[i].diffuse.rgb;\n"
+    "      float ndh = max(dot(N, normalize(L + V)), 0.0);\n"
+    "      s += att * pow(ndh, gl_FrontMaterial.shininess) * gl_FrontMaterial.specular.rgb * gl_LightSource[i].specular.rgb;\n"
+    "    }\n"
+    "  }\n"
+    "  vec3 t = texture2D(map, gl_TexCoord[0].st).rgb;\n"
+    "  gl_FragColor = vec4(clamp(clamp(c, 0.0, 1.0) * t + clamp(s, 0.0, 1.0), 0.0, 1.0), 1.0);\n"
+    "}\n";
+
+/* A binary P6 PPM as RGBA rows bottom first (OpenGL's order); NULL where it cannot be read. */
+static unsigned char *read_ppm(const char *path, int *w, int *h) {
+    FILE *f = fopen(path, "rb");
+    int max;
+    if (!f || fscanf(f, "P6 %d %d %d", w, h, &max) != 3 || max != 255 || fgetc(f) == EOF) return NULL;
+    unsigned char *rgb = malloc((size_t)*w * *h * 3), *rgba = malloc((size_t)*w * *h * 4);
+    if (fread(rgb, 3, (size_t)*w * *h, f) != (size_t)*w * *h) return NULL;
+    fclose(f);
+    for (int y = 0; y < *h; y++)
+        for (int x = 0; x < *w; x++) {
+            unsigned char *i = rgb + 3 * ((size_t)(*h - 1 - y) * *w + x), *o = rgba + 4 * ((size_t)y * *w + x);
+            o[0] = i[0]; o[1] = i[1]; o[2] = i[2]; o[3] = 255;
+        }
+    free(rgb);
+    return rgba;
+}
 
 static GLuint compile(GLenum kind, const char *src) {
     GLuint s = glCreateShader(kind);
@@ -95,10 +146,13 @@ int main(int argc, char **argv) {
      * formula and triangles, pole triangles of zero area dropped), or the fill scene's quad. */
     int rows = sphere ? (seg / 2 > 2 ? seg / 2 : 2) : 1, cols = sphere ? seg : 1;
     int nv = (rows + 1) * (cols + 1);
-    float *vtx = malloc(sizeof(float) * 6 * nv);
+    float *vtx = malloc(sizeof(float) * 6 * nv), *uv = malloc(sizeof(float) * 2 * nv);
     for (int i = 0; i <= rows; i++)
         for (int j = 0; j <= cols; j++) {
             float *o = vtx + 6 * (i * (cols + 1) + j);
+            /* phong's coordinates for the shape, times the scene's uv_scale. */
+            uv[2 * (i * (cols + 1) + j)] = (float)j / cols * 4.0f;
+            uv[2 * (i * (cols + 1) + j) + 1] = (1.0f - (float)i / rows) * (sphere ? 2.0f : 3.0f);
             if (sphere) {
                 float th = (float)i / rows * 3.14159265f, ph = (float)j / cols * 6.2831853f;
                 o[0] = sinf(th) * cosf(ph); o[1] = cosf(th); o[2] = sinf(th) * sinf(ph);
@@ -136,6 +190,31 @@ int main(int argc, char **argv) {
     glEnableClientState(GL_NORMAL_ARRAY);
     glVertexPointer(3, GL_FLOAT, 24, (void *)0);
     glNormalPointer(GL_FLOAT, 24, (void *)12);
+    const char *texture = getenv("TEXTURE");
+    if (texture) {
+        int tw, th;
+        unsigned char *texels = read_ppm(texture, &tw, &th);
+        if (!texels) {
+            fprintf(stderr, "cannot read %s (a binary P6 PPM)\n", texture);
+            return 1;
+        }
+        GLuint uvb, tex;
+        glGenBuffers(1, &uvb);
+        glBindBuffer(GL_ARRAY_BUFFER, uvb);
+        glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 2 * nv, uv, GL_STATIC_DRAW);
+        glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+        glTexCoordPointer(2, GL_FLOAT, 0, (void *)0);
+        glBindBuffer(GL_ARRAY_BUFFER, vbo);
+        glGenTextures(1, &tex);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, tw, th, 0, GL_RGBA, GL_UNSIGNED_BYTE, texels);
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glLightModeli(GL_LIGHT_MODEL_COLOR_CONTROL, GL_SEPARATE_SPECULAR_COLOR);
+        glEnable(GL_TEXTURE_2D);
+    }
 
     glViewport(0, 0, w, h);
     glMatrixMode(GL_PROJECTION);
@@ -178,9 +257,9 @@ int main(int argc, char **argv) {
 
     if (phong) {
         GLuint prog = glCreateProgram();
-        glAttachShader(prog, compile(GL_VERTEX_SHADER, VS));
-        char fs[4096];
-        snprintf(fs, sizeof fs, "#version 120\n#define NLIGHTS %d\n%s", nl, FS);
+        glAttachShader(prog, compile(GL_VERTEX_SHADER, texture ? VS_TEX : VS));
+        char fs[8192];
+        snprintf(fs, sizeof fs, "#version 120\n#define NLIGHTS %d\n%s", nl, texture ? FS_TEX : FS);
         glAttachShader(prog, compile(GL_FRAGMENT_SHADER, fs));
         glLinkProgram(prog);
         glUseProgram(prog);

@@ -107,8 +107,12 @@ impl Sampler {
 
 /// A texel's storage: 8 or 16 bits a channel.
 pub trait Texel: Copy + Send + Sync + std::fmt::Debug + PartialEq + 'static {
+    /// The largest channel value (255 or 65535).
+    const MAX: f32;
     /// The channels as values in `[0, 1]` (`c / 255` or `c / 65535`, correctly rounded).
     fn rgba(self) -> [f32; 4];
+    /// The channels as they are stored, as floats.
+    fn units(self) -> [f32; 4];
     /// The rounded mean of four texels (a mipmap's box filter).
     fn mean(t: [Self; 4]) -> Self;
     /// Whether alpha is below its maximum.
@@ -116,6 +120,11 @@ pub trait Texel: Copy + Send + Sync + std::fmt::Debug + PartialEq + 'static {
 }
 
 impl Texel for [u8; 4] {
+    const MAX: f32 = 255.0;
+    #[inline(always)]
+    fn units(self) -> [f32; 4] {
+        self.map(f32::from)
+    }
     #[inline(always)]
     fn rgba(self) -> [f32; 4] {
         self.map(|c| f32::from(c) / 255.0)
@@ -132,6 +141,11 @@ impl Texel for [u8; 4] {
 }
 
 impl Texel for [u16; 4] {
+    const MAX: f32 = 65535.0;
+    #[inline(always)]
+    fn units(self) -> [f32; 4] {
+        self.map(f32::from)
+    }
     #[inline(always)]
     fn rgba(self) -> [f32; 4] {
         self.map(|c| f32::from(c) / 65535.0)
@@ -305,46 +319,51 @@ impl Texture {
         let size = Vec2::new(self.width() as f32, self.height() as f32);
         // log2 ρ = ½ log2 ρ²: no square roots.
         let rho2 = (d_dx * size).length_squared().max((d_dy * size).length_squared());
-        0.5 * rho2.log2()
+        0.5 * log2(rho2)
     }
 
     /// The filtered RGBA at `uv` with level of detail `lod` (see [`Texture::lod`]), as OpenGL's
     /// sampler `s` gives it. A NaN level of detail magnifies.
     pub fn sample(&self, s: &Sampler, uv: Vec2, lod: f32) -> [f32; 4] {
+        with_levels!(self, l => sample_levels(l, s, uv, lod))
+    }
+}
+
+/// [`Texture::sample`] on one storage's levels.
+#[inline(always)]
+fn sample_levels<T: Texel>(levels: &[Level<T>], s: &Sampler, uv: Vec2, lod: f32) -> [f32; 4] {
+    let filter = |level: usize, f: Filter| levels[level].filter(f, s, uv);
+    {
         let minify = lod > s.switch_point();
         if !minify {
-            return self.filter(0, s.mag, s, uv);
+            return filter(0, s.mag);
         }
-        let q = (self.level_count() - 1) as f32;
+        let q = (levels.len() - 1) as f32;
         match s.mip {
-            MipFilter::None => self.filter(0, s.min, s, uv),
+            MipFilter::None => filter(0, s.min),
             MipFilter::Nearest => {
                 let d = if lod <= 0.5 {
                     0.0
                 } else {
                     ((lod + 0.5).ceil() - 1.0).min(q)
                 };
-                self.filter(d as usize, s.min, s, uv)
+                filter(d as usize, s.min)
             }
             MipFilter::Linear => {
                 if lod >= q {
-                    return self.filter(q as usize, s.min, s, uv);
+                    return filter(q as usize, s.min);
                 }
                 let d1 = floor(lod);
                 let t = lod - d1;
-                let a = self.filter(d1 as usize, s.min, s, uv);
-                let b = self.filter(d1 as usize + 1, s.min, s, uv);
+                let a = filter(d1 as usize, s.min);
+                let b = filter(d1 as usize + 1, s.min);
                 std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t)
             }
         }
     }
-
-    /// `uv` filtered within one level.
-    #[inline]
-    fn filter(&self, level: usize, f: Filter, s: &Sampler, uv: Vec2) -> [f32; 4] {
-        with_levels!(self, l => l[level].filter(f, s, uv))
-    }
 }
+
+impl Texture {}
 
 impl<T: Texel> Level<T> {
     #[inline(always)]
@@ -352,9 +371,10 @@ impl<T: Texel> Level<T> {
         self.texels[y as usize * self.width as usize + x as usize].rgba()
     }
 
+    /// Texel `(x, y)` in its storage's units (0 to 255 or 65535).
     #[inline(always)]
-    fn texel4(&self, x: u32, y: u32) -> Vec4 {
-        Vec4::from_array(self.texel(x, y))
+    fn raw(&self, x: u32, y: u32) -> Vec4 {
+        Vec4::from_array(self.texels[y as usize * self.width as usize + x as usize].units())
     }
 
     /// `uv` filtered within this level.
@@ -373,14 +393,15 @@ impl<T: Texel> Level<T> {
                 let (a, b) = (fx - ix, fy - iy);
                 let (x0, x1) = wrap_pair(s.wrap_u, ix, self.width);
                 let (y0, y1) = wrap_pair(s.wrap_v, iy, self.height);
-                // Four lanes at once (glam's SSE vectors): the same products and sums per channel.
-                let t00 = self.texel4(x0, y0);
-                let t10 = self.texel4(x1, y0);
-                let t01 = self.texel4(x0, y1);
-                let t11 = self.texel4(x1, y1);
+                // Four channels at once (glam's SSE vectors), in the storage's units, scaled to
+                // [0, 1] once.
+                let t00 = self.raw(x0, y0);
+                let t10 = self.raw(x1, y0);
+                let t01 = self.raw(x0, y1);
+                let t11 = self.raw(x1, y1);
                 let (w00, w10) = ((1.0 - a) * (1.0 - b), a * (1.0 - b));
                 let (w01, w11) = ((1.0 - a) * b, a * b);
-                (t00 * w00 + t10 * w10 + t01 * w01 + t11 * w11).to_array()
+                ((t00 * w00 + t10 * w10 + t01 * w01 + t11 * w11) / T::MAX).to_array()
             }
         }
     }
@@ -409,6 +430,22 @@ impl<T: Texel> Level<T> {
         }
         Some(Level { width, height, texels })
     }
+}
+
+/// `log2 x` within 2·10⁻⁵ (the level of detail needs no more: OpenGL allows an approximation,
+/// and a blend weight off by 10⁻⁵ is 0.003/255), without libm's call: the exponent, plus a
+/// degree-5 least-squares polynomial in the mantissa. 0 gives −∞, NaN and negatives NaN.
+#[inline(always)]
+fn log2(x: f32) -> f32 {
+    let bits = x.to_bits();
+    let e = ((bits >> 23) & 0xff) as i32;
+    if x.is_nan() || x <= 0.0 || e == 0 || e == 0xff {
+        // Zero, negative, NaN, subnormal or infinite: rare, exact.
+        return x.log2();
+    }
+    let t = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
+    let p = t * (1.441_879_9 + t * (-0.708_865_2 + t * (0.415_245_56 + t * (-0.193_516_53 + t * 0.045_268_293))));
+    (e - 127) as f32 + p
 }
 
 /// `x.floor()` without a call to libm's `floorf` (x86-64's baseline has no rounding
@@ -547,6 +584,22 @@ mod tests {
         };
         assert_eq!(t.sample(&n, uv, 0.4)[0], 1.0);
         assert_eq!(t.sample(&n, uv, 0.6)[0], l1);
+    }
+
+    #[test]
+    fn log2_is_within_2e_5() {
+        let mut x = 1e-30f32;
+        while x < 1e30 {
+            for k in 0..50 {
+                let v = x * (1.0 + k as f32 / 50.0);
+                assert!((log2(v) - v.log2()).abs() < 2e-5, "{v}: {} vs {}", log2(v), v.log2());
+            }
+            x *= 2.0;
+        }
+        assert_eq!(log2(0.0), f32::NEG_INFINITY);
+        assert!(log2(f32::NAN).is_nan() && log2(-1.0).is_nan());
+        assert_eq!(log2(f32::INFINITY), f32::INFINITY);
+        assert_eq!(log2(1.0), 0.0);
     }
 
     #[test]
