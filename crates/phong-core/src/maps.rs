@@ -128,6 +128,11 @@ pub struct Maps {
     pub alpha: Option<(TextureMap, Channel)>,
     /// The alpha test: a point whose alpha is below it is not drawn (`None`: no test).
     pub alpha_cutoff: Option<f32>,
+    /// Blending (`GL_BLEND` with `GL_ONE_MINUS_SRC_ALPHA`): the object is drawn after the
+    /// opaque ones, over what is behind it by its alpha, without writing depth (see
+    /// [`Scene::draw_order`](crate::Scene::draw_order)). Off by default, as in OpenGL: a
+    /// material's alpha alone changes nothing.
+    pub blend: bool,
 }
 
 /// What an object's maps give at one point: `1` (white, full) where a map is absent.
@@ -165,7 +170,7 @@ fn rgb(t: [f32; 4]) -> Color {
 }
 
 impl Maps {
-    /// Whether no map is set (the alpha test alone is not a map).
+    /// Whether no map is set (the alpha test and blending alone are not maps).
     pub fn is_empty(&self) -> bool {
         self.diffuse.is_none()
             && self.ambient.is_none()

@@ -243,6 +243,22 @@ impl Object {
         }
     }
 
+    /// Whether the object is blended: [`Maps::blend`], and an alpha that can be below 1 (the
+    /// material's, or a map's with alpha).
+    pub fn blends(&self) -> bool {
+        self.maps.blend
+            && (self.material.alpha() < 1.0
+                || (self.textured()
+                    && (self.maps.alpha.is_some()
+                        || self.maps.diffuse.as_ref().is_some_and(|m| m.texture.has_alpha()))))
+    }
+
+    /// The alpha of a point of this object that is not textured: the material's where it
+    /// blends, else 1.
+    pub fn plain_alpha(&self) -> f32 {
+        if self.blends() { self.material.alpha() } else { 1.0 }
+    }
+
     /// Whether the object is drawn with its maps: it has some, and texture coordinates.
     #[inline]
     pub fn textured(&self) -> bool {
@@ -311,5 +327,33 @@ impl Scene {
     /// Number of triangles in all objects.
     pub fn triangle_count(&self) -> usize {
         self.objects.iter().map(|o| o.mesh.triangles().len()).sum()
+    }
+
+    /// The order every renderer draws the objects in: the opaque ones as listed, then the
+    /// blended ones ([`Object::blends`]) back to front, by the distance of their bounds' centre
+    /// along the camera's view direction (farthest first; ties as listed).
+    pub fn draw_order(&self) -> Vec<usize> {
+        let (eye, forward) = (self.camera.eye(), self.camera.forward());
+        let depth = |o: &Object| {
+            o.mesh
+                .bounds()
+                .map_or(0.0, |(lo, hi)| ((lo + hi) * 0.5 - eye).dot(forward))
+        };
+        let mut order: Vec<usize> = (0..self.objects.len()).filter(|&i| !self.objects[i].blends()).collect();
+        let mut blended: Vec<(f32, usize)> = (0..self.objects.len())
+            .filter(|&i| self.objects[i].blends())
+            .map(|i| (depth(&self.objects[i]), i))
+            .collect();
+        blended.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        order.extend(blended.into_iter().map(|(_, i)| i));
+        order
+    }
+
+    /// Whether an object is blended or alpha-tested: what the fast path and the GPU's compute
+    /// rasterizer leave to the reference path and the render pipeline.
+    pub fn has_translucency(&self) -> bool {
+        self.objects
+            .iter()
+            .any(|o| o.blends() || (o.textured() && o.maps.alpha_cutoff.is_some()))
     }
 }

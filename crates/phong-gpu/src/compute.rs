@@ -100,9 +100,9 @@ impl Gpu {
         if !self.device.features().contains(needed) {
             return Some(format!("the adapter {} has no 64-bit atomics", self.info.name));
         }
-        if let Some(o) = scene.objects.iter().find(|o| o.textured()) {
+        if let Some(o) = scene.objects.iter().find(|o| o.textured() || o.blends()) {
             return Some(format!(
-                "object {} is textured (textures are sampled by the render pipeline)",
+                "object {} is textured or blended (the render pipeline draws those)",
                 o.name
             ));
         }

@@ -76,11 +76,11 @@ impl Gpu {
                 pass.set_bind_group(0, bind, &[]);
                 pass.set_vertex_buffer(0, vb.slice(..));
                 pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                for (i, (range, cull)) in draws.iter().enumerate() {
+                for (i, (range, cull, blend)) in draws.iter().enumerate() {
                     if range.is_empty() {
                         continue;
                     }
-                    pass.set_pipeline(&pipelines[usize::from(*cull)]);
+                    pass.set_pipeline(&pipelines[2 * usize::from(*blend) + usize::from(*cull)]);
                     pass.set_bind_group(1, &maps[i], &[]);
                     pass.draw_indexed(range.clone(), 0, i as u32..i as u32 + 1);
                 }

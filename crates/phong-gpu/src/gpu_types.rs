@@ -152,6 +152,8 @@ pub struct GpuMaps {
     /// x: the alpha cutoff; y: 1 with an alpha test; z: 1 for a textured object; w: the
     /// material's alpha.
     pub cutoff: [f32; 4],
+    /// x: 1 for a blended object (its fragments carry their alpha).
+    pub blend: [f32; 4],
     /// Per map (diffuse, ambient, specular, emission, shininess, alpha): its transform's linear
     /// part by columns, then its offset.
     pub transforms: [[f32; 4]; 12],

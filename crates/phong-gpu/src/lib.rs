@@ -198,8 +198,9 @@ pub(crate) enum Drawing {
         msaa_view: Option<wgpu::TextureView>,
         depth_view: wgpu::TextureView,
         /// Each object's index range and whether back faces are culled.
-        draws: Vec<(std::ops::Range<u32>, bool)>,
-        pipelines: [wgpu::RenderPipeline; 2],
+        draws: Vec<(std::ops::Range<u32>, bool, bool)>,
+        /// By (cull, blend): `pipelines[2·blend + cull]`.
+        pipelines: Box<[wgpu::RenderPipeline; 4]>,
     },
     Compute {
         stages: Vec<ComputeStage>,
@@ -236,7 +237,7 @@ pub struct Gpu {
     /// Group 1 of the pipeline: an object's maps and textures.
     pub(crate) maps_layout: wgpu::BindGroupLayout,
     pub(crate) pipeline_layout: wgpu::PipelineLayout,
-    pub(crate) pipelines: Mutex<HashMap<(u32, bool), wgpu::RenderPipeline>>,
+    pub(crate) pipelines: Mutex<HashMap<(u32, bool, bool), wgpu::RenderPipeline>>,
     pub(crate) kernels: std::sync::OnceLock<Result<Kernels, String>>,
     pub(crate) path: GpuPath,
     pub(crate) item_capacity: u32,

@@ -1,12 +1,14 @@
 //! The render pipeline path: the GPU's own rasterizer with a `Depth32Float` depth buffer and
-//! MSAA, one draw per object (instance index = object), pipelines cached per (samples, cull).
+//! MSAA, one draw per object in the scene's draw order (instance index = its place there),
+//! pipelines cached per (samples, cull, blend); a blended object's pipeline blends
+//! premultiplied colours over the target (`ONE`, `ONE_MINUS_SRC_ALPHA`) without writing depth.
 
 use crate::upload::{Upload, entries, non_empty};
 use crate::{COLOR_FORMAT, DEPTH_FORMAT, Drawing, Gpu, GpuVertex};
 
 impl Gpu {
     /// The pipeline's buffers, bind group and targets for `upload`.
-    pub(crate) fn prepare_pipeline(&self, upload: Upload, scene_maps: Vec<(phong_core::Maps, f32)>) -> Drawing {
+    pub(crate) fn prepare_pipeline(&self, upload: Upload, scene_maps: Vec<(phong_core::Maps, bool, f32)>) -> Drawing {
         let Upload {
             width,
             height,
@@ -37,15 +39,21 @@ impl Gpu {
             msaa_view: msaa.as_ref().map(|t| t.create_view(&Default::default())),
             depth_view: depth.create_view(&Default::default()),
             draws: geometry.draws,
-            pipelines: [self.pipeline(n, false), self.pipeline(n, true)],
+            pipelines: Box::new([
+                self.pipeline(n, false, false),
+                self.pipeline(n, true, false),
+                self.pipeline(n, false, true),
+                self.pipeline(n, true, true),
+            ]),
         }
     }
 
-    /// The render pipeline for `samples` per pixel, culling back faces with `cull` (cached).
-    fn pipeline(&self, samples: u32, cull: bool) -> wgpu::RenderPipeline {
+    /// The render pipeline for `samples` per pixel, culling back faces with `cull`, blending
+    /// with `blend` (cached).
+    fn pipeline(&self, samples: u32, cull: bool, blend: bool) -> wgpu::RenderPipeline {
         let mut cache = self.pipelines.lock().unwrap_or_else(|p| p.into_inner());
         cache
-            .entry((samples, cull))
+            .entry((samples, cull, blend))
             .or_insert_with(|| {
                 let attributes =
                     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2];
@@ -70,7 +78,7 @@ impl Gpu {
                     },
                     depth_stencil: Some(wgpu::DepthStencilState {
                         format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(true),
+                        depth_write_enabled: Some(!blend),
                         depth_compare: Some(wgpu::CompareFunction::Less),
                         stencil: Default::default(),
                         bias: Default::default(),
@@ -86,7 +94,7 @@ impl Gpu {
                         compilation_options: Default::default(),
                         targets: &[Some(wgpu::ColorTargetState {
                             format: COLOR_FORMAT,
-                            blend: None,
+                            blend: blend.then_some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
                             write_mask: wgpu::ColorWrites::ALL,
                         })],
                     }),

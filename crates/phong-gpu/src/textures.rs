@@ -155,15 +155,16 @@ impl Gpu {
         })
     }
 
-    /// Group 1 for each object: `(maps, material alpha)` (maps empty for untextured objects).
-    pub(crate) fn map_bind_groups(&self, objects: &[(Maps, f32)]) -> Vec<wgpu::BindGroup> {
+    /// Group 1 for each object: `(maps, blends, material alpha)` (maps empty for untextured
+    /// objects).
+    pub(crate) fn map_bind_groups(&self, objects: &[(Maps, bool, f32)]) -> Vec<wgpu::BindGroup> {
         let white = Texture::new(1, 1, &[[u16::MAX; 4]], 8).expect("a 1×1 texture");
         let white_view = self.upload_texture(&white);
         let plain = self.device.create_sampler(&Default::default());
         let mut views: HashMap<*const Texture, wgpu::TextureView> = HashMap::new();
         objects
             .iter()
-            .map(|(maps, alpha)| {
+            .map(|(maps, blends, alpha)| {
                 let slots: [Option<&TextureMap>; SLOTS] = [
                     maps.diffuse.as_ref(),
                     maps.ambient.as_ref(),
@@ -186,6 +187,7 @@ impl Gpu {
                         f32::from(u8::from(!maps.is_empty())),
                         *alpha,
                     ],
+                    blend: [f32::from(u8::from(*blends)), 0.0, 0.0, 0.0],
                     ..Default::default()
                 };
                 let mut samplers = Vec::new();

@@ -36,8 +36,11 @@ pub(crate) struct Geometry {
     /// Each vertex's object.
     pub vertex_object: Vec<u32>,
     pub indices: Vec<u32>,
-    /// Each object's index range and whether back faces are culled.
-    pub draws: Vec<(std::ops::Range<u32>, bool)>,
+    /// Each object's index range, whether back faces are culled, and whether it is blended;
+    /// in the scene's draw order (`Scene::draw_order`), which is also the objects' order here.
+    pub draws: Vec<(std::ops::Range<u32>, bool, bool)>,
+    /// The scene's object drawn `k`-th.
+    pub order: Vec<usize>,
     pub objects: Vec<GpuObject>,
 }
 
@@ -49,8 +52,10 @@ impl Geometry {
             indices: Vec::new(),
             draws: Vec::new(),
             objects: Vec::with_capacity(scene.objects.len()),
+            order: scene.draw_order(),
         };
-        for (i, o) in scene.objects.iter().enumerate() {
+        for (i, &k) in g.order.clone().iter().enumerate() {
+            let o = &scene.objects[k];
             let view = scene.camera.view(o.shading.viewer);
             g.objects.push(GpuObject::new(&o.material, &o.shading, &view));
             let m = &o.mesh;
@@ -88,7 +93,7 @@ impl Geometry {
             }
             g.vertex_object.resize(g.vertices.len(), i as u32);
             g.draws
-                .push((first..g.indices.len() as u32, !o.shading.options.two_sided));
+                .push((first..g.indices.len() as u32, !o.shading.options.two_sided, o.blends()));
         }
         g
     }
@@ -258,16 +263,21 @@ impl Gpu {
         let drawing: Drawing = if compute {
             self.prepare_compute(upload, &resolved_view)?
         } else {
-            let maps = scene
-                .objects
+            let maps = upload
+                .geometry
+                .order
                 .iter()
-                .map(|o| {
+                .map(|&k| {
+                    let o = &scene.objects[k];
                     let maps = if o.textured() {
                         o.maps.clone()
                     } else {
-                        Default::default()
+                        phong_core::Maps {
+                            blend: o.maps.blend,
+                            ..Default::default()
+                        }
                     };
-                    (maps, o.material.alpha())
+                    (maps, o.blends(), o.material.alpha())
                 })
                 .collect();
             self.prepare_pipeline(upload, maps)

@@ -519,3 +519,61 @@ fn textured_objects_match_the_cpu() {
         }
     }
 }
+
+/// Blended objects on the GPU (the render pipeline's premultiplied blending, drawn in the
+/// scene's draw order) against the CPU: two blended quads over an opaque one, listed out of
+/// order, and one over a transparent background (the pixel's alpha), within 1/255.
+#[test]
+fn blended_objects_match_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let quad = |z: f32, e: Color, alpha: f32, blend: bool| {
+        let mut scene = load("tour.toml");
+        let mut o = scene.objects.swap_remove(0);
+        o.mesh = primitives::plane(1).transformed(&glam::Mat4::from_rotation_translation(
+            glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+            Vec3::new(0.0, 0.0, z),
+        ));
+        o.material = Material::new(Color::BLACK, Color::BLACK, Color::BLACK, e, 1.0)
+            .unwrap()
+            .with_alpha(alpha)
+            .unwrap();
+        o.maps = Maps {
+            blend,
+            ..Maps::default()
+        };
+        o.shading.options.two_sided = true;
+        o
+    };
+    let (red, green, blue) = (
+        Color::new(1.0, 0.0, 0.0),
+        Color::new(0.0, 1.0, 0.0),
+        Color::new(0.0, 0.0, 1.0),
+    );
+    for (objects, background) in [
+        (
+            vec![
+                quad(0.0, green, 0.5, true),
+                quad(-0.5, red, 1.0, false),
+                quad(-0.25, blue, 0.5, true),
+            ],
+            [0.0, 0.0, 0.0, 1.0],
+        ),
+        (vec![quad(0.0, blue, 0.25, true)], [0.2, 0.2, 0.2, 0.0]),
+    ] {
+        let mut scene = load("tour.toml");
+        scene.image.width = 64;
+        scene.image.height = 48;
+        scene.image.background = background;
+        scene.objects = objects;
+        let cpu = phong_raster::render(&scene, &Default::default()).unwrap();
+        let (g, _) = gpu.render(&scene).unwrap();
+        let (a, b) = (cpu.to_bytes(Encoding::Linear, true), g.to_bytes(Encoding::Linear, true));
+        let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        assert!(
+            worst <= 1,
+            "background {background:?}: a channel differs by {worst}/255"
+        );
+        let c = cpu.get(32, 24);
+        assert!(c[3] > 0.2, "the quads cover the centre: {c:?}");
+    }
+}

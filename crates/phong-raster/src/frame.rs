@@ -152,7 +152,9 @@ impl<'a> Frame<'a> {
         };
         frame.bins.resize(tiles, Vec::new());
         let spare = Mutex::new(std::mem::take(&mut scratch.chunks));
-        for (oi, obj) in scene.objects.iter().enumerate() {
+        // Opaque objects first, then blended ones back to front (the bins keep this order).
+        for oi in scene.draw_order() {
+            let obj = &scene.objects[oi];
             let chunks = if path == Path::Reference || matches!(frame.modes[oi], Mode::Scalar) {
                 frame.setup_object_full(oi, obj, clip_from_world)
             } else {
@@ -224,7 +226,9 @@ pub(crate) fn render<P: Pixel>(
     scratch: &mut Scratch,
 ) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
-    let path = if options.reference || alpha_tested(scene) {
+    // Blending and the alpha test change what is visible, which the fast path decides before
+    // shading: such frames are the reference path's.
+    let path = if options.reference || scene.has_translucency() {
         Path::Reference
     } else {
         Path::Fast
@@ -248,15 +252,6 @@ pub(crate) fn render<P: Pixel>(
         tile_shade,
         tile_resolve,
     })
-}
-
-/// Whether an object of `scene` has an alpha test: such frames are drawn by the reference
-/// path, whose depth test comes after the shading (the fast path decides visibility first).
-fn alpha_tested(scene: &Scene) -> bool {
-    scene
-        .objects
-        .iter()
-        .any(|o| o.textured() && o.maps.alpha_cutoff.is_some())
 }
 
 /// Diagnostic for coverage tests: for each sample of each pixel (row-major,

@@ -897,3 +897,70 @@ fn the_alpha_test_discards_colour_and_depth() {
         }
     }
 }
+
+/// A quad of `emission` with alpha `alpha` at `z`, blended where `blend`.
+fn glass(z: f32, emission: Color, alpha: f32, blend: bool) -> Object {
+    let m = Material::new(Color::BLACK, Color::BLACK, Color::BLACK, emission, 1.0)
+        .unwrap()
+        .with_alpha(alpha)
+        .unwrap();
+    let mut o = obj(textured_quad(z), m);
+    o.maps.blend = blend;
+    o
+}
+
+/// Blending by hand: a red opaque quad behind a blue one of alpha 0.25 gives `0.25·blue +
+/// 0.75·red`, whatever the order the objects are listed in (opaque first, then blended back to
+/// front); two blended quads compose back to front; over a transparent background the pixel's
+/// alpha is `α` (straight colour: the quad's); without `blend` the alpha changes nothing.
+#[test]
+fn blended_objects_are_drawn_over_what_is_behind() {
+    let n = 16u32;
+    let lighting = Lighting::new(Color::BLACK, Vec::new()).unwrap();
+    let (red, green, blue) = (
+        Color::new(1.0, 0.0, 0.0),
+        Color::new(0.0, 1.0, 0.0),
+        Color::new(0.0, 0.0, 1.0),
+    );
+    let cases: Vec<(Vec<Object>, [f32; 4], [f32; 4])> = vec![
+        (
+            vec![glass(0.0, blue, 0.25, true), glass(-0.5, red, 1.0, false)],
+            [0.0; 4],
+            [0.75, 0.0, 0.25, 1.0],
+        ),
+        (
+            vec![
+                glass(0.0, green, 0.5, true),
+                glass(-0.5, red, 1.0, false),
+                glass(-0.25, blue, 0.5, true),
+            ],
+            [0.0; 4],
+            [0.25, 0.5, 0.25, 1.0],
+        ),
+        (
+            vec![glass(0.0, blue, 0.25, true)],
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.25],
+        ),
+        (
+            vec![glass(0.0, blue, 0.25, false), glass(-0.5, red, 1.0, false)],
+            [0.0; 4],
+            [0.0, 0.0, 1.0, 1.0],
+        ),
+    ];
+    for (k, (objects, background, want)) in cases.into_iter().enumerate() {
+        let mut s = scene(n, n, ortho_camera(1.0), objects, lighting.clone(), Interpolation::Phong);
+        s.image.background = background;
+        for path in common::paths() {
+            let img = path.render(&s);
+            let got = img.get(n / 2, n / 2);
+            for c in 0..4 {
+                assert!(
+                    (got[c] - want[c]).abs() < 1e-5,
+                    "case {k} {}: {got:?} vs {want:?}",
+                    path.name
+                );
+            }
+        }
+    }
+}

@@ -126,7 +126,7 @@ pub fn read_gltf(
     let buffers = load_buffers(&file, resource, &fail)?;
     let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
-    let (mut skipped_modes, mut textures, mut colours, mut transparent) = (0usize, BTreeSet::new(), 0usize, 0usize);
+    let (mut skipped_modes, mut textures, mut colours) = (0usize, BTreeSet::new(), 0usize);
     let mut cache = TextureCache::default();
     // Positions in f64 world space for all parts, re-centred together below.
     let mut pending: Vec<Pending> = Vec::new();
@@ -286,11 +286,7 @@ pub fn read_gltf(
                         textures.insert(name);
                     }
                 }
-                let m = phong_material(&mat);
-                if m.alpha() < 1.0 || mat.alpha_mode() == ::gltf::material::AlphaMode::Blend {
-                    transparent += 1;
-                }
-                m
+                phong_material(&mat)
             });
             // The textures' coordinates: one set for the mesh (the base colour's, else the
             // first used), v flipped to OpenGL's.
@@ -340,6 +336,11 @@ pub fn read_gltf(
                 }
                 Maps::default()
             };
+            // `alphaMode: BLEND`: blended by the base colour's alpha (and its texture's).
+            let maps = Maps {
+                blend: mat.alpha_mode() == ::gltf::material::AlphaMode::Blend,
+                ..maps
+            };
             let name = format!(
                 "{}:{}",
                 path.file_name()
@@ -386,11 +387,6 @@ pub fn read_gltf(
     if colours > 0 {
         warnings.push(format!(
             "{file}: vertex colours (COLOR_0, {colours} primitives) are not used"
-        ));
-    }
-    if transparent > 0 {
-        warnings.push(format!(
-            "{file}: {transparent} primitives are transparent or alpha-masked: drawn opaque (transparency is not rendered)"
         ));
     }
     // Re-centre the whole model together (one origin for every part).

@@ -382,6 +382,14 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         _ => output.term(&at),
     };
     let value = c3(value);
+    if obj.blends() {
+        let alpha = texture
+            .as_ref()
+            .map_or(obj.material.alpha(), |t| Maps::alpha(&obj.material, &t.3));
+        notes.push(format!(
+            "blended: the pixel is this colour at alpha {alpha:.3} over what is behind it (drawn after the opaque objects, back to front)"
+        ));
+    }
     let hit = hit_terms(scene, obj, &view, position, normal, &at);
     let texture = texture.map(|(uv, d_dx, d_dy, t)| {
         let alpha = Maps::alpha(&obj.material, &t);

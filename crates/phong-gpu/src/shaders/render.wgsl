@@ -18,6 +18,8 @@ struct Maps {
     scalar: vec4<u32>,
     // x: alpha cutoff; y: 1 with an alpha test; z: 1 when textured; w: the material's alpha.
     cutoff: vec4<f32>,
+    // x: 1 for a blended object.
+    blend: vec4<f32>,
     // Per map: the transform's linear part by columns, then its offset.
     transforms: array<vec4<f32>, 12>,
 }
@@ -227,14 +229,17 @@ fn fs_main(f: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f3
     // The coordinates' derivatives, in uniform control flow (the GPU's, per 2×2 quad).
     let dx = dpdx(f.uv);
     let dy = dpdy(f.uv);
-    // Back faces are drawn only for two-sided objects (culled otherwise). Premultiplied by
-    // alpha 1; the read-back divides by the resolved alpha (straight alpha).
+    // Back faces are drawn only for two-sided objects (culled otherwise). Premultiplied, alpha
+    // 1 but for blended objects; the read-back divides by the resolved alpha (straight alpha).
     if (maps.cutoff.z == 0.0) {
-        return vec4<f32>(fragment(f, !front), 1.0);
+        let a = select(1.0, maps.cutoff.w, maps.blend.x != 0.0);
+        return vec4<f32>(fragment(f, !front) * a, a);
     }
     let t = texels(f.uv, dx, dy);
-    if (maps.cutoff.y != 0.0 && maps.cutoff.w * t.diffuse.w * t.alpha < maps.cutoff.x) {
+    let alpha = maps.cutoff.w * t.diffuse.w * t.alpha;
+    if (maps.cutoff.y != 0.0 && alpha < maps.cutoff.x) {
         discard;
     }
-    return vec4<f32>(textured(f, !front, t), 1.0);
+    let a = select(1.0, alpha, maps.blend.x != 0.0);
+    return vec4<f32>(textured(f, !front, t) * a, a);
 }

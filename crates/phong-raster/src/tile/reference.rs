@@ -1,7 +1,8 @@
 //! The reference path's tile: per pixel and triangle in drawing order, each sample's edge
 //! functions evaluated directly, a `GL_LESS` depth test, and one `shade` at the pixel centre
 //! written to the samples that passed (as MSAA); then the resolve. Kept simple: the fast
-//! path is tested against it.
+//! path is tested against it. A blended object's pixels are blended over the samples by
+//! their alpha (`GL_ONE_MINUS_SRC_ALPHA`, in premultiplied form) without writing depth.
 
 use super::Tile;
 use crate::fixed::map3;
@@ -24,6 +25,7 @@ impl Frame<'_> {
         let mut zs = [0f32; 16];
         for &ti in tile.bin {
             let t = self.tri(ti);
+            let blends = self.scene.objects[self.object(ti)].blends();
             let bb = t.bbox();
             let (bx0, by0, bx1, by1) = (bb[0].max(x0), bb[1].max(y0), bb[2].min(x1), bb[3].min(y1));
             for py in by0..by1 {
@@ -53,8 +55,12 @@ impl Frame<'_> {
                     };
                     for s in 0..ns {
                         if mask & (1 << s) != 0 {
-                            depth[base + s] = zs[s];
-                            color[base + s] = c;
+                            if blends {
+                                color[base + s] = over(c, color[base + s]);
+                            } else {
+                                depth[base + s] = zs[s];
+                                color[base + s] = c;
+                            }
                         }
                     }
                 }
@@ -68,4 +74,16 @@ impl Frame<'_> {
         tile.clock.add(marks);
         shaded
     }
+}
+
+/// `src` over `dst` (straight alpha both): in premultiplied form `src + dst·(1 − α_src)`, back
+/// to straight alpha.
+#[inline]
+pub(crate) fn over(src: [f32; 4], dst: [f32; 4]) -> [f32; 4] {
+    let a = src[3] + dst[3] * (1.0 - src[3]);
+    if a <= 0.0 {
+        return [0.0; 4];
+    }
+    let c = |i: usize| (src[i] * src[3] + dst[i] * dst[3] * (1.0 - src[3])) / a;
+    [c(0), c(1), c(2), a]
 }

@@ -378,7 +378,7 @@ impl Frame<'_> {
                 }
             },
         };
-        Some([c.r, c.g, c.b, 1.0])
+        Some([c.r, c.g, c.b, obj.plain_alpha()])
     }
 
     /// [`Frame::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
@@ -390,7 +390,8 @@ impl Frame<'_> {
         let obj = &self.scene.objects[self.object(id)];
         let [uv, d_dx, d_dy] = Self::uv_at(t, corners, px, py);
         let texels = obj.maps.sample(uv, d_dx, d_dy);
-        if obj.maps.discards(Maps::alpha(&obj.material, &texels)) {
+        let alpha = Maps::alpha(&obj.material, &texels);
+        if obj.maps.discards(alpha) {
             return None;
         }
         let q = Self::weights(t, corners, px, py);
@@ -434,7 +435,7 @@ impl Frame<'_> {
                 obj.shading.output.term(&s)
             }
         };
-        Some([c.r, c.g, c.b, 1.0])
+        Some([c.r, c.g, c.b, if obj.blends() { alpha } else { 1.0 }])
     }
 }
 

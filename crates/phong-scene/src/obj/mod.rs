@@ -345,7 +345,18 @@ pub fn load_obj_text(
                 name: format!("{file}:{}", model.name),
                 mesh,
                 material: m.material_id.and_then(|i| materials.get(i).copied()),
-                maps: m.material_id.and_then(|i| maps.get(i).cloned()).unwrap_or_default(),
+                maps: m
+                    .material_id
+                    .and_then(|i| maps.get(i).cloned())
+                    .map(|mut maps| {
+                        // `d` or `Tr` below 1: blended, as the file means it.
+                        maps.blend = m
+                            .material_id
+                            .and_then(|i| materials.get(i))
+                            .is_some_and(|m| m.alpha() < 1.0);
+                        maps
+                    })
+                    .unwrap_or_default(),
                 has_normals,
                 origin: prepared.origin,
             },

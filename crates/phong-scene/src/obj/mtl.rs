@@ -80,7 +80,6 @@ pub(super) fn check_mtl(
 ) -> Result<(), Error> {
     let c = Checker { path, src };
     let mut unused: Vec<&str> = Vec::new();
-    let mut transparent = 0usize;
     let mut current = String::new();
     for (start, line) in lines(src) {
         let content = line.split('#').next().unwrap_or("");
@@ -108,14 +107,6 @@ pub(super) fn check_mtl(
                 }
                 Err(why) => warnings.push(format!("{}:{l}: {kw} {why}: not used", path.display())),
             }
-        }
-        let opacity = match (kw, rest.first().and_then(|x| x.parse::<f32>().ok())) {
-            ("d", Some(d)) => Some(d),
-            ("Tr", Some(t)) => Some(1.0 - t),
-            _ => None,
-        };
-        if opacity.is_some_and(|o| o < 1.0) {
-            transparent += 1;
         }
         let num = |i: usize| -> Result<f32, Error> {
             let f = rest
@@ -175,12 +166,6 @@ pub(super) fn check_mtl(
             "{}: texture statements not used: {}",
             path.display(),
             unused.join(", ")
-        ));
-    }
-    if transparent > 0 {
-        warnings.push(format!(
-            "{}: {transparent} materials are transparent (`d` or `Tr`): drawn opaque (transparency is not rendered)",
-            path.display()
         ));
     }
     Ok(())

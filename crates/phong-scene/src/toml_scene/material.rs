@@ -167,6 +167,9 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
         out.alpha = mine.alpha;
     }
     out.alpha_cutoff = alpha_cutoff.or(mine.alpha_cutoff).or(out.alpha_cutoff);
+    if let Some(b) = &m.blend {
+        out.blend = *b.get_ref();
+    }
     Ok(out)
 }
 

@@ -55,6 +55,7 @@ pub(super) fn object(
                     filter: at(m.span(), p.filter.clone()),
                     encoding: at(m.span(), p.encoding.clone()),
                     alpha_cutoff: at(m.span(), p.alpha_cutoff),
+                    blend: at(m.span(), p.blend),
                 };
                 material(ctx, &raw, "material", named)?
             }
@@ -249,7 +250,10 @@ pub(super) fn object(
                         "{}: its material has texture maps but the model has no texture coordinates: maps not used",
                         p.name
                     ));
-                    Maps::default()
+                    Maps {
+                        blend: maps.blend,
+                        ..Maps::default()
+                    }
                 } else {
                     maps
                 };

@@ -114,6 +114,7 @@ pub(crate) struct RawMaterial {
     pub filter: Option<S<String>>,
     pub encoding: Option<S<String>>,
     pub alpha_cutoff: Option<S<f32>>,
+    pub blend: Option<S<bool>>,
 }
 
 /// An inline material table: the same keys, without per-key spans (serde's
@@ -144,6 +145,7 @@ pub(crate) struct PlainMaterial {
     pub filter: Option<String>,
     pub encoding: Option<String>,
     pub alpha_cutoff: Option<f32>,
+    pub blend: Option<bool>,
 }
 
 #[derive(Deserialize)]
