@@ -165,6 +165,19 @@ impl Default for Texels {
     }
 }
 
+impl Texels {
+    /// The texels with a vertex colour: it multiplies the diffuse texel's colour, so it
+    /// modulates the diffuse, ambient and emission terms as a diffuse map does (with a white
+    /// material: OpenGL's `GL_COLOR_MATERIAL` for ambient and diffuse).
+    #[inline]
+    pub fn tinted(mut self, c: Color) -> Texels {
+        self.diffuse[0] *= c.r;
+        self.diffuse[1] *= c.g;
+        self.diffuse[2] *= c.b;
+        self
+    }
+}
+
 fn rgb(t: [f32; 4]) -> Color {
     Color::new(t[0], t[1], t[2])
 }

@@ -2,7 +2,7 @@
 //! the cross product, vertex normals from the facet normals or from the
 //! surface's formula).
 
-use crate::Error;
+use crate::{Color, Error};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use rustc_hash::FxHashMap;
 use std::collections::HashMap;
@@ -16,6 +16,8 @@ pub struct Mesh {
     triangles: Vec<[u32; 3]>,
     /// Empty, or one per position.
     uvs: Vec<Vec2>,
+    /// Vertex colours: empty, or one per position.
+    colors: Vec<Color>,
 }
 
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
@@ -54,7 +56,33 @@ impl Mesh {
             normals,
             triangles,
             uvs: Vec::new(),
+            colors: Vec::new(),
         })
+    }
+
+    /// The mesh with vertex colours, one per vertex (linear RGB, finite and non-negative); an
+    /// empty vector removes them.
+    pub fn with_colors(mut self, colors: Vec<Color>) -> Result<Self, Error> {
+        if !colors.is_empty() && colors.len() != self.positions.len() {
+            return Err(Error::OutOfRange {
+                what: "number of vertex colours",
+                range: "0 or the number of positions",
+                value: colors.len() as f32,
+            });
+        }
+        if let Some(c) = colors.iter().find(|c| !c.is_finite_non_negative()) {
+            return Err(Error::InvalidColor {
+                what: "vertex colour",
+                value: c.to_array(),
+            });
+        }
+        self.colors = colors;
+        Ok(self)
+    }
+
+    /// Vertex colours; empty where the mesh has none.
+    pub fn colors(&self) -> &[Color] {
+        &self.colors
     }
 
     /// The mesh with texture coordinates, one per vertex, finite (`v = 0` is the image's
@@ -121,6 +149,15 @@ impl Mesh {
                 self.uvs.extend_from_slice(&other.uvs);
             }
         }
+        if !self.colors.is_empty() || !other.colors.is_empty() {
+            self.colors.resize(self.positions.len(), Color::WHITE);
+            if other.colors.is_empty() {
+                self.colors
+                    .resize(self.positions.len() + other.positions.len(), Color::WHITE);
+            } else {
+                self.colors.extend_from_slice(&other.colors);
+            }
+        }
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles
@@ -152,6 +189,7 @@ impl Mesh {
                 self.triangles.clone()
             },
             uvs: self.uvs.clone(),
+            colors: self.colors.clone(),
         }
     }
 
@@ -161,6 +199,7 @@ impl Mesh {
         let mut normals = Vec::with_capacity(self.triangles.len() * 3);
         let mut triangles = Vec::with_capacity(self.triangles.len());
         let mut uvs = Vec::new();
+        let mut colors = Vec::new();
         for (t, corners) in self.triangles.iter().enumerate() {
             let [a, b, c] = self.corners(t);
             let n = facet_normal(a, b, c);
@@ -171,12 +210,16 @@ impl Mesh {
             if !self.uvs.is_empty() {
                 uvs.extend(corners.map(|k| self.uvs[k as usize]));
             }
+            if !self.colors.is_empty() {
+                colors.extend(corners.map(|k| self.colors[k as usize]));
+            }
         }
         Mesh {
             positions,
             normals,
             triangles,
             uvs,
+            colors,
         }
     }
 
@@ -209,6 +252,7 @@ impl Mesh {
             normals,
             triangles,
             uvs: Vec::new(),
+            colors: Vec::new(),
         };
         (mesh, remap)
     }
@@ -229,7 +273,7 @@ impl Mesh {
             }
         }
         m.normals = acc.into_iter().map(|n| n.normalize_or_zero()).collect();
-        if self.uvs.is_empty() {
+        if self.uvs.is_empty() && self.colors.is_empty() {
             return m;
         }
         Mesh {
@@ -237,6 +281,7 @@ impl Mesh {
             normals: remap.iter().map(|&r| m.normals[r as usize]).collect(),
             triangles: self.triangles.clone(),
             uvs: self.uvs.clone(),
+            colors: self.colors.clone(),
         }
     }
 
@@ -332,7 +377,9 @@ impl Mesh {
         let mut positions = Vec::new();
         let mut normals = Vec::new();
         let mut uvs = Vec::new();
-        let mut dedup: FxHashMap<(u32, [u32; 3], [u32; 2]), u32> = FxHashMap::default();
+        let mut colors = Vec::new();
+        type Key = (u32, [u32; 3], [u32; 2], [u32; 3]);
+        let mut dedup: FxHashMap<Key, u32> = FxHashMap::default();
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
             let own = unit[f];
@@ -340,6 +387,7 @@ impl Mesh {
             let tri = t.map(|v| {
                 // A corner keeps its own texture coordinates: vertices split where they differ.
                 let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
+                let color = self.colors.get(self.triangles[f][corner] as usize).copied();
                 corner += 1;
                 let n = match &vertex_rule[v as usize] {
                     Rule::Plain => around(v as usize)
@@ -363,11 +411,13 @@ impl Mesh {
                     v,
                     n.to_array().map(f32::to_bits),
                     uv.unwrap_or_default().to_array().map(f32::to_bits),
+                    color.unwrap_or_default().to_array().map(f32::to_bits),
                 );
                 *dedup.entry(key).or_insert_with(|| {
                     positions.push(w.positions[v as usize]);
                     normals.push(n);
                     uvs.extend(uv);
+                    colors.extend(color);
                     (positions.len() - 1) as u32
                 })
             });
@@ -378,6 +428,7 @@ impl Mesh {
             normals,
             triangles,
             uvs,
+            colors,
         };
         (mesh, work)
     }

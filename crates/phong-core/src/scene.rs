@@ -259,10 +259,13 @@ impl Object {
         if self.blends() { self.material.alpha() } else { 1.0 }
     }
 
-    /// Whether the object is drawn with its maps: it has some, and texture coordinates.
+    /// Whether the object is drawn with per-pixel texels: it has maps and texture coordinates,
+    /// or vertex colours (which multiply the diffuse texel: see [`Texels::tinted`]).
+    ///
+    /// [`Texels::tinted`]: crate::Texels::tinted
     #[inline]
     pub fn textured(&self) -> bool {
-        !self.maps.is_empty() && self.mesh.has_uvs()
+        (!self.maps.is_empty() && self.mesh.has_uvs()) || !self.mesh.colors().is_empty()
     }
 
     /// [`Object::shade`] with the object's maps sampled at texture coordinates `uv`, whose

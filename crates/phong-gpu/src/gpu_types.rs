@@ -139,6 +139,8 @@ pub struct GpuVertex {
     pub centroid: [f32; 3],
     /// Texture coordinates (0 where the mesh has none).
     pub uv: [f32; 2],
+    /// The vertex colour (white where the mesh has none).
+    pub color: [f32; 3],
 }
 
 /// WGSL `Maps` (render.wgsl): an object's texture maps, bound with its textures.
@@ -152,7 +154,8 @@ pub struct GpuMaps {
     /// x: the alpha cutoff; y: 1 with an alpha test; z: 1 for a textured object; w: the
     /// material's alpha.
     pub cutoff: [f32; 4],
-    /// x: 1 for a blended object (its fragments carry their alpha).
+    /// x: 1 for a blended object (its fragments carry their alpha); y: 1 where vertex colours
+    /// tint the diffuse texel.
     pub blend: [f32; 4],
     /// Per map (diffuse, ambient, specular, emission, shininess, alpha): its transform's linear
     /// part by columns, then its offset.

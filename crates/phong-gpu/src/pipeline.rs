@@ -8,7 +8,11 @@ use crate::{COLOR_FORMAT, DEPTH_FORMAT, Drawing, Gpu, GpuVertex};
 
 impl Gpu {
     /// The pipeline's buffers, bind group and targets for `upload`.
-    pub(crate) fn prepare_pipeline(&self, upload: Upload, scene_maps: Vec<(phong_core::Maps, bool, f32)>) -> Drawing {
+    pub(crate) fn prepare_pipeline(
+        &self,
+        upload: Upload,
+        scene_maps: Vec<(phong_core::Maps, bool, bool, f32)>,
+    ) -> Drawing {
         let Upload {
             width,
             height,
@@ -56,7 +60,7 @@ impl Gpu {
             .entry((samples, cull, blend))
             .or_insert_with(|| {
                 let attributes =
-                    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2];
+                    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2, 4 => Float32x3];
                 self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some("phong"),
                     layout: Some(&self.pipeline_layout),

@@ -155,16 +155,16 @@ impl Gpu {
         })
     }
 
-    /// Group 1 for each object: `(maps, blends, material alpha)` (maps empty for untextured
-    /// objects).
-    pub(crate) fn map_bind_groups(&self, objects: &[(Maps, bool, f32)]) -> Vec<wgpu::BindGroup> {
+    /// Group 1 for each object: `(maps, blends, vertex colours, material alpha)` (maps empty
+    /// for untextured objects).
+    pub(crate) fn map_bind_groups(&self, objects: &[(Maps, bool, bool, f32)]) -> Vec<wgpu::BindGroup> {
         let white = Texture::new(1, 1, &[[u16::MAX; 4]], 8).expect("a 1×1 texture");
         let white_view = self.upload_texture(&white);
         let plain = self.device.create_sampler(&Default::default());
         let mut views: HashMap<*const Texture, wgpu::TextureView> = HashMap::new();
         objects
             .iter()
-            .map(|(maps, blends, alpha)| {
+            .map(|(maps, blends, colors, alpha)| {
                 let slots: [Option<&TextureMap>; SLOTS] = [
                     maps.diffuse.as_ref(),
                     maps.ambient.as_ref(),
@@ -184,10 +184,10 @@ impl Gpu {
                     cutoff: [
                         maps.alpha_cutoff.unwrap_or(0.0),
                         f32::from(u8::from(maps.alpha_cutoff.is_some())),
-                        f32::from(u8::from(!maps.is_empty())),
+                        f32::from(u8::from(!maps.is_empty() || *colors)),
                         *alpha,
                     ],
-                    blend: [f32::from(u8::from(*blends)), 0.0, 0.0, 0.0],
+                    blend: [f32::from(u8::from(*blends)), f32::from(u8::from(*colors)), 0.0, 0.0],
                     ..Default::default()
                 };
                 let mut samplers = Vec::new();

@@ -62,6 +62,7 @@ impl Geometry {
             let base = g.vertices.len();
             let first = g.indices.len() as u32;
             let uv = |k: u32| m.uvs().get(k as usize).map_or([0.0; 2], |u| u.to_array());
+            let color = |k: u32| m.colors().get(k as usize).map_or([1.0; 3], |c| c.to_array());
             if o.shading.interpolation == Interpolation::Flat {
                 for (t, corners) in m.triangles().iter().enumerate() {
                     let [a, b, c] = m.corners(t);
@@ -74,6 +75,7 @@ impl Geometry {
                             normal: n,
                             centroid,
                             uv: uv(*k),
+                            color: color(*k),
                         });
                     }
                 }
@@ -86,6 +88,7 @@ impl Geometry {
                             normal: n.to_array(),
                             centroid: p.to_array(),
                             uv: uv(k),
+                            color: color(k),
                         }),
                 );
                 g.indices
@@ -277,7 +280,7 @@ impl Gpu {
                             ..Default::default()
                         }
                     };
-                    (maps, o.blends(), o.material.alpha())
+                    (maps, o.blends(), !o.mesh.colors().is_empty(), o.material.alpha())
                 })
                 .collect();
             self.prepare_pipeline(upload, maps)

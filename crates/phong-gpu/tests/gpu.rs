@@ -577,3 +577,29 @@ fn blended_objects_match_the_cpu() {
         assert!(c[3] > 0.2, "the quads cover the centre: {c:?}");
     }
 }
+
+/// Vertex colours on the GPU against the CPU: the tour's objects with a colour per vertex
+/// (from its position), each interpolation; at most 0.5% of pixels beyond 2/255 (silhouettes).
+#[test]
+fn vertex_colours_match_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("tour.toml");
+    scene.image.width = 160;
+    scene.image.height = 120;
+    for o in &mut scene.objects {
+        let colors = o
+            .mesh
+            .positions()
+            .iter()
+            .map(|p| Color::new(p.x.sin() * 0.5 + 0.5, p.y.cos() * 0.5 + 0.5, 0.5))
+            .collect();
+        o.mesh = o.mesh.clone().with_colors(colors).unwrap();
+    }
+    for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
+        for o in &mut scene.objects {
+            o.shading.interpolation = interp;
+        }
+        let (g, _) = gpu.render(&scene).unwrap();
+        compare(&format!("vertex colours {interp:?}"), &scene, &g, 2, 0.005);
+    }
+}

@@ -26,6 +26,8 @@ pub struct ClipVertex {
     pub spec: [Vec3; 2],
     /// Texture coordinates.
     pub uv: Vec2,
+    /// The vertex colour (white where the mesh has none).
+    pub rgb: Vec3,
 }
 
 impl ClipVertex {
@@ -41,6 +43,7 @@ impl ClipVertex {
             color_back: self.color_back.lerp(b.color_back, t),
             spec: [0, 1].map(|k| self.spec[k].lerp(b.spec[k], t)),
             uv: self.uv.lerp(b.uv, t),
+            rgb: self.rgb.lerp(b.rgb, t),
         }
     }
 }
@@ -165,6 +168,7 @@ mod tests {
             color_back: Vec3::ZERO,
             spec: [Vec3::ZERO; 2],
             uv: Vec2::ZERO,
+            rgb: Vec3::ONE,
         }
     }
 

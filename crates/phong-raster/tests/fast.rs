@@ -291,6 +291,7 @@ rotation = [0.0, 90.0, 0.0]
                             color_back: Vec3::ZERO,
                             spec: [Vec3::ZERO; 2],
                             uv: glam::Vec2::ZERO,
+                            rgb: Vec3::ONE,
                         }
                     })
                 })

@@ -964,3 +964,41 @@ fn blended_objects_are_drawn_over_what_is_behind() {
         }
     }
 }
+
+/// Vertex colours tint the diffuse texel: a white quad whose corners are red, red, blue, blue
+/// (left to right, in an orthographic view, lit head-on with no ambient) shows at each pixel
+/// the colour interpolated linearly across it, on every path and interpolation.
+#[test]
+fn vertex_colours_are_interpolated() {
+    let n = 32u32;
+    let m = Material::new(Color::BLACK, Color::WHITE, Color::BLACK, Color::BLACK, 1.0).unwrap();
+    let (red, blue) = (Color::new(1.0, 0.0, 0.0), Color::new(0.0, 0.0, 1.0));
+    // Corners of textured_quad: (−1,−1), (1,−1), (1,1), (−1,1).
+    let mesh = textured_quad(0.0).with_colors(vec![red, blue, blue, red]).unwrap();
+    for interp in [Interpolation::Phong, Interpolation::Gouraud] {
+        let s = scene(
+            n,
+            n,
+            ortho_camera(2.0),
+            vec![obj(mesh.clone(), m)],
+            one_light(-Vec3::Z),
+            interp,
+        );
+        for path in common::paths() {
+            let img = path.render(&s);
+            for y in 0..n {
+                for x in 0..n {
+                    let (wx, _) = ortho_world(x, y, n, 2.0);
+                    let t = (wx + 1.0) / 2.0;
+                    let want = Vec3::new(1.0 - t, 0.0, t);
+                    let got = px(&img, x, y);
+                    assert!(
+                        (got - want).abs().max_element() < 1e-5,
+                        "{} {interp:?} ({x}, {y}): {got} vs {want}",
+                        path.name
+                    );
+                }
+            }
+        }
+    }
+}

@@ -214,11 +214,27 @@ fn model_error(path: &Path, message: String) -> Error {
     }
 }
 
-/// A PLY vertex: position and, where the file has all three, a normal.
+/// A PLY vertex: position and, where the file has all three, a normal and a colour (`red`,
+/// `green`, `blue`, or `r`, `g`, `b`: bytes as 0–255, floats as 0–1, as scanners write them).
 #[derive(Default)]
 struct PlyVertex {
     p: [Option<f64>; 3],
     n: [Option<f64>; 3],
+    c: [Option<f64>; 3],
+}
+
+/// A PLY colour channel in [0, 1]: integers of 8 bits over 255, of 16 over 65535, floats as
+/// they are (clamped).
+fn channel(p: &Property) -> Option<f64> {
+    let v = match *p {
+        Property::UChar(v) => f64::from(v) / 255.0,
+        Property::Char(v) => f64::from(v) / 127.0,
+        Property::UShort(v) => f64::from(v) / 65535.0,
+        Property::Float(v) => f64::from(v),
+        Property::Double(v) => v,
+        _ => return None,
+    };
+    v.is_finite().then(|| v.clamp(0.0, 1.0))
 }
 
 fn scalar(p: &Property) -> Option<f64> {
@@ -247,6 +263,9 @@ impl PropertyAccess for PlyVertex {
             "nx" => &mut self.n[0],
             "ny" => &mut self.n[1],
             "nz" => &mut self.n[2],
+            "red" | "r" | "diffuse_red" => return self.c[0] = channel(&property),
+            "green" | "g" | "diffuse_green" => return self.c[1] = channel(&property),
+            "blue" | "b" | "diffuse_blue" => return self.c[2] = channel(&property),
             _ => return,
         };
         *slot = scalar(&property);
@@ -328,6 +347,15 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
     let mut points = Vec::with_capacity(vertices.len());
     let mut normals = Vec::with_capacity(vertices.len());
     let mut has_normals = !vertices.is_empty();
+    // Colours where every vertex has them.
+    let colors: Vec<phong_core::Color> = vertices
+        .iter()
+        .map(|v| match v.c {
+            [Some(r), Some(g), Some(b)] => Some(phong_core::Color::new(r as f32, g as f32, b as f32)),
+            _ => None,
+        })
+        .collect::<Option<Vec<_>>>()
+        .unwrap_or_default();
     for (i, v) in vertices.iter().enumerate() {
         let [Some(x), Some(y), Some(z)] = v.p else {
             return Err(fail(format!("vertex {i} has no x, y and z")));
@@ -372,15 +400,28 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
     if !has_normals {
         normals = vec![Vec3::ZERO; positions.len()];
     }
-    let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
+    let mesh = Mesh::new(positions, normals, triangles)
+        .and_then(|m| m.with_colors(colors))
+        .map_err(|e| fail(e.to_string()))?;
+    // With colours, a white material: they are the ambient and diffuse colours.
+    let material = (!mesh.colors().is_empty()).then(vertex_color_material);
     Ok(vec![ObjPart {
         name: part_name(path),
         mesh,
-        material: None,
+        material,
         maps: phong_core::Maps::default(),
         has_normals,
         origin,
     }])
+}
+
+/// The material of a part whose vertex colours stand for its ambient and diffuse colours
+/// (OpenGL's `GL_COLOR_MATERIAL` with `GL_AMBIENT_AND_DIFFUSE`): ambient and diffuse white
+/// (the colour multiplies them), the rest OpenGL's default.
+pub(crate) fn vertex_color_material() -> phong_core::Material {
+    let white = phong_core::Color::WHITE;
+    phong_core::Material::new(white, white, phong_core::Color::BLACK, phong_core::Color::BLACK, 0.0)
+        .expect("valid colours")
 }
 
 /// An STL file (ASCII or binary) as one part, its vertices shared where they are equal

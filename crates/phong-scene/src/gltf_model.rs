@@ -208,8 +208,10 @@ pub fn read_gltf(
                         .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
                 }
             }
-            if prim.get(&::gltf::Semantic::Colors(0)).is_some() {
-                colours += 1;
+            if let Some(a) = prim.get(&::gltf::Semantic::Colors(0)) {
+                use ::gltf::accessor::Dimensions;
+                check_accessor(&a, &buffers, &[Dimensions::Vec3, Dimensions::Vec4], false)
+                    .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
             }
             let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let positions: Vec<[f32; 3]> = reader
@@ -224,6 +226,22 @@ pub fn read_gltf(
                 return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
             }
             let n = positions.len();
+            // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
+            let colors: Vec<Color> = match reader.read_colors(0) {
+                Some(c) => {
+                    let c: Vec<Color> = c
+                        .into_rgb_f32()
+                        .map(|[r, g, b]| Color::new(r.max(0.0), g.max(0.0), b.max(0.0)))
+                        .collect();
+                    if c.len() == n && c.iter().all(|c| c.is_finite()) {
+                        c
+                    } else {
+                        colours += 1;
+                        Vec::new()
+                    }
+                }
+                None => Vec::new(),
+            };
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(i) => i.into_u32().collect(),
                 None => (0..n as u32).collect(),
@@ -357,6 +375,7 @@ pub fn read_gltf(
                 material,
                 has_normals,
                 uvs,
+                colors,
                 maps,
             });
         }
@@ -386,7 +405,7 @@ pub fn read_gltf(
     }
     if colours > 0 {
         warnings.push(format!(
-            "{file}: vertex colours (COLOR_0, {colours} primitives) are not used"
+            "{file}: vertex colours (COLOR_0, {colours} primitives) are not used: not one finite colour per vertex"
         ));
     }
     // Re-centre the whole model together (one origin for every part).
@@ -399,12 +418,14 @@ pub fn read_gltf(
         material,
         has_normals,
         uvs,
+        colors,
         maps,
     } in pending
     {
         let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
         let mesh = Mesh::new(positions, normals, tris)
             .and_then(|m| m.with_uvs(uvs))
+            .and_then(|m| m.with_colors(colors))
             .map_err(|e| fail(format!("{name}: {e}")))?;
         model.parts.push(ObjPart {
             name,
@@ -500,6 +521,7 @@ fn node_instances<'a>(
 struct Pending {
     name: String,
     uvs: Vec<Vec2>,
+    colors: Vec<Color>,
     maps: Maps,
     world_pos: Vec<DVec3>,
     normals: Vec<Vec3>,

@@ -639,3 +639,29 @@ fn transparency_is_blending() {
     assert!(!scene("").objects[0].blends(), "alpha alone: OpenGL without GL_BLEND");
     assert!(scene(", blend = true").objects[0].blends());
 }
+
+/// Vertex colours: an OBJ whose every `v` has `x y z r g b`, a PLY's `red green blue` bytes,
+/// glTF's COLOR_0; read where the part has no material (then a white material: they are its
+/// ambient and diffuse colours); an OBJ where not every vertex has one is warned about.
+#[test]
+fn vertex_colours_are_read() {
+    let d = dir("colours");
+    let p = write(&d, "c.obj", b"v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n");
+    let parts = load_model(&p, &mut Vec::new()).unwrap();
+    let mut c: Vec<[f32; 3]> = parts[0].mesh.colors().iter().map(|c| c.to_array()).collect();
+    c.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    assert_eq!(c, [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]);
+    assert_eq!(parts[0].material.unwrap().diffuse().to_array(), [1.0; 3]);
+    let p = write(&d, "partial.obj", b"v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    assert!(parts[0].mesh.colors().is_empty());
+    assert!(w.iter().any(|w| w.contains("vertex colours")), "{w:?}");
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\n\
+end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 51\n3 0 1 2\n";
+    let p = write(&d, "c.ply", ply);
+    let parts = load_model(&p, &mut Vec::new()).unwrap();
+    let c: Vec<[f32; 3]> = parts[0].mesh.colors().iter().map(|c| c.to_array()).collect();
+    assert_eq!(c, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.2]]);
+}

@@ -300,7 +300,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     let lit_output = !matches!(output, Output::Normal | Output::Depth);
     let texture = (obj.textured() && lit_output).then(|| {
         let uv_at = |bary: [f64; 3]| {
-            let uvs = tri.map(|i| mesh.uvs()[i as usize].as_dvec2());
+            let uvs = tri.map(|i| mesh.uvs().get(i as usize).copied().unwrap_or_default().as_dvec2());
             (uvs[0] * bary[0] + uvs[1] * bary[1] + uvs[2] * bary[2]).as_vec2()
         };
         let corners = ps.map(|p| p.as_dvec3());
@@ -311,7 +311,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         let h = 1.0 / 16.0;
         let at = |dx: f64, dy: f64| {
             plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| {
-                let uvs = tri.map(|i| mesh.uvs()[i as usize].as_dvec2());
+                let uvs = tri.map(|i| mesh.uvs().get(i as usize).copied().unwrap_or_default().as_dvec2());
                 uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
             })
         };
@@ -320,7 +320,13 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
             _ => Vec2::ZERO,
         };
         let (d_dx, d_dy) = (derivative(1.0, 0.0), derivative(0.0, 1.0));
-        (uv, d_dx, d_dy, obj.maps.sample(uv, d_dx, d_dy))
+        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        if !mesh.colors().is_empty() {
+            let c = tri.map(|i| mesh.colors()[i as usize]);
+            let w = bary.map(|w| w as f32);
+            texels = texels.tinted(c[0] * w[0] + c[1] * w[1] + c[2] * w[2]);
+        }
+        (uv, d_dx, d_dy, texels)
     });
     let texels = texture.map(|t| t.3);
     let options = ShadingOptions {

@@ -34,6 +34,8 @@ struct VsOut {
     @location(9) spec_back: vec3<f32>,
     @location(10) @interpolate(flat) flat_spec: vec3<f32>,
     @location(11) @interpolate(flat) flat_spec_back: vec3<f32>,
+    // The vertex colour (white where the mesh has none).
+    @location(12) vcolor: vec3<f32>,
 }
 
 // The object's options with the per-point two-sided flip off: the renderer flips by polygon

@@ -8,6 +8,7 @@ struct VsIn {
     // Flat shading: the triangle's centroid (its normal is then the facet normal).
     @location(2) centroid: vec3<f32>,
     @location(3) uv: vec2<f32>,
+    @location(4) color: vec3<f32>,
 }
 
 // An object's texture maps (textures.rs); a white 1×1 texture where a map is absent.
@@ -18,7 +19,7 @@ struct Maps {
     scalar: vec4<u32>,
     // x: alpha cutoff; y: 1 with an alpha test; z: 1 when textured; w: the material's alpha.
     cutoff: vec4<f32>,
-    // x: 1 for a blended object.
+    // x: 1 for a blended object; y: 1 where vertex colours tint the diffuse texel.
     blend: vec4<f32>,
     // Per map: the transform's linear part by columns, then its offset.
     transforms: array<vec4<f32>, 12>,
@@ -64,6 +65,7 @@ fn lit(position: vec3<f32>, normal: vec3<f32>, object: u32) -> array<vec3<f32>, 
 fn vs_main(v: VsIn, @builtin(instance_index) object: u32) -> VsOut {
     var out = vertex(v.position, v.normal, v.centroid, object);
     out.uv = v.uv;
+    out.vcolor = v.color;
     let o = objects[object];
     let interpolation = o.options.mode.x;
     let two_sided = o.options.flags.z != 0u;
@@ -235,7 +237,10 @@ fn fs_main(f: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f3
         let a = select(1.0, maps.cutoff.w, maps.blend.x != 0.0);
         return vec4<f32>(fragment(f, !front) * a, a);
     }
-    let t = texels(f.uv, dx, dy);
+    var t = texels(f.uv, dx, dy);
+    if (maps.blend.y != 0.0) {
+        t.diffuse = vec4<f32>(t.diffuse.xyz * f.vcolor, t.diffuse.w);
+    }
     let alpha = maps.cutoff.w * t.diffuse.w * t.alpha;
     if (maps.cutoff.y != 0.0 && alpha < maps.cutoff.x) {
         discard;

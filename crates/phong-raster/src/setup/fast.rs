@@ -45,6 +45,8 @@ impl Frame<'_> {
         let textured = matches!(self.modes[oi], Mode::Textured(_));
         let uvs = mesh.uvs();
         let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
+        let colors = mesh.colors();
+        let rgb_of = |i: u32| colors.get(i as usize).map_or(Vec3::ONE, |c| Vec3::from(c.to_array()));
         let lighting = gouraud.then(|| VertexLighting {
             isa: self.isa,
             prepared: Prepared::new(
@@ -102,7 +104,8 @@ impl Frame<'_> {
                         } else {
                             out.planes.push(phong_planes(&s, tri));
                             if textured {
-                                out.uv.push(uv_planes(&s, each3(|k| uv_of(tri[s.order[k]]))));
+                                let idx = each3(|k| tri[s.order[k]]);
+                                out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(rgb_of)));
                             }
                         }
                         out.tris.push(s.tri);
@@ -127,6 +130,7 @@ impl Frame<'_> {
                         color_back: lit3[1][k],
                         spec: [Vec3::ZERO; 2],
                         uv: uv_of(tri[k]),
+                        rgb: rgb_of(tri[k]),
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {

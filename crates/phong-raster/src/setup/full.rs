@@ -24,6 +24,7 @@ impl Frame<'_> {
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
         let uvs = mesh.uvs();
+        let colors = mesh.colors();
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
         let vec3 = |c: Color| Vec3::from(c.to_array());
         let verts: Vec<ClipVertex> = mesh
@@ -50,6 +51,7 @@ impl Frame<'_> {
                     color_back: vec3(back.0),
                     spec: [vec3(front.1), vec3(back.1)],
                     uv: uvs.get(i).copied().unwrap_or_default(),
+                    rgb: colors.get(i).map_or(Vec3::ONE, |c| Vec3::from(c.to_array())),
                 }
             })
             .collect();

@@ -267,12 +267,15 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
 }
 
 /// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
-/// The planes of texture coordinates `uv` (per set-up vertex) of triangle `s`: `u/w` and
-/// `v/w` in `attr[0]` and `attr[1]`.
+/// The planes of texture coordinates `uv` and vertex colours `rgb` (per set-up vertex) of
+/// triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the colour over `w` in `attr[2..5]`.
 #[inline]
-pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3]) -> Planes {
-    let attrs = [uv.map(|t| Vec3::new(t.x, t.y, 0.0)), [Vec3::ZERO; 3]];
-    plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, true)
+pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], rgb: [Vec3; 3]) -> Planes {
+    let attrs = [
+        crate::fixed::each3(|k| Vec3::new(uv[k].x, uv[k].y, rgb[k].x)),
+        crate::fixed::each3(|k| Vec3::new(rgb[k].y, rgb[k].z, 0.0)),
+    ];
+    plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
 }
 
 /// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with vertex 0 snapped at `origin` (1/256
@@ -346,7 +349,7 @@ impl Frame<'_> {
             return Some((s.tri, Planes::default(), Some(corners), None));
         }
         let mode = &self.modes[object as usize];
-        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv)));
+        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv), v.map(|v| v.rgb)));
         let planes = match mode {
             Mode::Scalar => Planes::default(),
             Mode::Phong(..) | Mode::Textured(_) => {

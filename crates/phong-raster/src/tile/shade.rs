@@ -199,6 +199,7 @@ impl Frame<'_> {
     ) {
         let obj = &self.scene.objects[object];
         let clamp = obj.shading.options.clamp;
+        let tinted = !obj.mesh.colors().is_empty();
         let centre = |p: u32| ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
         shade_batch_lit(
             self.isa,
@@ -212,8 +213,11 @@ impl Frame<'_> {
             |i, primary, specular| {
                 let (p, id) = items[i];
                 let (x, y) = centre(p);
-                let [uv, d_dx, d_dy] = uv_from_planes(self.uv_planes(id), x, y);
-                let texels = obj.maps.sample(uv, d_dx, d_dy);
+                let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
+                let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+                if tinted {
+                    texels = texels.tinted(rgb);
+                }
                 let lit = Lit {
                     primary: Color::new(primary[0], primary[1], primary[2]),
                     specular: Color::new(specular[0], specular[1], specular[2]),
@@ -389,14 +393,18 @@ impl Frame<'_> {
         let (t, corners) = (self.tri(id), self.corners(id));
         let obj = &self.scene.objects[self.object(id)];
         let [uv, d_dx, d_dy] = Self::uv_at(t, corners, px, py);
-        let texels = obj.maps.sample(uv, d_dx, d_dy);
+        let q = Self::weights(t, corners, px, py);
+        let v = &corners.v;
+        let lerp3 = |f: &dyn Fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
+        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        if !obj.mesh.colors().is_empty() {
+            let c = lerp3(&|v| v.rgb);
+            texels = texels.tinted(Color::new(c.x, c.y, c.z));
+        }
         let alpha = Maps::alpha(&obj.material, &texels);
         if obj.maps.discards(alpha) {
             return None;
         }
-        let q = Self::weights(t, corners, px, py);
-        let v = &corners.v;
-        let lerp3 = |f: &dyn Fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
         let color = |c: Vec3| Color::new(c.x, c.y, c.z);
         let clamp = obj.shading.options.clamp;
         let side = usize::from(t.back);
@@ -440,17 +448,19 @@ impl Frame<'_> {
 }
 
 /// Texture coordinates at pixel centre `(x, y)` from a triangle's planes of `u/w`, `v/w` and
-/// `1/w`, and their screen derivatives: with `q = 1/w`, `u = q_u/q` and `∂u/∂x = (∂q_u/∂x −
-/// u·∂q/∂x)/q` (the planes' gradients are constant).
+/// `1/w` (see `setup::uv_planes`), their screen derivatives, and the vertex colour: with
+/// `q = 1/w`, `u = q_u/q` and `∂u/∂x = (∂q_u/∂x − u·∂q/∂x)/q` (the planes' gradients are
+/// constant).
 #[inline]
-fn uv_from_planes(p: &Planes, x: f32, y: f32) -> [Vec2; 3] {
+fn uv_from_planes(p: &Planes, x: f32, y: f32) -> ([Vec2; 3], Color) {
     let (dx, dy) = (x - p.origin[0], y - p.origin[1]);
     let eval = |k: [f32; 3]| k[0] + k[1] * dx + k[2] * dy;
     let q = eval(p.inv_w);
     let (qu, qv) = (eval(p.attr[0]), eval(p.attr[1]));
     let uv = Vec2::new(qu / q, qv / q);
     let d = |g: usize| Vec2::new(p.attr[0][g] - uv.x * p.inv_w[g], p.attr[1][g] - uv.y * p.inv_w[g]) / q;
-    [uv, d(1), d(2)]
+    let rgb = Color::new(eval(p.attr[2]) / q, eval(p.attr[3]) / q, eval(p.attr[4]) / q);
+    ([uv, d(1), d(2)], rgb)
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ use crate::Error;
 use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, resolve};
 use glam::{DVec3, Vec2, Vec3};
 use mtl::{check_mtl, mtl_names, normalize_mtl, to_material};
-use phong_core::{Maps, Material, Mesh};
+use phong_core::{Color, Maps, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -337,14 +337,37 @@ pub fn load_obj_text(
         } else {
             Vec::new()
         };
+        // Vertex colours, where the part has no material (they stand for its ambient and
+        // diffuse colours, as OpenGL's GL_COLOR_MATERIAL; a material's colours win).
+        let material = m.material_id.and_then(|i| materials.get(i).copied());
+        let colors: Vec<Color> = if m.vertex_color.len() == 3 * n && material.is_none() {
+            m.vertex_color
+                .chunks_exact(3)
+                .map(|c| Color::new(c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)))
+                .collect()
+        } else {
+            if m.vertex_color.len() == 3 * n {
+                warnings.push(format!(
+                    "{}: group {}: vertex colours not used: the group has a material",
+                    path.display(),
+                    model.name
+                ));
+            }
+            Vec::new()
+        };
+        let coloured = !colors.is_empty();
         let mesh = Mesh::new(positions, normals, tris)
             .and_then(|mesh| mesh.with_uvs(uvs))
+            .and_then(|mesh| mesh.with_colors(colors))
             .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
         parts.push((
             ObjPart {
                 name: format!("{file}:{}", model.name),
                 mesh,
-                material: m.material_id.and_then(|i| materials.get(i).copied()),
+                material: match material {
+                    None if coloured => Some(crate::formats::vertex_color_material()),
+                    other => other,
+                },
                 maps: m
                     .material_id
                     .and_then(|i| maps.get(i).cloned())

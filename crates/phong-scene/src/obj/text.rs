@@ -102,8 +102,9 @@ pub(super) struct Prepared {
 /// - numbers as `strtod` reads them, positions re-centred in f64 (see [`Prepared::origin`]);
 /// - comments after a statement removed (tobj reads them as values);
 /// - `v` records cut to `x y z` (a `w`, which the format gives no meaning for polygon
-///   vertices and tobj divides by, is dropped; so are vertex colours, which phong does not use
-///   and which tobj refuses unless every vertex has them), and `vt u` given its `v` of 0;
+///   vertices and tobj divides by, is dropped; vertex colours `v x y z r g b` are kept where
+///   every vertex has them, as tobj needs, else dropped with a warning), and `vt u` given its
+///   `v` of 0;
 /// - faces with fewer than 3 vertices removed, and a face's texture or normal indices that
 ///   refer to nothing dropped from that face (its normals are then computed);
 /// - `l` and `p` statements removed (phong draws surfaces).
@@ -137,6 +138,11 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
         let p: Vec<f64> = w[1..4].iter().filter_map(|(_, t)| strtod(t).map(|x| x.0)).collect();
         (p.len() == 3 && p.iter().all(|x| x.is_finite())).then(|| DVec3::new(p[0], p[1], p[2]))
     }));
+    // Vertex colours are kept where every `v` has exactly `x y z r g b`.
+    let mut vertices = lines(src)
+        .map(|(_, l)| words(l))
+        .filter(|w| w.first().is_some_and(|&(_, k)| k == "v"));
+    let keep_colours = vertices.all(|w| w.len() == 7);
     let mut out = String::with_capacity(src.len() + 64);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let (mut short_faces, mut bad_refs, mut colours, mut lenient) = (0usize, 0usize, 0usize, None);
@@ -196,7 +202,7 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 for i in used + 1..w.len().min(8) {
                     number(i, &mut lenient)?;
                 }
-                if kw == "v" && w.len() > 6 {
+                if kw == "v" && w.len() > 6 && !keep_colours {
                     colours += 1;
                 }
                 out.push_str(kw);
@@ -213,6 +219,12 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 }
                 if kw == "vt" && xs.len() == 1 {
                     out.push_str(" 0");
+                }
+                if kw == "v" && keep_colours {
+                    for i in 4..7 {
+                        out.push(' ');
+                        out.push_str(&(number(i, &mut lenient)? as f32).to_string());
+                    }
                 }
                 out.push('\n');
                 match kw {
@@ -314,7 +326,9 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
         ));
     }
     if colours > 0 {
-        notes.push(format!("{file}: vertex colours ({colours} vertices) are not used"));
+        notes.push(format!(
+            "{file}: vertex colours ({colours} vertices) are not used: not every vertex has `x y z r g b`"
+        ));
     }
     if lines_ + points > 0 {
         notes.push(format!(

@@ -208,6 +208,7 @@ pub(super) fn object(
                         .collect();
                     p.mesh = Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec())
                         .and_then(|m| m.with_uvs(p.mesh.uvs().to_vec()))
+                        .and_then(|m| m.with_colors(p.mesh.colors().to_vec()))
                         .map_err(|e| Error::Model {
                             path: ctx.path.to_path_buf(),
                             message: format!("{}: {e}", p.name),
