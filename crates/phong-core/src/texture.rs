@@ -119,47 +119,34 @@ pub trait Texel: Copy + Send + Sync + std::fmt::Debug + PartialEq + 'static {
     fn translucent(self) -> bool;
 }
 
-impl Texel for [u8; 4] {
-    const MAX: f32 = 255.0;
-    #[inline(always)]
-    fn units(self) -> [f32; 4] {
-        self.map(f32::from)
-    }
-    #[inline(always)]
-    fn rgba(self) -> [f32; 4] {
-        self.map(|c| f32::from(c) / 255.0)
-    }
-    #[inline(always)]
-    fn mean(t: [Self; 4]) -> Self {
-        std::array::from_fn(|i| {
-            ((u16::from(t[0][i]) + u16::from(t[1][i]) + u16::from(t[2][i]) + u16::from(t[3][i]) + 2) / 4) as u8
-        })
-    }
-    fn translucent(self) -> bool {
-        self[3] < u8::MAX
-    }
+/// [`Texel`] for RGBA of `$t` channels, `$wide` wide enough for the sum of four.
+macro_rules! texel {
+    ($t:ty, $wide:ty) => {
+        impl Texel for [$t; 4] {
+            const MAX: f32 = <$t>::MAX as f32;
+            #[inline(always)]
+            fn units(self) -> [f32; 4] {
+                self.map(f32::from)
+            }
+            #[inline(always)]
+            fn rgba(self) -> [f32; 4] {
+                self.map(|c| f32::from(c) / Self::MAX)
+            }
+            #[inline(always)]
+            fn mean(t: [Self; 4]) -> Self {
+                std::array::from_fn(|i| {
+                    let sum: $wide = t.iter().map(|x| <$wide>::from(x[i])).sum();
+                    ((sum + 2) / 4) as $t
+                })
+            }
+            fn translucent(self) -> bool {
+                self[3] < <$t>::MAX
+            }
+        }
+    };
 }
-
-impl Texel for [u16; 4] {
-    const MAX: f32 = 65535.0;
-    #[inline(always)]
-    fn units(self) -> [f32; 4] {
-        self.map(f32::from)
-    }
-    #[inline(always)]
-    fn rgba(self) -> [f32; 4] {
-        self.map(|c| f32::from(c) / 65535.0)
-    }
-    #[inline(always)]
-    fn mean(t: [Self; 4]) -> Self {
-        std::array::from_fn(|i| {
-            ((u32::from(t[0][i]) + u32::from(t[1][i]) + u32::from(t[2][i]) + u32::from(t[3][i]) + 2) / 4) as u16
-        })
-    }
-    fn translucent(self) -> bool {
-        self[3] < u16::MAX
-    }
-}
+texel!(u8, u16);
+texel!(u16, u32);
 
 /// One mipmap level: `width × height` RGBA texels, bottom row first.
 #[derive(Clone, Debug, PartialEq)]

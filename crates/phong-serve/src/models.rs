@@ -129,17 +129,21 @@ pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, Stri
 pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, String> {
     let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
     let lower = name.to_ascii_lowercase();
-    if [".ply", ".stl", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
-        // A glTF's external buffers are looked up among the client's uploads, by file name.
-        let buffer = |uri: &str| -> Result<Vec<u8>, String> {
+    // A file the model names (a glTF's buffers and images, an MTL's images) is looked up among
+    // the client's uploads, by file name.
+    let uploaded = |what: &'static str| {
+        move |uri: &str| -> Result<Vec<u8>, String> {
             let key = uri.rsplit(['/', '\\']).next().unwrap_or(uri);
             files
                 .0
                 .get(key)
                 .map(|f| f.to_vec())
-                .ok_or_else(|| format!("{key} is not uploaded (upload it with the glTF)"))
-        };
-        return phong_scene::parse_model_bytes_with(Path::new(name), data, &buffer).map_err(|e| e.to_string());
+                .ok_or_else(|| format!("{key} is not uploaded (upload it with the {what})"))
+        }
+    };
+    if [".ply", ".stl", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
+        return phong_scene::parse_model_bytes_with(Path::new(name), data, &uploaded("glTF"))
+            .map_err(|e| e.to_string());
     }
     let src = std::str::from_utf8(data).map_err(|_| format!("uploaded {name} is not UTF-8 text"))?;
     let read = |mtl: &Path| -> std::io::Result<String> {
@@ -150,18 +154,9 @@ pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, Stri
         })?;
         String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
     };
-    // Texture images, likewise among the uploads by file name.
-    let image = |name: &str| -> Result<Vec<u8>, String> {
-        let key = name.rsplit(['/', '\\']).next().unwrap_or(name);
-        files
-            .0
-            .get(key)
-            .map(|f| f.to_vec())
-            .ok_or_else(|| format!("{key} is not uploaded (upload it with the OBJ)"))
-    };
     let mut warnings = Vec::new();
-    let parts =
-        phong_scene::load_obj_text(Path::new(name), src, &read, &image, &mut warnings).map_err(|e| e.to_string())?;
+    let parts = phong_scene::load_obj_text(Path::new(name), src, &read, &uploaded("OBJ"), &mut warnings)
+        .map_err(|e| e.to_string())?;
     Ok(LoadedModel::new(parts, ModelFormat::Obj))
 }
 

@@ -550,23 +550,38 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     };
     let mut start = 0;
     while start < n {
-        let m = (n - start).min(V::N);
-        let mut xs = V::A::default();
-        let mut ys = V::A::default();
-        let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
-        for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
-            let (x, y, p) = lane(start + i.min(m - 1));
-            xs.as_mut()[i] = x;
-            ys.as_mut()[i] = y;
-            *plane = p;
-        }
-        let q = interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys));
+        let (m, q) = lanes::<V>(&lane, start, n, attrs);
         let rgb = batch_color(batch, q).map(V::to_array);
         for i in 0..m {
             out(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
         }
         start += m;
     }
+}
+
+/// Pixels `start..` (at most [`V::N`](Vf32::N), `m` of them; the last repeated to fill the
+/// vector) gathered by `lane`, and their first `attrs` attributes interpolated.
+#[inline(always)]
+fn lanes<'p, V: Vf32>(
+    lane: &impl Fn(usize) -> (f32, f32, &'p Planes),
+    start: usize,
+    n: usize,
+    attrs: usize,
+) -> (usize, [V; 6]) {
+    let m = (n - start).min(V::N);
+    let mut xs = V::A::default();
+    let mut ys = V::A::default();
+    let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
+    for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
+        let (x, y, p) = lane(start + i.min(m - 1));
+        xs.as_mut()[i] = x;
+        ys.as_mut()[i] = y;
+        *plane = p;
+    }
+    (
+        m,
+        interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys)),
+    )
 }
 
 /// [`shade_batch`] for a textured object (Phong, its colour): `out(i, primary, specular)`
@@ -582,17 +597,7 @@ pub(crate) fn shade_batch_lit<'p, V: Vf32>(
 ) {
     let mut start = 0;
     while start < n {
-        let m = (n - start).min(V::N);
-        let mut xs = V::A::default();
-        let mut ys = V::A::default();
-        let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
-        for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
-            let (x, y, p) = lane(start + i.min(m - 1));
-            xs.as_mut()[i] = x;
-            ys.as_mut()[i] = y;
-            *plane = p;
-        }
-        let q = interpolate::<V>(&planes[..V::N], 6, V::from_array(xs), V::from_array(ys));
+        let (m, q) = lanes::<V>(&lane, start, n, 6);
         let pos = V3 {
             x: q[0],
             y: q[1],
