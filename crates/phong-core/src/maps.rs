@@ -126,6 +126,8 @@ pub struct Maps {
     pub shininess: Option<(TextureMap, Channel)>,
     /// `map_d`: multiplies the alpha, by one channel.
     pub alpha: Option<(TextureMap, Channel)>,
+    /// `norm`, glTF's normal texture: a tangent-space normal map (with Phong interpolation).
+    pub normal: Option<NormalMap>,
     /// The alpha test: a point whose alpha is below it is not drawn (`None`: no test).
     pub alpha_cutoff: Option<f32>,
     /// Blending (`GL_BLEND` with `GL_ONE_MINUS_SRC_ALPHA`): the object is drawn after the
@@ -133,6 +135,33 @@ pub struct Maps {
     /// [`Scene::draw_order`](crate::Scene::draw_order)). Off by default, as in OpenGL: a
     /// material's alpha alone changes nothing.
     pub blend: bool,
+}
+
+/// A tangent-space normal map: `n = (2·rgb − 1)` with `x, y` times `scale` (glTF's
+/// `normalTexture.scale`), in the frame of the mesh's MikkTSpace tangents; green points along
+/// the bitangent (`+v`: OpenGL's, Blender's and glTF's convention) unless `green_down` (DirectX's).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The image.
+    pub map: TextureMap,
+    /// Scales the tangential components.
+    pub scale: f32,
+    /// Green points along `−v`.
+    pub green_down: bool,
+}
+
+/// The normal at a point from an interpolated normal `n`, tangent `t` (`w`: the bitangent's
+/// sign) and a tangent-space normal `ts`: `T·x + B·y + N·z` with `N = n/|n|`, `T` the tangent
+/// made orthogonal to `N`, `B = w·(N × T)`. Where the tangent is zero or parallel to `n`, `n`.
+#[inline]
+pub fn perturb(n: glam::Vec3, t: glam::Vec4, ts: glam::Vec3) -> glam::Vec3 {
+    let nn = n.normalize_or_zero();
+    let tt = (t.truncate() - nn * nn.dot(t.truncate())).normalize_or_zero();
+    if tt == glam::Vec3::ZERO || nn == glam::Vec3::ZERO {
+        return n;
+    }
+    let b = nn.cross(tt) * if t.w < 0.0 { -1.0 } else { 1.0 };
+    tt * ts.x + b * ts.y + nn * ts.z
 }
 
 /// What an object's maps give at one point: `1` (white, full) where a map is absent.
@@ -150,6 +179,8 @@ pub struct Texels {
     pub shininess: f32,
     /// The alpha map's value.
     pub alpha: f32,
+    /// The normal map's tangent-space normal, if there is one.
+    pub normal: Option<glam::Vec3>,
 }
 
 impl Default for Texels {
@@ -161,6 +192,7 @@ impl Default for Texels {
             emission: None,
             shininess: 1.0,
             alpha: 1.0,
+            normal: None,
         }
     }
 }
@@ -191,6 +223,7 @@ impl Maps {
             && self.emission.is_none()
             && self.shininess.is_none()
             && self.alpha.is_none()
+            && self.normal.is_none()
     }
 
     /// Every map set, for memory accounting and uploads.
@@ -200,6 +233,7 @@ impl Maps {
             .flatten()
             .chain(self.shininess.iter().map(|(m, _)| m))
             .chain(self.alpha.iter().map(|(m, _)| m))
+            .chain(self.normal.iter().map(|n| &n.map))
     }
 
     /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy`.
@@ -212,6 +246,15 @@ impl Maps {
             emission: self.emission.as_ref().map(|m| rgb(at(m))),
             shininess: self.shininess.as_ref().map_or(1.0, |(m, c)| c.of(at(m))),
             alpha: self.alpha.as_ref().map_or(1.0, |(m, c)| c.of(at(m))),
+            normal: self.normal.as_ref().map(|n| {
+                let t = at(&n.map);
+                let y = 2.0 * t[1] - 1.0;
+                glam::Vec3::new(
+                    (2.0 * t[0] - 1.0) * n.scale,
+                    if n.green_down { -y } else { y } * n.scale,
+                    2.0 * t[2] - 1.0,
+                )
+            }),
         }
     }
 

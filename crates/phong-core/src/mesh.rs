@@ -3,7 +3,7 @@
 //! surface's formula).
 
 use crate::{Color, Error};
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 
@@ -18,6 +18,8 @@ pub struct Mesh {
     uvs: Vec<Vec2>,
     /// Vertex colours: empty, or one per position.
     colors: Vec<Color>,
+    /// Tangents (`xyz`, and in `w` the bitangent's sign): empty, or one per position.
+    tangents: Vec<Vec4>,
 }
 
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
@@ -57,6 +59,7 @@ impl Mesh {
             triangles,
             uvs: Vec::new(),
             colors: Vec::new(),
+            tangents: Vec::new(),
         })
     }
 
@@ -83,6 +86,80 @@ impl Mesh {
     /// Vertex colours; empty where the mesh has none.
     pub fn colors(&self) -> &[Color] {
         &self.colors
+    }
+
+    /// Tangents per vertex (`w`: the bitangent's sign, `B = w·(N × T)`); empty where the mesh
+    /// has none (see [`Mesh::with_mikktspace_tangents`]).
+    pub fn tangents(&self) -> &[Vec4] {
+        &self.tangents
+    }
+
+    /// The mesh with MikkTSpace tangents (the convention of Blender, three.js and glTF's
+    /// normal maps), from its normals and texture coordinates; a vertex whose corners get
+    /// different tangents is split. Without texture coordinates the mesh is returned as it is.
+    /// The tangents are dropped by the normals' functions (compute them after the normals).
+    pub fn with_mikktspace_tangents(&self) -> Mesh {
+        if self.uvs.is_empty() || self.triangles.is_empty() {
+            return self.clone();
+        }
+        struct Corners<'a> {
+            m: &'a Mesh,
+            out: Vec<[f32; 4]>,
+        }
+        impl mikktspace::Geometry for Corners<'_> {
+            fn num_faces(&self) -> usize {
+                self.m.triangles.len()
+            }
+            fn num_vertices_of_face(&self, _: usize) -> usize {
+                3
+            }
+            fn position(&self, f: usize, v: usize) -> [f32; 3] {
+                self.m.positions[self.m.triangles[f][v] as usize].to_array()
+            }
+            fn normal(&self, f: usize, v: usize) -> [f32; 3] {
+                self.m.normals[self.m.triangles[f][v] as usize].to_array()
+            }
+            fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
+                self.m.uvs[self.m.triangles[f][v] as usize].to_array()
+            }
+            fn set_tangent_encoded(&mut self, t: [f32; 4], f: usize, v: usize) {
+                self.out[3 * f + v] = t;
+            }
+        }
+        let mut c = Corners {
+            m: self,
+            out: vec![[0.0; 4]; 3 * self.triangles.len()],
+        };
+        if !mikktspace::generate_tangents(&mut c) {
+            return self.clone();
+        }
+        let per_corner = c.out;
+        // One vertex per (vertex, tangent).
+        let mut m = Mesh::default();
+        let mut dedup: FxHashMap<(u32, [u32; 4]), u32> = FxHashMap::default();
+        for (f, t) in self.triangles.iter().enumerate() {
+            let tri = std::array::from_fn(|k| {
+                let (v, tangent) = (t[k], per_corner[3 * f + k]);
+                let tangent = if tangent.iter().all(|x| x.is_finite()) {
+                    tangent
+                } else {
+                    [0.0; 4]
+                };
+                *dedup.entry((v, tangent.map(f32::to_bits))).or_insert_with(|| {
+                    let i = v as usize;
+                    m.positions.push(self.positions[i]);
+                    m.normals.push(self.normals[i]);
+                    m.uvs.push(self.uvs[i]);
+                    if let Some(c) = self.colors.get(i) {
+                        m.colors.push(*c);
+                    }
+                    m.tangents.push(Vec4::from_array(tangent));
+                    (m.positions.len() - 1) as u32
+                })
+            });
+            m.triangles.push(tri);
+        }
+        m
     }
 
     /// The mesh with texture coordinates, one per vertex, finite (`v = 0` is the image's
@@ -149,6 +226,15 @@ impl Mesh {
                 self.uvs.extend_from_slice(&other.uvs);
             }
         }
+        if !self.tangents.is_empty() || !other.tangents.is_empty() {
+            self.tangents.resize(self.positions.len(), Vec4::ZERO);
+            if other.tangents.is_empty() {
+                self.tangents
+                    .resize(self.positions.len() + other.positions.len(), Vec4::ZERO);
+            } else {
+                self.tangents.extend_from_slice(&other.tangents);
+            }
+        }
         if !self.colors.is_empty() || !other.colors.is_empty() {
             self.colors.resize(self.positions.len(), Color::WHITE);
             if other.colors.is_empty() {
@@ -190,6 +276,16 @@ impl Mesh {
             },
             uvs: self.uvs.clone(),
             colors: self.colors.clone(),
+            // A tangent is a direction in the surface: transformed by `m` itself; a mirror
+            // flips the bitangent.
+            tangents: self
+                .tangents
+                .iter()
+                .map(|t| {
+                    let d = (Mat3::from_mat4(*m) * t.truncate()).normalize_or_zero();
+                    d.extend(if flip { -t.w } else { t.w })
+                })
+                .collect(),
         }
     }
 
@@ -220,6 +316,7 @@ impl Mesh {
             triangles,
             uvs,
             colors,
+            tangents: Vec::new(),
         }
     }
 
@@ -253,6 +350,7 @@ impl Mesh {
             triangles,
             uvs: Vec::new(),
             colors: Vec::new(),
+            tangents: Vec::new(),
         };
         (mesh, remap)
     }
@@ -282,6 +380,7 @@ impl Mesh {
             triangles: self.triangles.clone(),
             uvs: self.uvs.clone(),
             colors: self.colors.clone(),
+            tangents: Vec::new(),
         }
     }
 
@@ -429,6 +528,7 @@ impl Mesh {
             triangles,
             uvs,
             colors,
+            tangents: Vec::new(),
         };
         (mesh, work)
     }

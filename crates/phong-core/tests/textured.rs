@@ -123,6 +123,7 @@ fn each_map_modulates_its_term() {
         emission: Some(Color::new(0.0, 0.0, 1.0)),
         shininess: 0.5,
         alpha: 1.0,
+        normal: None,
     };
     let s = shade_textured(&p, &View::Infinite { to_viewer: v }, &m, &texels, &lighting, &o);
     // A = 0.5·0.2 (the uniform light has no ambient) = 0.1; D = 0.4; S = 0.5^(8·0.5).

@@ -141,6 +141,8 @@ pub struct GpuVertex {
     pub uv: [f32; 2],
     /// The vertex colour (white where the mesh has none).
     pub color: [f32; 3],
+    /// The tangent, `w` the bitangent's sign (zero where the mesh has none).
+    pub tangent: [f32; 4],
 }
 
 /// WGSL `Maps` (render.wgsl): an object's texture maps, bound with its textures.
@@ -157,9 +159,11 @@ pub struct GpuMaps {
     /// x: 1 for a blended object (its fragments carry their alpha); y: 1 where vertex colours
     /// tint the diffuse texel.
     pub blend: [f32; 4],
-    /// Per map (diffuse, ambient, specular, emission, shininess, alpha): its transform's linear
-    /// part by columns, then its offset.
-    pub transforms: [[f32; 4]; 12],
+    /// A normal map: x 1 where there is one, y its scale, z 1 for green along −v.
+    pub normal: [f32; 4],
+    /// Per map (diffuse, ambient, specular, emission, shininess, alpha, normal): its
+    /// transform's linear part by columns, then its offset.
+    pub transforms: [[f32; 4]; 14],
 }
 
 /// WGSL `Case` (compute tests).

@@ -11,10 +11,10 @@ use phong_core::{Channel, Filter, Maps, MipFilter, Texture, TextureMap, Wrap};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// The maps' order in [`GpuMaps`] and the group's bindings (textures at 1.., samplers at 7..).
-const SLOTS: usize = 6;
+/// The maps' order in [`GpuMaps`] and the group's bindings (textures at 1.., samplers at 8..).
+const SLOTS: usize = 7;
 
-/// The layout of group 1: the uniform [`GpuMaps`], six textures, six samplers.
+/// The layout of group 1: the uniform [`GpuMaps`], seven textures, seven samplers.
 pub(crate) fn maps_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![wgpu::BindGroupLayoutEntry {
@@ -172,6 +172,7 @@ impl Gpu {
                     maps.emission.as_ref(),
                     maps.shininess.as_ref().map(|(m, _)| m),
                     maps.alpha.as_ref().map(|(m, _)| m),
+                    maps.normal.as_ref().map(|n| &n.map),
                 ];
                 let mut params = GpuMaps {
                     present: std::array::from_fn(|k| u32::from(slots[k].is_some())),
@@ -188,6 +189,10 @@ impl Gpu {
                         *alpha,
                     ],
                     blend: [f32::from(u8::from(*blends)), f32::from(u8::from(*colors)), 0.0, 0.0],
+                    normal: maps
+                        .normal
+                        .as_ref()
+                        .map_or([0.0; 4], |n| [1.0, n.scale, f32::from(u8::from(n.green_down)), 0.0]),
                     ..Default::default()
                 };
                 let mut samplers = Vec::new();

@@ -63,6 +63,7 @@ impl Geometry {
             let first = g.indices.len() as u32;
             let uv = |k: u32| m.uvs().get(k as usize).map_or([0.0; 2], |u| u.to_array());
             let color = |k: u32| m.colors().get(k as usize).map_or([1.0; 3], |c| c.to_array());
+            let tangent = |k: u32| m.tangents().get(k as usize).map_or([0.0; 4], |t| t.to_array());
             if o.shading.interpolation == Interpolation::Flat {
                 for (t, corners) in m.triangles().iter().enumerate() {
                     let [a, b, c] = m.corners(t);
@@ -76,6 +77,7 @@ impl Geometry {
                             centroid,
                             uv: uv(*k),
                             color: color(*k),
+                            tangent: tangent(*k),
                         });
                     }
                 }
@@ -89,6 +91,7 @@ impl Geometry {
                             centroid: p.to_array(),
                             uv: uv(k),
                             color: color(k),
+                            tangent: tangent(k),
                         }),
                 );
                 g.indices
@@ -187,6 +190,12 @@ impl Gpu {
         let max_tex = u64::from(self.limits.max_texture_dimension_2d);
         self.check_limit("image width", u64::from(w), max_tex)?;
         self.check_limit("image height", u64::from(h), max_tex)?;
+        for o in scene.objects.iter().filter(|o| o.textured()) {
+            for m in o.maps.each() {
+                let side = m.texture.width().max(m.texture.height());
+                self.check_limit("texture side", u64::from(side), max_tex)?;
+            }
+        }
         self.check_lost("starting a render")?;
         let compute = match path {
             GpuPath::Pipeline => false,

@@ -28,6 +28,8 @@ pub struct ClipVertex {
     pub uv: Vec2,
     /// The vertex colour (white where the mesh has none).
     pub rgb: Vec3,
+    /// The tangent (`w`: the bitangent's sign; zero where the mesh has none).
+    pub tangent: Vec4,
 }
 
 impl ClipVertex {
@@ -44,6 +46,7 @@ impl ClipVertex {
             spec: [0, 1].map(|k| self.spec[k].lerp(b.spec[k], t)),
             uv: self.uv.lerp(b.uv, t),
             rgb: self.rgb.lerp(b.rgb, t),
+            tangent: self.tangent.lerp(b.tangent, t),
         }
     }
 }
@@ -169,6 +172,7 @@ mod tests {
             spec: [Vec3::ZERO; 2],
             uv: Vec2::ZERO,
             rgb: Vec3::ONE,
+            tangent: Vec4::ZERO,
         }
     }
 

@@ -292,6 +292,7 @@ rotation = [0.0, 90.0, 0.0]
                             spec: [Vec3::ZERO; 2],
                             uv: glam::Vec2::ZERO,
                             rgb: Vec3::ONE,
+                            tangent: glam::Vec4::ZERO,
                         }
                     })
                 })

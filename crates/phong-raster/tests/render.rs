@@ -1002,3 +1002,50 @@ fn vertex_colours_are_interpolated() {
         }
     }
 }
+
+/// A normal map by hand: the quad facing +z (texture coordinates along +x and +y, so its
+/// MikkTSpace tangent is +x and bitangent +y) with a constant tangent-space normal
+/// `(0.6, 0, 0.8)`, lit from `L = (0.6, 0, 0.8)` with a white diffuse material: `N'·L = 1`
+/// where the flat normal gives 0.8 (and a tangent the wrong way round 0.28). Green along +v,
+/// and with `green_down` along −v. Per-pixel shading, every CPU path.
+#[test]
+fn a_normal_map_tilts_the_normal_in_its_tangent_frame() {
+    let n = 16u32;
+    let m = Material::new(Color::BLACK, Color::WHITE, Color::BLACK, Color::BLACK, 1.0).unwrap();
+    let lighting = |l: Vec3| {
+        Lighting::new(
+            Color::BLACK,
+            vec![Light::directional(-l, LightColor::uniform(Color::WHITE).unwrap()).unwrap()],
+        )
+        .unwrap()
+    };
+    let encode = |v: f32| ((v + 1.0) / 2.0 * 65535.0).round() as u16;
+    for (ts, l, green_down, want) in [
+        (Vec3::new(0.6, 0.0, 0.8), Vec3::new(0.6, 0.0, 0.8), false, 1.0),
+        (Vec3::new(0.0, 0.6, 0.8), Vec3::new(0.0, 0.6, 0.8), false, 1.0),
+        (Vec3::new(0.0, 0.6, 0.8), Vec3::new(0.0, 0.6, 0.8), true, 0.28),
+    ] {
+        let texel = [encode(ts.x), encode(ts.y), encode(ts.z), 65535];
+        let texture = std::sync::Arc::new(Texture::new(1, 1, &[texel], 16).unwrap());
+        let mut o = obj(textured_quad(0.0).with_mikktspace_tangents(), m);
+        o.maps.normal = Some(NormalMap {
+            map: TextureMap::new(texture),
+            scale: 1.0,
+            green_down,
+        });
+        let s = scene(n, n, ortho_camera(2.0), vec![o], lighting(l), Interpolation::Phong);
+        for path in common::paths() {
+            let img = path.render(&s);
+            for y in 0..n {
+                for x in 0..n {
+                    let got = px(&img, x, y);
+                    assert!(
+                        (got - Vec3::splat(want)).abs().max_element() < 2e-4,
+                        "{} {ts} down {green_down} ({x}, {y}): {got}",
+                        path.name
+                    );
+                }
+            }
+        }
+    }
+}

@@ -297,7 +297,6 @@ pub fn read_gltf(
                         "metallicRoughnessTexture",
                         mat.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
                     ),
-                    ("normalTexture", mat.normal_texture().is_some()),
                     ("occlusionTexture", mat.occlusion_texture().is_some()),
                 ] {
                     if t {
@@ -325,7 +324,7 @@ pub fn read_gltf(
                 let requests: Vec<MapRequest> = infos
                     .iter()
                     .filter(|(_, info)| Some(info.tex_coord()) == set)
-                    .filter_map(|(slot, info)| texture_request(*slot, info, &buffers, &what))
+                    .filter_map(|(_, tex)| texture_request(tex, &buffers, &what))
                     .collect();
                 if infos.iter().any(|(_, info)| Some(info.tex_coord()) != set) {
                     warnings.push(format!(
@@ -652,25 +651,60 @@ fn percent_decode(s: &str) -> String {
 
 /// The textures a material uses that phong renders, with their slots: base colour (or
 /// KHR_materials_pbrSpecularGlossiness's diffuse texture), emissive.
-fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<(Slot, ::gltf::texture::Info<'a>)> {
+/// A texture a material uses: its slot, the texture, its coordinate set, its
+/// KHR_texture_transform and (a normal texture) its scale.
+struct Tex<'a> {
+    slot: Slot,
+    texture: ::gltf::Texture<'a>,
+    set: u32,
+    transform: Option<::gltf::texture::TextureTransform<'a>>,
+    scale: f32,
+}
+
+impl<'a> Tex<'a> {
+    fn of(slot: Slot, info: ::gltf::texture::Info<'a>) -> Tex<'a> {
+        Tex {
+            slot,
+            texture: info.texture(),
+            set: info.tex_coord(),
+            transform: info.texture_transform(),
+            scale: 1.0,
+        }
+    }
+    fn tex_coord(&self) -> u32 {
+        self.set
+    }
+}
+
+fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<(Slot, Tex<'a>)> {
     let mut out = Vec::new();
     let diffuse = match mat.pbr_specular_glossiness() {
         Some(sg) => sg.diffuse_texture(),
         None => mat.pbr_metallic_roughness().base_color_texture(),
     };
     if let Some(t) = diffuse {
-        out.push((Slot::Diffuse, t));
+        out.push((Slot::Diffuse, Tex::of(Slot::Diffuse, t)));
     }
     if let Some(t) = mat.emissive_texture() {
-        out.push((Slot::Emission, t));
+        out.push((Slot::Emission, Tex::of(Slot::Emission, t)));
+    }
+    if let Some(n) = mat.normal_texture() {
+        let t = Tex {
+            slot: Slot::Normal,
+            texture: n.texture(),
+            set: n.tex_coord(),
+            transform: None,
+            scale: n.scale(),
+        };
+        out.push((Slot::Normal, t));
     }
     out
 }
 
 /// A glTF texture as a map request: its image (a buffer view's bytes, a data URI, or a file
 /// read by the loader's reader), sampler and KHR_texture_transform, in OpenGL's coordinates.
-fn texture_request(slot: Slot, info: &::gltf::texture::Info, buffers: &[Vec<u8>], what: &str) -> Option<MapRequest> {
-    let texture = info.texture();
+fn texture_request(tex: &Tex, buffers: &[Vec<u8>], what: &str) -> Option<MapRequest> {
+    let (slot, texture) = (tex.slot, tex.texture.clone());
     let name = format!("image {}", texture.source().index());
     let source = match texture.source().source() {
         ::gltf::image::Source::View { view, .. } => {
@@ -718,7 +752,7 @@ fn texture_request(slot: Slot, info: &::gltf::texture::Info, buffers: &[Vec<u8>]
         linear: Mat2::from_diagonal(Vec2::new(1.0, -1.0)),
         offset: Vec2::new(0.0, 1.0),
     };
-    let m = match info.texture_transform() {
+    let m = match &tex.transform {
         Some(t) => {
             let (sin, cos) = t.rotation().sin_cos();
             let rotation = Mat2::from_cols(Vec2::new(cos, -sin), Vec2::new(sin, cos));
@@ -737,5 +771,7 @@ fn texture_request(slot: Slot, info: &::gltf::texture::Info, buffers: &[Vec<u8>]
         channel: None,
         srgb: true,
         at: what.to_string(),
+        normal_scale: tex.scale,
+        green_down: false,
     })
 }

@@ -6,7 +6,7 @@
 //! file and why; the material is drawn without it (as three.js does).
 
 use phong_core::limits::{MAX_IMAGE_FILE_BYTES, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
-use phong_core::{Channel, Maps, Sampler, Texture, TextureMap, UvTransform, Wrap};
+use phong_core::{Channel, Maps, NormalMap, Sampler, Texture, TextureMap, UvTransform, Wrap};
 use std::cell::Cell;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -100,6 +100,10 @@ pub struct MapRequest {
     pub srgb: bool,
     /// Where the request is, for messages (`file.mtl:12`, `scene.toml: materials.brick`).
     pub at: String,
+    /// A normal map: the scale of its tangential components (1 by default).
+    pub normal_scale: f32,
+    /// A normal map: green along `−v` (DirectX's convention).
+    pub green_down: bool,
 }
 
 /// Decoded textures by (name, sRGB), so that a file named by several materials is read once.
@@ -219,11 +223,10 @@ pub fn resolve(
 ) -> Maps {
     let mut maps = Maps::default();
     for r in requests {
-        if matches!(r.slot, Slot::Bump | Slot::Normal) {
+        if r.slot == Slot::Bump {
             warnings.push(format!(
-                "{}: material {name}: {} map {} is not used (bump and normal maps are not rendered yet)",
+                "{}: material {name}: bump map {} is not used (bump maps are not rendered yet; a normal map is)",
                 r.at,
-                if r.slot == Slot::Bump { "bump" } else { "normal" },
                 r.source.name()
             ));
             continue;
@@ -259,7 +262,14 @@ pub fn resolve(
                 maps.alpha = Some((map, channel));
                 maps.alpha_cutoff.get_or_insert(0.5);
             }
-            Slot::Bump | Slot::Normal => {}
+            Slot::Normal => {
+                maps.normal = Some(NormalMap {
+                    map,
+                    scale: r.normal_scale,
+                    green_down: r.green_down,
+                })
+            }
+            Slot::Bump => {}
         }
     }
     maps
@@ -365,6 +375,8 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
         channel,
         srgb: false,
         at: String::new(),
+        normal_scale: 1.0,
+        green_down: false,
     };
     Ok(Some((request, unused)))
 }

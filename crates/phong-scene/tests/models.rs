@@ -665,3 +665,35 @@ end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 51\n3 0 1 2\n";
     let c: Vec<[f32; 3]> = parts[0].mesh.colors().iter().map(|c| c.to_array()).collect();
     assert_eq!(c, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.2]]);
 }
+
+/// Normal maps from each source: a scene's `normal_map` (with `normal_scale` and
+/// `normal_green`), an MTL's `norm`; the object gets MikkTSpace tangents (a plane's: +x).
+#[test]
+fn normal_maps_are_read_with_tangents() {
+    let d = dir("normals");
+    let flat = phong_core::Image::new(2, 2, [0.5, 0.5, 1.0, 1.0]).unwrap();
+    let png = phong_scene::encode_png(&flat, phong_core::Encoding::Linear).unwrap();
+    write(&d, "n.png", &png);
+    let scene = write(
+        &d,
+        "s.toml",
+        b"[[object]]\nshape = \"plane\"\nmaterial = { normal_map = \"n.png\", normal_scale = 0.5, normal_green = \"down\" }\n",
+    );
+    let loaded = load_with(&scene, &ModelOptions::default()).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let o = &loaded.scene.objects[0];
+    let n = o.maps.normal.as_ref().expect("a normal map");
+    assert_eq!((n.scale, n.green_down), (0.5, true));
+    assert!(!o.mesh.tangents().is_empty());
+    for t in o.mesh.tangents() {
+        assert!((t.truncate() - Vec3::X).length() < 1e-5 && t.w == 1.0, "{t}");
+    }
+    write(&d, "q.mtl", b"newmtl m\nnorm n.png\n");
+    let obj = write(
+        &d,
+        "q.obj",
+        b"mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n",
+    );
+    let parts = load_model(&obj, &mut Vec::new()).unwrap();
+    assert!(parts[0].maps.normal.is_some());
+}

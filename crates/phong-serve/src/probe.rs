@@ -15,7 +15,8 @@ use glam::{DVec3, Vec2, Vec3};
 use phong_core::mesh::facet_normal;
 use phong_core::{
     Color, Interpolation, Light, Lighting, Lit, Maps, Material, Object, Output, Scene, Shading, ShadingOptions,
-    SpecularModel, SurfacePoint, Texels, View, depth_color, normal_color, shade, shade_textured, specular_factor,
+    SpecularModel, SurfacePoint, Texels, View, depth_color, normal_color, perturb, shade, shade_textured,
+    specular_factor,
 };
 use serde::Serialize;
 
@@ -332,6 +333,15 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     let options = ShadingOptions {
         two_sided: false,
         ..obj.shading.options
+    };
+    // A normal map tilts the interpolated normal in the mesh's tangent frame (per-pixel
+    // shading only, as the renderers).
+    let normal = match texels.and_then(|t| t.normal) {
+        Some(ts) if interpolation == Interpolation::Phong && !mesh.tangents().is_empty() => {
+            let tg = tri.map(|i| mesh.tangents()[i as usize]);
+            perturb(normal, tg[0] * b[0] + tg[1] * b[1] + tg[2] * b[2], ts)
+        }
+        _ => normal,
     };
     let at = match &texels {
         Some(t) => shade_textured(

@@ -36,6 +36,8 @@ struct VsOut {
     @location(11) @interpolate(flat) flat_spec_back: vec3<f32>,
     // The vertex colour (white where the mesh has none).
     @location(12) vcolor: vec3<f32>,
+    // The tangent (w: the bitangent's sign), for normal maps.
+    @location(13) tangent: vec4<f32>,
 }
 
 // The object's options with the per-point two-sided flip off: the renderer flips by polygon

@@ -9,6 +9,7 @@ struct VsIn {
     @location(2) centroid: vec3<f32>,
     @location(3) uv: vec2<f32>,
     @location(4) color: vec3<f32>,
+    @location(5) tangent: vec4<f32>,
 }
 
 // An object's texture maps (textures.rs); a white 1×1 texture where a map is absent.
@@ -21,8 +22,10 @@ struct Maps {
     cutoff: vec4<f32>,
     // x: 1 for a blended object; y: 1 where vertex colours tint the diffuse texel.
     blend: vec4<f32>,
+    // A normal map: x 1 where there is one, y its scale, z 1 for green along −v.
+    normal: vec4<f32>,
     // Per map: the transform's linear part by columns, then its offset.
-    transforms: array<vec4<f32>, 12>,
+    transforms: array<vec4<f32>, 14>,
 }
 
 @group(1) @binding(0) var<uniform> maps: Maps;
@@ -32,12 +35,14 @@ struct Maps {
 @group(1) @binding(4) var t_emission: texture_2d<f32>;
 @group(1) @binding(5) var t_shininess: texture_2d<f32>;
 @group(1) @binding(6) var t_alpha: texture_2d<f32>;
-@group(1) @binding(7) var s_diffuse: sampler;
-@group(1) @binding(8) var s_ambient: sampler;
-@group(1) @binding(9) var s_specular: sampler;
-@group(1) @binding(10) var s_emission: sampler;
-@group(1) @binding(11) var s_shininess: sampler;
-@group(1) @binding(12) var s_alpha: sampler;
+@group(1) @binding(7) var t_normal: texture_2d<f32>;
+@group(1) @binding(8) var s_diffuse: sampler;
+@group(1) @binding(9) var s_ambient: sampler;
+@group(1) @binding(10) var s_specular: sampler;
+@group(1) @binding(11) var s_emission: sampler;
+@group(1) @binding(12) var s_shininess: sampler;
+@group(1) @binding(13) var s_alpha: sampler;
+@group(1) @binding(14) var s_normal: sampler;
 
 // A textured object's light before its texels: (primary, specular), as phong-core's `Lit` with
 // every term in the primary colour (Gouraud and flat shading), or the term an output shows.
@@ -66,6 +71,7 @@ fn vs_main(v: VsIn, @builtin(instance_index) object: u32) -> VsOut {
     var out = vertex(v.position, v.normal, v.centroid, object);
     out.uv = v.uv;
     out.vcolor = v.color;
+    out.tangent = v.tangent;
     let o = objects[object];
     let interpolation = o.options.mode.x;
     let two_sided = o.options.flags.z != 0u;
@@ -123,6 +129,8 @@ struct Texels {
     emission: vec3<f32>,
     shininess: f32,
     alpha: f32,
+    // The normal map's tangent-space normal (z 1 without one).
+    normal: vec3<f32>,
 }
 
 // Every map sampled at `uv` with the screen derivatives `dx`, `dy` (1 where a map is absent).
@@ -134,6 +142,7 @@ fn texels(uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Texels {
     t.emission = vec3<f32>(1.0);
     t.shininess = 1.0;
     t.alpha = 1.0;
+    t.normal = vec3<f32>(0.0, 0.0, 1.0);
     if (maps.present.x != 0u) {
         t.diffuse = textureSampleGrad(t_diffuse, s_diffuse, map_uv(0u, uv), map_d(0u, dx), map_d(0u, dy));
     }
@@ -153,6 +162,10 @@ fn texels(uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Texels {
     if (maps.scalar.y != 0u) {
         let a = textureSampleGrad(t_alpha, s_alpha, map_uv(5u, uv), map_d(5u, dx), map_d(5u, dy));
         t.alpha = channel(maps.scalar.w, a);
+    }
+    if (maps.normal.x != 0.0) {
+        let n = textureSampleGrad(t_normal, s_normal, map_uv(6u, uv), map_d(6u, dx), map_d(6u, dy)).xyz * 2.0 - 1.0;
+        t.normal = vec3<f32>(n.x * maps.normal.y, select(n.y, -n.y, maps.normal.z != 0.0) * maps.normal.y, n.z);
     }
     return t;
 }
@@ -184,6 +197,15 @@ fn textured(f: VsOut, back: bool, t: Texels) -> vec3<f32> {
     var normal = f.normal;
     if (back) {
         normal = -normal;
+    }
+    // A normal map tilts the normal in the tangent frame (phong-core's `perturb`).
+    if (maps.normal.x != 0.0) {
+        let nn = normalize_or_zero(normal);
+        let tt = normalize_or_zero(f.tangent.xyz - nn * dot(nn, f.tangent.xyz));
+        if (any(tt != vec3<f32>(0.0)) && any(nn != vec3<f32>(0.0))) {
+            let b = cross(nn, tt) * select(1.0, -1.0, f.tangent.w < 0.0);
+            normal = tt * t.normal.x + b * t.normal.y + nn * t.normal.z;
+        }
     }
     var m = o.material;
     let e = m.emission.xyz;

@@ -131,6 +131,7 @@ impl Frame<'_> {
                         spec: [Vec3::ZERO; 2],
                         uv: uv_of(tri[k]),
                         rgb: rgb_of(tri[k]),
+                        tangent: Vec4::ZERO,
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {

@@ -25,6 +25,7 @@ impl Frame<'_> {
         let gouraud = interpolation == Interpolation::Gouraud;
         let uvs = mesh.uvs();
         let colors = mesh.colors();
+        let tangents = mesh.tangents();
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
         let vec3 = |c: Color| Vec3::from(c.to_array());
         let verts: Vec<ClipVertex> = mesh
@@ -52,6 +53,7 @@ impl Frame<'_> {
                     spec: [vec3(front.1), vec3(back.1)],
                     uv: uvs.get(i).copied().unwrap_or_default(),
                     rgb: colors.get(i).map_or(Vec3::ONE, |c| Vec3::from(c.to_array())),
+                    tangent: tangents.get(i).copied().unwrap_or(Vec4::ZERO),
                 }
             })
             .collect();

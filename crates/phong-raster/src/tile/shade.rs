@@ -18,7 +18,8 @@ use crate::target::{Store, fill, resolve};
 use glam::{Vec2, Vec3};
 use phong_core::limits::SUBPIXEL_BITS;
 use phong_core::{
-    Color, Interpolation, Lit, Maps, Output, ShadingOptions, SurfacePoint, depth_color, normal_color, shade_textured,
+    Color, Interpolation, Lit, Maps, Output, ShadingOptions, SurfacePoint, depth_color, normal_color, perturb,
+    shade_textured,
 };
 
 /// How many of `ids` from the start equal `k`: 8 compared at a time (a branch-free mask LLVM
@@ -430,9 +431,18 @@ impl Frame<'_> {
             }
             _ => {
                 let n = lerp3(&|v| v.normal);
+                let n = if t.back { -n } else { n };
+                // A normal map tilts the interpolated normal in its tangent frame.
+                let normal = match texels.normal {
+                    Some(ts) => {
+                        let tangent = v[0].tangent * q[0] + v[1].tangent * q[1] + v[2].tangent * q[2];
+                        perturb(n, tangent, ts)
+                    }
+                    None => n,
+                };
                 let point = SurfacePoint {
                     position: lerp3(&|v| v.world),
-                    normal: if t.back { -n } else { n },
+                    normal,
                 };
                 let options = ShadingOptions {
                     two_sided: false,

@@ -100,6 +100,14 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
     if let Some(b) = &m.bump_scale {
         ctx.num(b, "bump_scale", f32::is_finite, "finite")?;
     }
+    let normal_scale = match &m.normal_scale {
+        Some(s) => ctx.num(s, "normal_scale", f32::is_finite, "finite")?,
+        None => 1.0,
+    };
+    let green_down = match &m.normal_green {
+        Some(g) => ctx.choice(g, "normal_green", &[("up", false), ("down", true)])?,
+        None => false,
+    };
     let alpha_cutoff = match &m.alpha_cutoff {
         Some(a) => Some(ctx.num(a, "alpha_cutoff", |x| (0.0..=1.0).contains(&x), "in [0, 1]")?),
         None => None,
@@ -126,6 +134,8 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
             channel: None,
             srgb,
             at: format!("{}:{line}: `{k}`", ctx.path.display()),
+            normal_scale,
+            green_down,
         });
     }
     let dir = ctx.path.parent().unwrap_or(std::path::Path::new("")).to_path_buf();
@@ -165,6 +175,9 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
     }
     if mine.alpha.is_some() {
         out.alpha = mine.alpha;
+    }
+    if mine.normal.is_some() {
+        out.normal = mine.normal;
     }
     out.alpha_cutoff = alpha_cutoff.or(mine.alpha_cutoff).or(out.alpha_cutoff);
     if let Some(b) = &m.blend {

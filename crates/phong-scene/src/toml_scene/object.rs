@@ -56,6 +56,8 @@ pub(super) fn object(
                     encoding: at(m.span(), p.encoding.clone()),
                     alpha_cutoff: at(m.span(), p.alpha_cutoff),
                     blend: at(m.span(), p.blend),
+                    normal_scale: at(m.span(), p.normal_scale),
+                    normal_green: at(m.span(), p.normal_green.clone()),
                 };
                 material(ctx, &raw, "material", named)?
             }
@@ -149,6 +151,7 @@ pub(super) fn object(
             }
             let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
             let (material, maps) = material.unwrap_or_default();
+            let mesh = tangents_for(mesh, &maps);
             Ok(vec![Object {
                 name: kind.to_string(),
                 mesh: mesh.transformed(&world_from_object),
@@ -258,6 +261,7 @@ pub(super) fn object(
                 } else {
                     maps
                 };
+                let mesh = tangents_for(mesh, &maps);
                 out.push(Object {
                     name: p.name,
                     mesh: mesh.transformed(&world_from_file),
@@ -277,6 +281,16 @@ pub(super) fn object(
             "object",
             "an object needs `shape` (sphere, torus, ...) or `mesh` (a file)",
         ),
+    }
+}
+
+/// The mesh with MikkTSpace tangents where a normal map needs them (after its normals, which
+/// they are computed from).
+fn tangents_for(mesh: Mesh, maps: &Maps) -> Mesh {
+    if maps.normal.is_some() && mesh.has_uvs() {
+        mesh.with_mikktspace_tangents()
+    } else {
+        mesh
     }
 }
 

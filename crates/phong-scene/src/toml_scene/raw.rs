@@ -115,6 +115,8 @@ pub(crate) struct RawMaterial {
     pub encoding: Option<S<String>>,
     pub alpha_cutoff: Option<S<f32>>,
     pub blend: Option<S<bool>>,
+    pub normal_scale: Option<S<f32>>,
+    pub normal_green: Option<S<String>>,
 }
 
 /// An inline material table: the same keys, without per-key spans (serde's
@@ -146,6 +148,8 @@ pub(crate) struct PlainMaterial {
     pub encoding: Option<String>,
     pub alpha_cutoff: Option<f32>,
     pub blend: Option<bool>,
+    pub normal_scale: Option<f32>,
+    pub normal_green: Option<String>,
 }
 
 #[derive(Deserialize)]
