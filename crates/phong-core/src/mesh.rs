@@ -214,36 +214,13 @@ impl Mesh {
     }
 
     /// Appends `other`'s vertices and triangles. Where only one of the two has texture
-    /// coordinates, the other's vertices get `(0, 0)`.
+    /// coordinates, colours or tangents, the other's vertices get `(0, 0)`, white or none.
     pub fn append(&mut self, other: &Mesh) {
         let base = self.positions.len() as u32;
-        if !self.uvs.is_empty() || !other.uvs.is_empty() {
-            self.uvs.resize(self.positions.len(), Vec2::ZERO);
-            if other.uvs.is_empty() {
-                self.uvs
-                    .resize(self.positions.len() + other.positions.len(), Vec2::ZERO);
-            } else {
-                self.uvs.extend_from_slice(&other.uvs);
-            }
-        }
-        if !self.tangents.is_empty() || !other.tangents.is_empty() {
-            self.tangents.resize(self.positions.len(), Vec4::ZERO);
-            if other.tangents.is_empty() {
-                self.tangents
-                    .resize(self.positions.len() + other.positions.len(), Vec4::ZERO);
-            } else {
-                self.tangents.extend_from_slice(&other.tangents);
-            }
-        }
-        if !self.colors.is_empty() || !other.colors.is_empty() {
-            self.colors.resize(self.positions.len(), Color::WHITE);
-            if other.colors.is_empty() {
-                self.colors
-                    .resize(self.positions.len() + other.positions.len(), Color::WHITE);
-            } else {
-                self.colors.extend_from_slice(&other.colors);
-            }
-        }
+        let (mine, theirs) = (self.positions.len(), other.positions.len());
+        append_attribute(&mut self.uvs, &other.uvs, mine, theirs, Vec2::ZERO);
+        append_attribute(&mut self.tangents, &other.tangents, mine, theirs, Vec4::ZERO);
+        append_attribute(&mut self.colors, &other.colors, mine, theirs, Color::WHITE);
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
         self.triangles
@@ -531,6 +508,20 @@ impl Mesh {
             tangents: Vec::new(),
         };
         (mesh, work)
+    }
+}
+
+/// Appends a per-vertex attribute: `theirs` (for `n_theirs` vertices) after `mine` (for
+/// `n_mine`), where either has it, the other's vertices given `fill`.
+fn append_attribute<T: Clone>(mine: &mut Vec<T>, theirs: &[T], n_mine: usize, n_theirs: usize, fill: T) {
+    if mine.is_empty() && theirs.is_empty() {
+        return;
+    }
+    mine.resize(n_mine, fill.clone());
+    if theirs.is_empty() {
+        mine.resize(n_mine + n_theirs, fill);
+    } else {
+        mine.extend_from_slice(theirs);
     }
 }
 

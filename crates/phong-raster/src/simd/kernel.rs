@@ -513,22 +513,24 @@ pub enum Batch<'a> {
     Gouraud,
 }
 
+/// Interpolated attributes `q` as a position (`q[0..3]`) and a normal (`q[3..6]`).
+#[inline(always)]
+fn position_normal<V: Vf32>(q: [V; 6]) -> (V3<V>, V3<V>) {
+    let v3 = |k: usize| V3 {
+        x: q[k],
+        y: q[k + 1],
+        z: q[k + 2],
+    };
+    (v3(0), v3(3))
+}
+
 /// The colour of a batch's interpolated attributes `q`: Phong shades position `q[0..3]` and
 /// normal `q[3..6]` and keeps its term; Gouraud's colour is `q[0..3]`.
 #[inline(always)]
 fn batch_color<V: Vf32>(batch: Batch, q: [V; 6]) -> [V; 3] {
     match batch {
         Batch::Phong(prep, term) => {
-            let pos = V3 {
-                x: q[0],
-                y: q[1],
-                z: q[2],
-            };
-            let nrm = V3 {
-                x: q[3],
-                y: q[4],
-                z: q[5],
-            };
+            let (pos, nrm) = position_normal(q);
             shade(prep, pos, nrm).get(term)
         }
         Batch::Gouraud => [q[0], q[1], q[2]],
@@ -598,16 +600,7 @@ pub(crate) fn shade_batch_lit<'p, V: Vf32>(
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(&lane, start, n, 6);
-        let pos = V3 {
-            x: q[0],
-            y: q[1],
-            z: q[2],
-        };
-        let nrm = V3 {
-            x: q[3],
-            y: q[4],
-            z: q[5],
-        };
+        let (pos, nrm) = position_normal(q);
         let t = shade(prep, pos, nrm);
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         // Plain loops, not closures: a closure is not compiled with the caller's AVX2.
