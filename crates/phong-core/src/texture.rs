@@ -168,6 +168,8 @@ enum Chain {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     chain: Chain,
+    /// Whether a texel of level 0 has alpha below 1 (asked per pixel: found once).
+    translucent: bool,
 }
 
 /// Checks a texture's size and its texel count.
@@ -239,6 +241,7 @@ impl Texture {
         check_size(width, height, top_first.len(), 8)?;
         Ok(Texture {
             chain: Chain::Sixteen(chain(width, top_first)),
+            translucent: top_first.iter().any(|t| t.translucent()),
         })
     }
 
@@ -247,6 +250,7 @@ impl Texture {
         check_size(width, height, top_first.len(), 4)?;
         Ok(Texture {
             chain: Chain::Eight(chain(width, top_first)),
+            translucent: top_first.iter().any(|t| t.translucent()),
         })
     }
 
@@ -289,7 +293,7 @@ impl Texture {
     }
     /// Whether any texel of level 0 has alpha below 1.
     pub fn has_alpha(&self) -> bool {
-        with_levels!(self, l => l[0].texels.iter().any(|t| t.translucent()))
+        self.translucent
     }
 
     /// Texel `(x, y)` of `level` (bottom row 0) as linear RGBA.
