@@ -4,9 +4,9 @@
 
 use crate::{
     Camera, Color, Encoding, Error, Lighting, Maps, Material, Mesh, Shading, ShadingOptions, SurfacePoint, View,
-    Viewer, light, shade, shade_textured,
+    Viewer, light, shade,
 };
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// Where lighting is computed (seed 001: per-vertex vs per-fragment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -266,34 +266,6 @@ impl Object {
     #[inline]
     pub fn textured(&self) -> bool {
         (!self.maps.is_empty() && self.mesh.has_uvs()) || !self.mesh.colors().is_empty()
-    }
-
-    /// [`Object::shade`] with the object's maps sampled at texture coordinates `uv`, whose
-    /// screen derivatives (per pixel) are `d_dx` and `d_dy`: [`shade_textured`], and the
-    /// point's alpha ([`Maps::alpha`]).
-    pub fn shade_textured(
-        &self,
-        lighting: &Lighting,
-        view: &View,
-        position: Vec3,
-        normal: Vec3,
-        uv: [Vec2; 3],
-    ) -> (Shading, f32) {
-        let [uv, d_dx, d_dy] = uv;
-        let texels = self.maps.sample(uv, d_dx, d_dy);
-        let options = ShadingOptions {
-            two_sided: false,
-            ..self.shading.options
-        };
-        let s = shade_textured(
-            &SurfacePoint { position, normal },
-            view,
-            &self.material,
-            &texels,
-            lighting,
-            &options,
-        );
-        (s, Maps::alpha(&self.material, &texels))
     }
 }
 

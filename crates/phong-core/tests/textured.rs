@@ -132,7 +132,7 @@ fn each_map_modulates_its_term() {
     assert!(close(s.color, expected, 1e-6), "{:?} vs {expected:?}", s.color);
 }
 
-/// A diffuse map through `Object::shade_textured`: the texel at the coordinates, its alpha
+/// A diffuse map through `Maps::sample`: the texel at the coordinates, its alpha
 /// multiplied into the material's, and the alpha test.
 #[test]
 fn an_object_samples_its_maps() {

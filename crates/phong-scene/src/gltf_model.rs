@@ -201,7 +201,7 @@ pub fn read_gltf(
             }
             // The texture coordinate sets the material's textures use (checked like the others).
             let mat = prim.material();
-            let sets: BTreeSet<u32> = texture_infos(&mat).iter().map(|(_, info)| info.tex_coord()).collect();
+            let sets: BTreeSet<u32> = texture_infos(&mat).iter().map(|t| t.set).collect();
             for &set in &sets {
                 if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
                     check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Vec2], false)
@@ -308,7 +308,7 @@ pub fn read_gltf(
             // The textures' coordinates: one set for the mesh (the base colour's, else the
             // first used), v flipped to OpenGL's.
             let infos = texture_infos(&mat);
-            let set = infos.first().map(|(_, i)| i.tex_coord());
+            let set = infos.first().map(|t| t.set);
             let uvs: Vec<Vec2> = match set.and_then(|s| reader.read_tex_coords(s)) {
                 Some(t) => {
                     let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
@@ -323,10 +323,10 @@ pub fn read_gltf(
             let maps = if mat.index().is_some() && !uvs.is_empty() {
                 let requests: Vec<MapRequest> = infos
                     .iter()
-                    .filter(|(_, info)| Some(info.tex_coord()) == set)
-                    .filter_map(|(_, tex)| texture_request(tex, &buffers, &what))
+                    .filter(|t| Some(t.set) == set)
+                    .filter_map(|t| texture_request(t, &buffers, &what))
                     .collect();
-                if infos.iter().any(|(_, info)| Some(info.tex_coord()) != set) {
+                if infos.iter().any(|t| Some(t.set) != set) {
                     warnings.push(format!(
                         "{}: {what}: textures on a second texture coordinate set are not used",
                         path.display()
@@ -671,22 +671,19 @@ impl<'a> Tex<'a> {
             scale: 1.0,
         }
     }
-    fn tex_coord(&self) -> u32 {
-        self.set
-    }
 }
 
-fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<(Slot, Tex<'a>)> {
+fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
     let mut out = Vec::new();
     let diffuse = match mat.pbr_specular_glossiness() {
         Some(sg) => sg.diffuse_texture(),
         None => mat.pbr_metallic_roughness().base_color_texture(),
     };
     if let Some(t) = diffuse {
-        out.push((Slot::Diffuse, Tex::of(Slot::Diffuse, t)));
+        out.push(Tex::of(Slot::Diffuse, t));
     }
     if let Some(t) = mat.emissive_texture() {
-        out.push((Slot::Emission, Tex::of(Slot::Emission, t)));
+        out.push(Tex::of(Slot::Emission, t));
     }
     if let Some(n) = mat.normal_texture() {
         let t = Tex {
@@ -696,7 +693,7 @@ fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<(Slot, Tex<'a>)> {
             transform: None,
             scale: n.scale(),
         };
-        out.push((Slot::Normal, t));
+        out.push(t);
     }
     out
 }
