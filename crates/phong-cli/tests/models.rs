@@ -1,5 +1,6 @@
 //! Models as a user renders them: `phong render MODEL -o out.png`, end to end.
 
+use glam::Vec3;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -471,4 +472,82 @@ fn texture_problems_are_named() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("no texture coordinates"), "{}", stderr(&o));
+}
+
+/// Bump maps end to end: a height ramp rising 40/255 a texel along `+u`, times 2 (a scene's
+/// `bump_scale`, an MTL's `-bm`), tilts a quad facing the camera to
+/// `N' = normalize(−2·40/255, 0, 1)` in its tangent frame (`+x`, `+y`). Lit along `N'`, a
+/// white diffuse material is white (`N'·L = 1`); lit along the flat normal it is
+/// `255·N'·z = 243.5`. A material with both a normal map and a bump map keeps the normal map
+/// and says so.
+#[test]
+fn bump_maps_tilt_the_normal_by_their_slope() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (w, h) = (7u32, 3u32);
+    let f = std::fs::File::create(d.join("h.png")).unwrap();
+    let mut e = png::Encoder::new(std::io::BufWriter::new(f), w, h);
+    e.set_color(png::ColorType::Grayscale);
+    e.set_depth(png::BitDepth::Eight);
+    let ramp: Vec<u8> = (0..h).flat_map(|_| (0..w).map(|x| (40 * x) as u8)).collect();
+    e.write_header().unwrap().write_image_data(&ramp).unwrap();
+    let tilted = Vec3::new(-2.0 * 40.0 / 255.0, 0.0, 1.0).normalize();
+    let centre = |png: &str| {
+        let (w, h, ch, px) = read_png(&d.join(png));
+        px[((h / 2 * w + w / 2) as usize) * ch] as f32
+    };
+    let scene = |light: Vec3, material: &str| {
+        format!(
+            "[image]\nwidth = 41\nheight = 31\n[camera]\nposition = [0.0, 0.0, 3.0]\n\
+             [shading]\nambient = [0.0, 0.0, 0.0]\n\
+             [[light]]\ntype = \"directional\"\ndirection = [{}, {}, {}]\n\
+             [[object]]\nshape = \"plane\"\nrotation = [90.0, 0.0, 0.0]\nmaterial = \"m\"\n\
+             [materials.m]\ndiffuse = [1.0, 1.0, 1.0]\nambient = [0.0, 0.0, 0.0]\nwrap = \"clamp\"\n{material}\n",
+            -light.x, -light.y, -light.z
+        )
+    };
+    for (light, want) in [(tilted, 255.0), (Vec3::Z, 255.0 * tilted.z)] {
+        std::fs::write(d.join("s.toml"), scene(light, "bump_map = \"h.png\"\nbump_scale = 2.0")).unwrap();
+        let o = phong(d, &["render", "s.toml", "-o", "s.png"]);
+        assert!(o.status.success() && stderr(&o).is_empty(), "{}", stderr(&o));
+        let got = centre("s.png");
+        assert!((got - want).abs() <= 1.0, "scene, light {light}: {got} vs {want}");
+    }
+    std::fs::write(
+        d.join("q.mtl"),
+        "newmtl m\nKd 1 1 1\nKa 0 0 0\nbump -bm 2 -clamp on h.png\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("q.obj"),
+        "mtllib q.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("o.toml"),
+        format!(
+            "[image]\nwidth = 41\nheight = 31\n[camera]\nposition = [0.0, 0.0, 3.0]\n\
+             [shading]\nambient = [0.0, 0.0, 0.0]\n\
+             [[light]]\ntype = \"directional\"\ndirection = [{}, {}, {}]\n\
+             [[object]]\nmesh = \"q.obj\"\n",
+            -tilted.x, -tilted.y, -tilted.z
+        ),
+    )
+    .unwrap();
+    let o = phong(d, &["render", "o.toml", "-o", "o.png"]);
+    assert!(o.status.success() && stderr(&o).is_empty(), "{}", stderr(&o));
+    let got = centre("o.png");
+    assert!((got - 255.0).abs() <= 1.0, "MTL bump -bm 2: {got}");
+    std::fs::write(
+        d.join("s.toml"),
+        scene(tilted, "bump_map = \"h.png\"\nnormal_map = \"h.png\""),
+    )
+    .unwrap();
+    let o = phong(d, &["render", "s.toml", "-o", "s.png"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bump map h.png is not used (the material has a normal map)"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -150,6 +150,54 @@ pub struct NormalMap {
     pub green_down: bool,
 }
 
+impl NormalMap {
+    /// The tangent-space normal map a bump (height) map implies, so that every renderer draws
+    /// bump maps as normal maps. Per texel of level 0, the height `h` (`channel`) is differenced
+    /// with its neighbours (central differences, wrapping as `sampler` does; mirror and clamp
+    /// both repeat the edge texel), and the normal is `normalize(−k·∂h/∂x, −k·∂h/∂y, 1)`, with
+    /// `k = scale` (MTL's `-bm`, a scene's `bump_scale`) and the derivatives per texel (`x`
+    /// along `+u`, `y` along `+v`), as normal-map tools build them from height maps. It is
+    /// stored in 16 bits, sampled with `sampler` and `transform`, and green points along `+v`.
+    pub fn from_height(
+        height: &Texture,
+        channel: Channel,
+        scale: f32,
+        sampler: Sampler,
+        transform: UvTransform,
+    ) -> Result<NormalMap, crate::Error> {
+        let (w, h) = (height.width(), height.height());
+        let at = |x: u32, y: u32| channel.of(height.texel(0, x, y));
+        let step = |i: u32, n: u32, d: i64, wrap: crate::Wrap| -> u32 {
+            let j = i64::from(i) + d;
+            match wrap {
+                crate::Wrap::Repeat => j.rem_euclid(i64::from(n)) as u32,
+                _ => j.clamp(0, i64::from(n) - 1) as u32,
+            }
+        };
+        let mut top_first = Vec::with_capacity(w as usize * h as usize);
+        for y in (0..h).rev() {
+            for x in 0..w {
+                let (xm, xp) = (step(x, w, -1, sampler.wrap_u), step(x, w, 1, sampler.wrap_u));
+                let (ym, yp) = (step(y, h, -1, sampler.wrap_v), step(y, h, 1, sampler.wrap_v));
+                let dx = 0.5 * (at(xp, y) - at(xm, y));
+                let dy = 0.5 * (at(x, yp) - at(x, ym));
+                let n = glam::Vec3::new(-scale * dx, -scale * dy, 1.0).normalize();
+                let c = |v: f32| ((v * 0.5 + 0.5) * 65535.0).round() as u16;
+                top_first.push([c(n.x), c(n.y), c(n.z), u16::MAX]);
+            }
+        }
+        Ok(NormalMap {
+            map: TextureMap {
+                texture: Arc::new(Texture::new(w, h, &top_first, 16)?),
+                sampler,
+                transform,
+            },
+            scale: 1.0,
+            green_down: false,
+        })
+    }
+}
+
 /// The normal at a point from an interpolated normal `n`, tangent `t` (`w`: the bitangent's
 /// sign) and a tangent-space normal `ts`: `T·x + B·y + N·z` with `N = n/|n|`, `T` the tangent
 /// made orthogonal to `N`, `B = w·(N × T)`. Where the tangent is zero or parallel to `n`, `n`.
@@ -269,5 +317,61 @@ impl Maps {
     #[inline]
     pub fn discards(&self, alpha: f32) -> bool {
         self.alpha_cutoff.is_some_and(|c| alpha < c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Wrap;
+
+    /// The normal stored at texel `(x, y)` (bottom row 0), decoded.
+    fn stored(n: &NormalMap, x: u32, y: u32) -> glam::Vec3 {
+        let t = n.map.texture.texel(0, x, y);
+        glam::Vec3::new(t[0], t[1], t[2]) * 2.0 - 1.0
+    }
+
+    #[test]
+    fn bump_maps_become_the_normals_of_their_slopes() {
+        // Heights 10·x + 30·y (bytes, in grey), y counted from the bottom row.
+        let (w, h) = (6u32, 4u32);
+        let top_first: Vec<[u8; 4]> = (0..h)
+            .rev()
+            .flat_map(|y| (0..w).map(move |x| [(10 * x + 30 * y) as u8; 3]))
+            .map(|[r, g, b]| [r, g, b, 255])
+            .collect();
+        let height = Texture::from_rgba8(w, h, &top_first).unwrap();
+        let k = 2.0;
+        let n = NormalMap::from_height(
+            &height,
+            Channel::R,
+            k,
+            Sampler::bilinear(Wrap::Clamp),
+            UvTransform::default(),
+        )
+        .unwrap();
+        // Inside: ∂h/∂x = 10/255 and ∂h/∂y = 30/255 a texel.
+        let inside = glam::Vec3::new(-k * 10.0 / 255.0, -k * 30.0 / 255.0, 1.0).normalize();
+        // At a clamped edge the central difference spans one texel: half the slope.
+        let edge = glam::Vec3::new(-k * 5.0 / 255.0, -k * 30.0 / 255.0, 1.0).normalize();
+        for (x, y, want) in [(2, 1, inside), (3, 2, inside), (0, 1, edge), (5, 2, edge)] {
+            let got = stored(&n, x, y);
+            assert!(
+                (got - want).abs().max_element() < 2.0 / 65535.0,
+                "({x}, {y}): {got} vs {want}"
+            );
+        }
+        // Repeat wraps: at x = 0 the left neighbour is x = 5, 50 higher.
+        let r = NormalMap::from_height(
+            &height,
+            Channel::R,
+            k,
+            Sampler::bilinear(Wrap::Repeat),
+            UvTransform::default(),
+        )
+        .unwrap();
+        let want = glam::Vec3::new(-k * 0.5 * (10.0 - 50.0) / 255.0, -k * 30.0 / 255.0, 1.0).normalize();
+        assert!((stored(&r, 0, 1) - want).abs().max_element() < 2.0 / 65535.0);
+        assert!(!r.green_down && r.scale == 1.0);
     }
 }

@@ -100,7 +100,8 @@ pub struct MapRequest {
     pub srgb: bool,
     /// Where the request is, for messages (`file.mtl:12`, `scene.toml: materials.brick`).
     pub at: String,
-    /// A normal map: the scale of its tangential components (1 by default).
+    /// A normal map: the scale of its tangential components; a bump map: its multiplier
+    /// (`-bm`, `bump_scale`). 1 by default.
     pub normal_scale: f32,
     /// A normal map: green along `−v` (DirectX's convention).
     pub green_down: bool,
@@ -222,10 +223,11 @@ pub fn resolve(
     warnings: &mut Vec<String>,
 ) -> Maps {
     let mut maps = Maps::default();
+    let has_normal_map = requests.iter().any(|r| r.slot == Slot::Normal);
     for r in requests {
-        if r.slot == Slot::Bump {
+        if r.slot == Slot::Bump && has_normal_map {
             warnings.push(format!(
-                "{}: material {name}: bump map {} is not used (bump maps are not rendered yet; a normal map is)",
+                "{}: material {name}: bump map {} is not used (the material has a normal map)",
                 r.at,
                 r.source.name()
             ));
@@ -269,7 +271,17 @@ pub fn resolve(
                     green_down: r.green_down,
                 })
             }
-            Slot::Bump => {}
+            Slot::Bump => {
+                let channel = r.channel.unwrap_or(Channel::Luminance);
+                match NormalMap::from_height(&map.texture, channel, r.normal_scale, r.sampler, r.transform) {
+                    Ok(n) => maps.normal = Some(n),
+                    Err(why) => warnings.push(format!(
+                        "{}: material {name}: bump map {} not used: {why}",
+                        r.at,
+                        r.source.name()
+                    )),
+                }
+            }
         }
     }
     maps
@@ -295,6 +307,7 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
     let (mut scale, mut offset) = ([1.0f32; 2], [0.0f32; 2]);
     let mut wrap = Wrap::Repeat;
     let mut channel = None;
+    let mut bump = 1.0;
     let mut i = 0;
     let num = |s: &str| s.parse::<f32>().ok().filter(|x| x.is_finite());
     while i < args.len() && args[i].starts_with('-') && num(args[i]).is_none() {
@@ -346,7 +359,11 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
             }
             "-bm" => {
                 take(&mut i, 1, &mut numbers);
-                unused.push("-bm (bump maps are not rendered yet)".into());
+                match (slot, numbers.first()) {
+                    (Slot::Bump, Some(&k)) => bump = k,
+                    (Slot::Bump, None) => return Err("-bm needs a number".into()),
+                    _ => unused.push("-bm (only bump maps have a multiplier)".into()),
+                }
             }
             "-mm" => {
                 take(&mut i, 2, &mut numbers);
@@ -375,7 +392,7 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
         channel,
         srgb: false,
         at: String::new(),
-        normal_scale: 1.0,
+        normal_scale: bump,
         green_down: false,
     };
     Ok(Some((request, unused)))
@@ -399,7 +416,9 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(r.slot, Slot::Bump);
-        assert_eq!(unused.len(), 2);
+        assert_eq!(r.normal_scale, 0.5);
+        assert_eq!(unused.len(), 1);
+        assert!(parse_mtl_map("bump", &["-bm", "b.png"]).is_err());
         let (r, _) = parse_mtl_map("map_d", &["-imfchan", "r", "a.png"]).unwrap().unwrap();
         assert_eq!(r.channel, Some(Channel::R));
         assert!(parse_mtl_map("map_Kd", &["-clamp", "maybe", "a.png"]).is_err());

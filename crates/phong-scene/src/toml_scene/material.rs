@@ -97,9 +97,10 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
     };
     let scale = pair(ctx, &m.uv_scale, "uv_scale", 1.0)?;
     let offset = pair(ctx, &m.uv_offset, "uv_offset", 0.0)?;
-    if let Some(b) = &m.bump_scale {
-        ctx.num(b, "bump_scale", f32::is_finite, "finite")?;
-    }
+    let bump_scale = match &m.bump_scale {
+        Some(b) => ctx.num(b, "bump_scale", f32::is_finite, "finite")?,
+        None => 1.0,
+    };
     let normal_scale = match &m.normal_scale {
         Some(s) => ctx.num(s, "normal_scale", f32::is_finite, "finite")?,
         None => 1.0,
@@ -134,7 +135,7 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
             channel: None,
             srgb,
             at: format!("{}:{line}: `{k}`", ctx.path.display()),
-            normal_scale,
+            normal_scale: if slot == Slot::Bump { bump_scale } else { normal_scale },
             green_down,
         });
     }
