@@ -47,7 +47,7 @@ pub use color::Color;
 pub use error::Error;
 pub use image::{Canvas, Encoding, Image, Image8};
 pub use light::{Attenuation, DirectionalLight, Incidence, Light, LightColor, PointLight, SpotLight};
-pub use maps::{Channel, Maps, NormalMap, Texels, TextureMap, UvTransform, perturb};
+pub use maps::{Channel, Maps, MetalRough, NormalMap, Occlusion, Texels, TextureMap, UvTransform, perturb};
 pub use material::{Material, NamedMaterial, named_materials, nearest_names, normalize_name};
 pub use mesh::Mesh;
 pub use scene::{

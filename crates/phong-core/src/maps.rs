@@ -128,6 +128,10 @@ pub struct Maps {
     pub alpha: Option<(TextureMap, Channel)>,
     /// `norm`, glTF's normal texture: a tangent-space normal map (with Phong interpolation).
     pub normal: Option<NormalMap>,
+    /// glTF's metallic-roughness texture, mapped to Phong per texel (see [`MetalRough`]).
+    pub metal_rough: Option<MetalRough>,
+    /// glTF's occlusion texture: scales the ambient terms (see [`Occlusion`]).
+    pub occlusion: Option<Occlusion>,
     /// The alpha test: a point whose alpha is below it is not drawn (`None`: no test).
     pub alpha_cutoff: Option<f32>,
     /// Blending (`GL_BLEND` with `GL_ONE_MINUS_SRC_ALPHA`): the object is drawn after the
@@ -198,6 +202,55 @@ impl NormalMap {
     }
 }
 
+/// glTF's metallic-roughness texture (metalness in blue, roughness in green) mapped to Phong per
+/// texel, as the loader maps a glTF material's factors: with `base = base_factor ⊗ T_Kd`,
+/// `m = metallic·T.b`, `r = roughness·T.g`, the texels give diffuse (and ambient)
+/// `base·(1 − m)`, specular `mix(0.04, base, m)` and shininess [`MetalRough::shininess`]`(r)`.
+/// The material it goes with is [`MetalRough::material`]'s, so that the texels are the terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MetalRough {
+    /// The image.
+    pub map: TextureMap,
+    /// glTF's `baseColorFactor` (RGB).
+    pub base_factor: Color,
+    /// `metallicFactor`.
+    pub metallic: f32,
+    /// `roughnessFactor`.
+    pub roughness: f32,
+}
+
+impl MetalRough {
+    /// The highest shininess a roughness maps to (roughness 0 would be infinite).
+    pub const MAX_SHININESS: f32 = 10_000.0;
+
+    /// The Blinn-Phong shininess equivalent to a roughness (Beckmann's distribution with
+    /// `α = roughness²`): `2/α² − 2`, at most [`MetalRough::MAX_SHININESS`].
+    pub fn shininess(roughness: f32) -> f32 {
+        let a = roughness.clamp(0.0, 1.0).powi(2);
+        if a > 0.0 {
+            (2.0 / (a * a) - 2.0).clamp(0.0, Self::MAX_SHININESS)
+        } else {
+            Self::MAX_SHININESS
+        }
+    }
+
+    /// The material a metallic-roughness map scales: ambient and diffuse `base_factor`,
+    /// specular white, shininess 1, with `emission` and `alpha`.
+    pub fn material(&self, emission: Color, alpha: f32) -> Material {
+        let m = Material::new(self.base_factor, self.base_factor, Color::WHITE, emission, 1.0).unwrap_or_default();
+        m.with_alpha(alpha).unwrap_or(m)
+    }
+}
+
+/// glTF's occlusion texture: the ambient terms times `1 + strength·(T.r − 1)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Occlusion {
+    /// The image.
+    pub map: TextureMap,
+    /// glTF's `strength` (1 by default).
+    pub strength: f32,
+}
+
 /// The normal at a point from an interpolated normal `n`, tangent `t` (`w`: the bitangent's
 /// sign) and a tangent-space normal `ts`: `T·x + B·y + N·z` with `N = n/|n|`, `T` the tangent
 /// made orthogonal to `N`, `B = w·(N × T)`. Where the tangent is zero or parallel to `n`, `n`.
@@ -229,6 +282,8 @@ pub struct Texels {
     pub alpha: f32,
     /// The normal map's tangent-space normal, if there is one.
     pub normal: Option<glam::Vec3>,
+    /// The occlusion map's factor on the ambient terms, if there is one.
+    pub occlusion: Option<f32>,
 }
 
 impl Default for Texels {
@@ -241,11 +296,20 @@ impl Default for Texels {
             shininess: 1.0,
             alpha: 1.0,
             normal: None,
+            occlusion: None,
         }
     }
 }
 
 impl Texels {
+    /// What the ambient terms are multiplied by: the ambient map's colour, else the diffuse
+    /// texel's, times the occlusion.
+    #[inline]
+    pub fn ambient_texel(&self) -> Color {
+        let t = self.ambient.unwrap_or(rgb(self.diffuse));
+        self.occlusion.map_or(t, |o| t * o)
+    }
+
     /// The texels with a vertex colour: it multiplies the diffuse texel's colour, so it
     /// modulates the diffuse, ambient and emission terms as a diffuse map does (with a white
     /// material: OpenGL's `GL_COLOR_MATERIAL` for ambient and diffuse).
@@ -272,6 +336,8 @@ impl Maps {
             && self.shininess.is_none()
             && self.alpha.is_none()
             && self.normal.is_none()
+            && self.metal_rough.is_none()
+            && self.occlusion.is_none()
     }
 
     /// Every map set, for memory accounting and uploads.
@@ -282,12 +348,14 @@ impl Maps {
             .chain(self.shininess.iter().map(|(m, _)| m))
             .chain(self.alpha.iter().map(|(m, _)| m))
             .chain(self.normal.iter().map(|n| &n.map))
+            .chain(self.metal_rough.iter().map(|m| &m.map))
+            .chain(self.occlusion.iter().map(|o| &o.map))
     }
 
     /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy`.
     pub fn sample(&self, uv: Vec2, d_dx: Vec2, d_dy: Vec2) -> Texels {
         let at = |m: &TextureMap| m.sample(uv, d_dx, d_dy);
-        Texels {
+        let mut t = Texels {
             diffuse: self.diffuse.as_ref().map_or([1.0; 4], at),
             ambient: self.ambient.as_ref().map(|m| rgb(at(m))),
             specular: self.specular.as_ref().map_or(Color::WHITE, |m| rgb(at(m))),
@@ -303,7 +371,22 @@ impl Maps {
                     2.0 * t[2] - 1.0,
                 )
             }),
+            occlusion: self
+                .occlusion
+                .as_ref()
+                .map(|o| 1.0 + o.strength * (at(&o.map)[0] - 1.0)),
+        };
+        if let Some(mr) = &self.metal_rough {
+            let s = at(&mr.map);
+            let m = (mr.metallic * s[2]).clamp(0.0, 1.0);
+            let base = mr.base_factor * rgb(t.diffuse);
+            t.specular = Color::splat(0.04 * (1.0 - m)) + base * m;
+            t.shininess = MetalRough::shininess(mr.roughness * s[1]);
+            for c in &mut t.diffuse[..3] {
+                *c *= 1.0 - m;
+            }
         }
+        t
     }
 
     /// The alpha of a point of `material` with these texels: the material's alpha times the

@@ -323,16 +323,19 @@ pub fn shade(
 ///
 /// ```text
 /// s' = s·T_Ns                                   (the shininess the terms are lit with)
-/// P  = e_m·[no map_Ke] + A·[no map_Ka] + D      (A: every ambient term; D: the diffuse sum)
-/// Q  = e_m⊗T_Ke·[map_Ke] + A⊗T_Ka·[map_Ka]
+/// P  = e_m·[no map_Ke] + A·[no map_Ka, no AO] + D  (A: every ambient term; D: the diffuse sum)
+/// Q  = e_m⊗T_Ke·[map_Ke] + A⊗T_Ka·T_AO·[map_Ka or AO]     (T_Ka is T_Kd without map_Ka)
 /// c  = clamp( clamp(P)⊗T_Kd + Q + clamp(S)⊗T_Ks )     (clamps only with `options.clamp`)
 /// ```
+///
+/// `T_AO` is glTF's occlusion; glTF's metallic-roughness map gives `T_Kd`, `T_Ks` and `T_Ns`
+/// ([`MetalRough`](crate::MetalRough)).
 ///
 /// With only `map_Kd` this is OpenGL's fixed function exactly: the primary colour (emission +
 /// ambient + diffuse) clamped, times the texel, plus the clamped specular, clamped. The
 /// specular term is added after the texture, so a dark texel does not darken the highlight.
 /// Without maps (every texel 1) it equals [`shade`] (the terms are non-negative). The terms
-/// reported are `ambient = e_m⊗(T_Ke or T_Kd) + A⊗(T_Ka or T_Kd)`, `diffuse = D⊗T_Kd`,
+/// reported are `ambient = e_m⊗(T_Ke or T_Kd) + A⊗(T_Ka or T_Kd)·T_AO`, `diffuse = D⊗T_Kd`,
 /// `specular = S⊗T_Ks`, before any clamp.
 pub fn shade_textured(
     point: &SurfacePoint,
@@ -342,11 +345,14 @@ pub fn shade_textured(
     lighting: &Lighting,
     options: &ShadingOptions,
 ) -> Shading {
-    let split = (texels.emission.is_some(), texels.ambient.is_some());
+    let split = (
+        texels.emission.is_some(),
+        texels.ambient.is_some() || texels.occlusion.is_some(),
+    );
     let (lit, [e, a, d, sp]) = light(point, view, material, texels.shininess, split, lighting, options);
     let td = Color::new(texels.diffuse[0], texels.diffuse[1], texels.diffuse[2]);
     Shading {
-        ambient: finite_or_zero(e * texels.emission.unwrap_or(td) + a * texels.ambient.unwrap_or(td)),
+        ambient: finite_or_zero(e * texels.emission.unwrap_or(td) + a * texels.ambient_texel()),
         diffuse: finite_or_zero(d * td),
         specular: finite_or_zero(sp * texels.specular),
         color: lit.modulate(texels, options.clamp),
@@ -374,7 +380,7 @@ impl Lit {
         let td = Color::new(t.diffuse[0], t.diffuse[1], t.diffuse[2]);
         let sum = self.primary * td
             + self.emission * t.emission.unwrap_or(Color::WHITE)
-            + self.ambient * t.ambient.unwrap_or(Color::WHITE)
+            + self.ambient * t.ambient_texel()
             + self.specular * t.specular;
         let sum = finite_or_zero(sum);
         if clamp { sum.clamp01() } else { sum }

@@ -124,6 +124,7 @@ fn each_map_modulates_its_term() {
         shininess: 0.5,
         alpha: 1.0,
         normal: None,
+        occlusion: None,
     };
     let s = shade_textured(&p, &View::Infinite { to_viewer: v }, &m, &texels, &lighting, &o);
     // A = 0.5·0.2 (the uniform light has no ambient) = 0.1; D = 0.4; S = 0.5^(8·0.5).
@@ -160,4 +161,56 @@ fn an_object_samples_its_maps() {
     assert!((alpha - 0.1).abs() < 1e-6);
     assert!(maps.discards(alpha));
     assert!(!maps.discards(0.5));
+}
+
+/// A 1×1 texture of linear RGBA (16 bits).
+fn one_texel(c: [f32; 4]) -> TextureMap {
+    let t = c.map(|v| (v * 65535.0).round() as u16);
+    TextureMap::new(Arc::new(Texture::new(1, 1, &[t], 16).unwrap()))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// glTF's metallic-roughness and occlusion textures against the loader's factor mapping
+    /// written out per texel: a point with base texel `T`, metalness `m` and roughness `r`
+    /// shades as `shade` does the material `diffuse = base·(1 − m)`, `ambient = diffuse·ao`,
+    /// `specular = mix(0.04, base, m)`, `s = 2/α² − 2` (`α = r²`), `base = factor⊗T`. The
+    /// light is dim, so that no clamp separates the two.
+    #[test]
+    fn metal_rough_and_occlusion_are_the_factor_mapping_per_texel(
+        factor in color01(), t in color01(), mt in 0.0f32..1.0, rt in 0.05f32..1.0, mf in 0.0f32..1.0,
+        rf in 0.3f32..1.0, ao in 0.0f32..1.0, strength in 0.0f32..1.0, e in color01(),
+        n in unit(), l in unit(), v in unit(),
+    ) {
+        let mr = MetalRough { map: one_texel([0.0, rt, mt, 1.0]), base_factor: factor, metallic: mf, roughness: rf };
+        let maps = Maps {
+            diffuse: Some(one_texel([t.r, t.g, t.b, 1.0])),
+            metal_rough: Some(mr.clone()),
+            occlusion: Some(Occlusion { map: one_texel([ao, 0.5, 0.5, 1.0]), strength }),
+            // As the glTF loader gives it: glTF's emission is not modulated by the base colour.
+            emission: Some(one_texel([1.0; 4])),
+            ..Maps::default()
+        };
+        let q = |x: f32| (x * 65535.0).round() / 65535.0;
+        let (m, r, ao) = (mf * q(mt), rf * q(rt), 1.0 + strength * (q(ao) - 1.0));
+        let base = factor * Color::new(q(t.r), q(t.g), q(t.b));
+        let a = (r * r).max(1e-9);
+        let sh = (2.0 / (a * a) - 2.0).min(10_000.0);
+        let d = base * (1.0 - m);
+        let plain = Material::new(d * ao, d, Color::splat(0.04 * (1.0 - m)) + base * m, e * 0.1, sh).unwrap();
+        let lighting = Lighting::new(
+            Color::splat(0.1),
+            vec![Light::directional(-l, LightColor::new(Color::splat(0.05), Color::splat(0.3), Color::splat(0.3)).unwrap()).unwrap()],
+        ).unwrap();
+        let o = ShadingOptions::opengl(false);
+        let p = SurfacePoint { position: Vec3::ZERO, normal: n };
+        let view = View::Infinite { to_viewer: v };
+        let want = shade(&p, &view, &plain, &lighting, &o);
+        let texels = maps.sample(Vec2::splat(0.5), Vec2::ZERO, Vec2::ZERO);
+        let got = shade_textured(&p, &view, &mr.material(e * 0.1, 1.0), &texels, &lighting, &o);
+        prop_assert!(close(want.color, got.color, 2e-5), "{:?} vs {:?}", want.color, got.color);
+        prop_assert!(close(want.ambient, got.ambient, 2e-5));
+        prop_assert!(close(want.specular, got.specular, 2e-5));
+    }
 }

@@ -161,9 +161,14 @@ pub struct GpuMaps {
     pub blend: [f32; 4],
     /// A normal map: x 1 where there is one, y its scale, z 1 for green along −v.
     pub normal: [f32; 4],
-    /// Per map (diffuse, ambient, specular, emission, shininess, alpha, normal): its
-    /// transform's linear part by columns, then its offset.
-    pub transforms: [[f32; 4]; 14],
+    /// A metallic-roughness map: x 1 where there is one, y the metallic factor, z the
+    /// roughness factor; w 1 with an occlusion map.
+    pub pbr: [f32; 4],
+    /// The metallic-roughness map's base colour factor (RGB); w the occlusion's strength.
+    pub base: [f32; 4],
+    /// Per map (diffuse, ambient, specular, emission, shininess, alpha, normal,
+    /// metallic-roughness, occlusion): its transform's linear part by columns, then its offset.
+    pub transforms: [[f32; 4]; 18],
 }
 
 /// WGSL `Case` (compute tests).

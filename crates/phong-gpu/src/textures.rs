@@ -11,10 +11,10 @@ use phong_core::{Channel, Filter, Maps, MipFilter, Texture, TextureMap, Wrap};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// The maps' order in [`GpuMaps`] and the group's bindings (textures at 1.., samplers at 8..).
-const SLOTS: usize = 7;
+/// The maps' order in [`GpuMaps`] and the group's bindings (textures at 1.., samplers at 10..).
+const SLOTS: usize = 9;
 
-/// The layout of group 1: the uniform [`GpuMaps`], seven textures, seven samplers.
+/// The layout of group 1: the uniform [`GpuMaps`], nine textures, nine samplers.
 pub(crate) fn maps_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![wgpu::BindGroupLayoutEntry {
@@ -173,6 +173,8 @@ impl Gpu {
                     maps.shininess.as_ref().map(|(m, _)| m),
                     maps.alpha.as_ref().map(|(m, _)| m),
                     maps.normal.as_ref().map(|n| &n.map),
+                    maps.metal_rough.as_ref().map(|m| &m.map),
+                    maps.occlusion.as_ref().map(|o| &o.map),
                 ];
                 let mut params = GpuMaps {
                     present: std::array::from_fn(|k| u32::from(slots[k].is_some())),
@@ -193,6 +195,19 @@ impl Gpu {
                         .normal
                         .as_ref()
                         .map_or([0.0; 4], |n| [1.0, n.scale, f32::from(u8::from(n.green_down)), 0.0]),
+                    pbr: [
+                        f32::from(u8::from(maps.metal_rough.is_some())),
+                        maps.metal_rough.as_ref().map_or(0.0, |m| m.metallic),
+                        maps.metal_rough.as_ref().map_or(0.0, |m| m.roughness),
+                        f32::from(u8::from(maps.occlusion.is_some())),
+                    ],
+                    base: {
+                        let b = maps
+                            .metal_rough
+                            .as_ref()
+                            .map_or(phong_core::Color::WHITE, |m| m.base_factor);
+                        [b.r, b.g, b.b, maps.occlusion.as_ref().map_or(1.0, |o| o.strength)]
+                    },
                     ..Default::default()
                 };
                 let mut samplers = Vec::new();

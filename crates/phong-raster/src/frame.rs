@@ -109,8 +109,12 @@ impl<'a> Frame<'a> {
                 };
                 if o.textured() {
                     let m = &o.maps;
-                    let per_pixel_light =
-                        m.ambient.is_some() || m.emission.is_some() || m.shininess.is_some() || m.normal.is_some();
+                    let per_pixel_light = m.ambient.is_some()
+                        || m.emission.is_some()
+                        || m.shininess.is_some()
+                        || m.normal.is_some()
+                        || m.metal_rough.is_some()
+                        || m.occlusion.is_some();
                     let one_sample = scene.image.samples == phong_core::Samples::One;
                     if o.shading.interpolation == Interpolation::Phong
                         && term == Term::Color

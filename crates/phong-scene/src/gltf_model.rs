@@ -15,7 +15,9 @@
 //! Textures: the base colour texture (sRGB) is the diffuse map (modulating the diffuse and
 //! ambient colours as the factor does; its alpha multiplies the material's), the emissive
 //! texture (sRGB) the emission map, with their texture coordinate sets, KHR_texture_transform
-//! and samplers; `alphaMode: MASK` is the alpha test at `alphaCutoff`. Texture coordinates are
+//! and samplers; the normal texture (with its scale) the normal map; the metallic-roughness
+//! texture the same mapping per texel (phong-core's `MetalRough`); the occlusion texture (with
+//! its strength) scales the ambient terms. `alphaMode: MASK` is the alpha test at `alphaCutoff`. Texture coordinates are
 //! flipped to OpenGL's (`v = 1 − v`: glTF's `v` runs down the image).
 
 use crate::formats::far_origin;
@@ -23,12 +25,12 @@ use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use crate::{Error, ObjPart};
 use base64::Engine;
 use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3};
-use phong_core::{Color, Filter, Maps, Material, Mesh, MipFilter, Sampler, UvTransform, Wrap};
+use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
 use std::collections::BTreeSet;
 use std::path::Path;
 
 /// The highest shininess a glTF roughness maps to (roughness 0 would be infinite).
-pub const MAX_GLTF_SHININESS: f32 = 10_000.0;
+pub const MAX_GLTF_SHININESS: f32 = MetalRough::MAX_SHININESS;
 
 /// Extensions phong reads (or whose absence of support is harmless to the geometry); any
 /// other required extension is refused.
@@ -126,7 +128,7 @@ pub fn read_gltf(
     let buffers = load_buffers(&file, resource, &fail)?;
     let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
-    let (mut skipped_modes, mut textures, mut colours) = (0usize, BTreeSet::new(), 0usize);
+    let (mut skipped_modes, mut colours) = (0usize, 0usize);
     let mut cache = TextureCache::default();
     // Positions in f64 world space for all parts, re-centred together below.
     let mut pending: Vec<Pending> = Vec::new();
@@ -291,20 +293,7 @@ pub fn read_gltf(
                 None => (vec![Vec3::ZERO; n], false),
             };
             model.double_sided |= mat.double_sided();
-            let material = mat.index().map(|_| {
-                for (name, t) in [
-                    (
-                        "metallicRoughnessTexture",
-                        mat.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
-                    ),
-                    ("occlusionTexture", mat.occlusion_texture().is_some()),
-                ] {
-                    if t {
-                        textures.insert(name);
-                    }
-                }
-                phong_material(&mat)
-            });
+            let mut material = mat.index().map(|_| phong_material(&mat));
             // The textures' coordinates: one set for the mesh (the base colour's, else the
             // first used), v flipped to OpenGL's.
             let infos = texture_infos(&mat);
@@ -341,6 +330,22 @@ pub fn read_gltf(
                 );
                 if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
                     maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
+                }
+                // The factors go with the map, and the material becomes the one it scales.
+                if let (Some(mr), Some(m)) = (&mut maps.metal_rough, &mut material) {
+                    let pbr = mat.pbr_metallic_roughness();
+                    let b = pbr.base_color_factor();
+                    mr.base_factor = Color::new(b[0], b[1], b[2]).clamp01();
+                    mr.metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+                    mr.roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+                    *m = mr.material(m.emission(), m.alpha());
+                }
+                // glTF's emission is not the base colour's to modulate (GL_MODULATE's would be):
+                // a white emission map keeps it apart.
+                let modulated = maps.diffuse.is_some() || maps.metal_rough.is_some();
+                if maps.emission.is_none() && modulated && material.is_some_and(|m| m.emission() != Color::BLACK) {
+                    let white = phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture");
+                    maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::new(white)));
                 }
                 maps
             } else {
@@ -393,13 +398,6 @@ pub fn read_gltf(
     if skipped_modes > 0 {
         warnings.push(format!(
             "{file}: {skipped_modes} primitives of points or lines skipped: phong draws surfaces"
-        ));
-    }
-    if !textures.is_empty() {
-        let names: Vec<&str> = textures.into_iter().collect();
-        warnings.push(format!(
-            "{file}: textures not rendered yet ({}): the factors alone are used for them",
-            names.join(", ")
         ));
     }
     if colours > 0 {
@@ -554,12 +552,7 @@ fn phong_material(m: &::gltf::Material) -> Material {
             )
         }
     };
-    let a = roughness.clamp(0.0, 1.0).powi(2);
-    let shininess = if a > 0.0 {
-        (2.0 / (a * a) - 2.0).clamp(0.0, MAX_GLTF_SHININESS)
-    } else {
-        MAX_GLTF_SHININESS
-    };
+    let shininess = MetalRough::shininess(roughness);
     let strength = m.emissive_strength().unwrap_or(1.0);
     let col = |c: [f32; 3]| {
         let c = c.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
@@ -685,6 +678,20 @@ fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
     if let Some(t) = mat.emissive_texture() {
         out.push(Tex::of(Slot::Emission, t));
     }
+    if mat.pbr_specular_glossiness().is_none()
+        && let Some(t) = mat.pbr_metallic_roughness().metallic_roughness_texture()
+    {
+        out.push(Tex::of(Slot::MetalRough, t));
+    }
+    if let Some(o) = mat.occlusion_texture() {
+        out.push(Tex {
+            slot: Slot::Occlusion,
+            texture: o.texture(),
+            set: o.tex_coord(),
+            transform: None,
+            scale: o.strength(),
+        });
+    }
     if let Some(n) = mat.normal_texture() {
         let t = Tex {
             slot: Slot::Normal,
@@ -768,7 +775,7 @@ fn texture_request(tex: &Tex, buffers: &[Vec<u8>], what: &str) -> Option<MapRequ
         channel: None,
         srgb: true,
         at: what.to_string(),
-        normal_scale: tex.scale,
+        scale: tex.scale,
         green_down: false,
     })
 }

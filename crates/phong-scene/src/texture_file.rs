@@ -6,7 +6,7 @@
 //! file and why; the material is drawn without it (as three.js does).
 
 use phong_core::limits::{MAX_IMAGE_FILE_BYTES, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
-use phong_core::{Channel, Maps, NormalMap, Sampler, Texture, TextureMap, UvTransform, Wrap};
+use phong_core::{Channel, Maps, MetalRough, NormalMap, Occlusion, Sampler, Texture, TextureMap, UvTransform, Wrap};
 use std::cell::Cell;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -56,6 +56,10 @@ pub enum Slot {
     Bump,
     /// `norm`, `normal_map`, glTF's normal texture: a tangent-space normal map.
     Normal,
+    /// glTF's metallic-roughness texture (its factors are the loader's to set).
+    MetalRough,
+    /// glTF's occlusion texture.
+    Occlusion,
 }
 
 impl Slot {
@@ -101,8 +105,8 @@ pub struct MapRequest {
     /// Where the request is, for messages (`file.mtl:12`, `scene.toml: materials.brick`).
     pub at: String,
     /// A normal map: the scale of its tangential components; a bump map: its multiplier
-    /// (`-bm`, `bump_scale`). 1 by default.
-    pub normal_scale: f32,
+    /// (`-bm`, `bump_scale`); an occlusion map: its strength. 1 by default.
+    pub scale: f32,
     /// A normal map: green along `−v` (DirectX's convention).
     pub green_down: bool,
 }
@@ -267,13 +271,13 @@ pub fn resolve(
             Slot::Normal => {
                 maps.normal = Some(NormalMap {
                     map,
-                    scale: r.normal_scale,
+                    scale: r.scale,
                     green_down: r.green_down,
                 })
             }
             Slot::Bump => {
                 let channel = r.channel.unwrap_or(Channel::Luminance);
-                match NormalMap::from_height(&map.texture, channel, r.normal_scale, r.sampler, r.transform) {
+                match NormalMap::from_height(&map.texture, channel, r.scale, r.sampler, r.transform) {
                     Ok(n) => maps.normal = Some(n),
                     Err(why) => warnings.push(format!(
                         "{}: material {name}: bump map {} not used: {why}",
@@ -282,6 +286,15 @@ pub fn resolve(
                     )),
                 }
             }
+            Slot::MetalRough => {
+                maps.metal_rough = Some(MetalRough {
+                    map,
+                    base_factor: phong_core::Color::WHITE,
+                    metallic: 1.0,
+                    roughness: 1.0,
+                })
+            }
+            Slot::Occlusion => maps.occlusion = Some(Occlusion { map, strength: r.scale }),
         }
     }
     maps
@@ -392,7 +405,7 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
         channel,
         srgb: false,
         at: String::new(),
-        normal_scale: bump,
+        scale: bump,
         green_down: false,
     };
     Ok(Some((request, unused)))
@@ -416,7 +429,7 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(r.slot, Slot::Bump);
-        assert_eq!(r.normal_scale, 0.5);
+        assert_eq!(r.scale, 0.5);
         assert_eq!(unused.len(), 1);
         assert!(parse_mtl_map("bump", &["-bm", "b.png"]).is_err());
         let (r, _) = parse_mtl_map("map_d", &["-imfchan", "r", "a.png"]).unwrap().unwrap();

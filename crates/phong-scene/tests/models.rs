@@ -3,7 +3,7 @@
 //! readers), and the real models of `../shared/models/` are read where they are.
 
 use base64::Engine;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use phong_scene::{Axis, ModelOptions, ViewName, load_model, load_model_full, load_with};
 use std::path::{Path, PathBuf};
 
@@ -696,4 +696,83 @@ fn normal_maps_are_read_with_tangents() {
     );
     let parts = load_model(&obj, &mut Vec::new()).unwrap();
     assert!(parts[0].maps.normal.is_some());
+}
+
+/// glTF's metallic-roughness and occlusion textures: read with their factors (the material
+/// becomes the one the map scales: diffuse the base factor, specular white, shininess 1) and
+/// the occlusion's strength; the emissive factor kept apart from the base colour by a white
+/// emission map; no warning.
+#[test]
+fn gltf_metal_rough_and_occlusion_textures_are_read() {
+    let d = dir("gltf_pbr");
+    for (name, rgb) in [
+        ("base.png", [200u8, 100, 50]),
+        ("mr.png", [0, 128, 255]),
+        ("ao.png", [64, 0, 0]),
+    ] {
+        let img = image::RgbImage::from_pixel(2, 2, image::Rgb(rgb));
+        img.save(d.join(name)).unwrap();
+    }
+    let mut bin = Vec::new();
+    for x in [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+    ] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}],
+  "images": [{{"uri": "base.png"}}, {{"uri": "mr.png"}}, {{"uri": "ao.png"}}],
+  "textures": [{{"source": 0}}, {{"source": 1}}, {{"source": 2}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.5, 1.0, 1.0, 1.0], "metallicFactor": 0.75,
+                  "roughnessFactor": 0.5, "baseColorTexture": {{"index": 0}}, "metallicRoughnessTexture": {{"index": 1}}}},
+                  "occlusionTexture": {{"index": 2, "strength": 0.5}}, "emissiveFactor": [0.1, 0.0, 0.0]}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+    );
+    let p = write(&d, "pbr.gltf", json.as_bytes());
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let (maps, m) = (&parts[0].maps, parts[0].material.unwrap());
+    let mr = maps.metal_rough.as_ref().expect("a metallic-roughness map");
+    assert_eq!(
+        (mr.base_factor.to_array(), mr.metallic, mr.roughness),
+        ([0.5, 1.0, 1.0], 0.75, 0.5)
+    );
+    assert_eq!(
+        mr.map.texture.texel(0, 0, 0),
+        [0.0, 128.0 / 255.0, 1.0, 1.0],
+        "linear, not sRGB"
+    );
+    assert_eq!(m.diffuse().to_array(), [0.5, 1.0, 1.0]);
+    assert_eq!((m.specular().to_array(), m.shininess()), ([1.0; 3], 1.0));
+    assert_eq!(m.emission().to_array(), [0.1, 0.0, 0.0]);
+    let ao = maps.occlusion.as_ref().expect("an occlusion map");
+    assert_eq!((ao.strength, ao.map.texture.texel(0, 1, 1)[0]), (0.5, 64.0 / 255.0));
+    let e = maps.emission.as_ref().expect("the emission kept apart");
+    assert_eq!(e.texture.texel(0, 0, 0), [1.0; 4]);
+    // At a texel: metalness 0.75·1, roughness 0.5·128/255, occlusion 1 + 0.5·(64/255 − 1).
+    let t = maps.sample(Vec2::splat(0.5), Vec2::ZERO, Vec2::ZERO);
+    // The diffuse texel multiplies the material's diffuse (the base factor); the specular
+    // texel is the specular colour itself (the material's is white).
+    let texel = ((200.0f32 / 255.0 + 0.055) / 1.055).powf(2.4);
+    assert!((t.diffuse[0] - texel * 0.25).abs() < 1e-3, "{:?}", t.diffuse);
+    assert!(
+        (t.specular.r - (0.04 * 0.25 + 0.5 * texel * 0.75)).abs() < 1e-3,
+        "{:?}",
+        t.specular
+    );
+    let a = (0.5f32 * 128.0 / 255.0).powi(2);
+    assert!(
+        (t.shininess - (2.0 / (a * a) - 2.0)).abs() < 1e-2 * t.shininess,
+        "{}",
+        t.shininess
+    );
+    assert!((t.occlusion.unwrap() - (1.0 + 0.5 * (64.0 / 255.0 - 1.0))).abs() < 1e-6);
 }

@@ -104,8 +104,13 @@ pub struct TextureValue {
     pub uv_dy: [f32; 2],
     /// The diffuse map's RGBA (1 without one).
     pub diffuse: [f32; 4],
-    /// The specular map's colour (1 without one).
+    /// The specular map's colour (1 without one; a metallic-roughness map's specular colour).
     pub specular: [f32; 3],
+    /// The factor on the shininess (a shininess map's; a metallic-roughness map gives the
+    /// shininess itself, its material's being 1).
+    pub shininess: f32,
+    /// The occlusion on the ambient terms (1 without an occlusion map).
+    pub occlusion: f32,
     /// The point's alpha (material, diffuse map, alpha map).
     pub alpha: f32,
     /// Whether the alpha test discards the point.
@@ -429,6 +434,8 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
             uv_dy: d_dy.to_array(),
             diffuse: t.diffuse,
             specular: c3(t.specular),
+            shininess: t.shininess,
+            occlusion: t.occlusion.unwrap_or(1.0),
             alpha,
             discarded,
         }

@@ -24,8 +24,13 @@ struct Maps {
     blend: vec4<f32>,
     // A normal map: x 1 where there is one, y its scale, z 1 for green along −v.
     normal: vec4<f32>,
+    // A metallic-roughness map: x 1 where there is one, y metallic, z roughness; w 1 with an
+    // occlusion map.
+    pbr: vec4<f32>,
+    // The base colour factor; w the occlusion's strength.
+    base: vec4<f32>,
     // Per map: the transform's linear part by columns, then its offset.
-    transforms: array<vec4<f32>, 14>,
+    transforms: array<vec4<f32>, 18>,
 }
 
 @group(1) @binding(0) var<uniform> maps: Maps;
@@ -36,13 +41,17 @@ struct Maps {
 @group(1) @binding(5) var t_shininess: texture_2d<f32>;
 @group(1) @binding(6) var t_alpha: texture_2d<f32>;
 @group(1) @binding(7) var t_normal: texture_2d<f32>;
-@group(1) @binding(8) var s_diffuse: sampler;
-@group(1) @binding(9) var s_ambient: sampler;
-@group(1) @binding(10) var s_specular: sampler;
-@group(1) @binding(11) var s_emission: sampler;
-@group(1) @binding(12) var s_shininess: sampler;
-@group(1) @binding(13) var s_alpha: sampler;
-@group(1) @binding(14) var s_normal: sampler;
+@group(1) @binding(8) var t_metal_rough: texture_2d<f32>;
+@group(1) @binding(9) var t_occlusion: texture_2d<f32>;
+@group(1) @binding(10) var s_diffuse: sampler;
+@group(1) @binding(11) var s_ambient: sampler;
+@group(1) @binding(12) var s_specular: sampler;
+@group(1) @binding(13) var s_emission: sampler;
+@group(1) @binding(14) var s_shininess: sampler;
+@group(1) @binding(15) var s_alpha: sampler;
+@group(1) @binding(16) var s_normal: sampler;
+@group(1) @binding(17) var s_metal_rough: sampler;
+@group(1) @binding(18) var s_occlusion: sampler;
 
 // A textured object's light before its texels: (primary, specular), as phong-core's `Lit` with
 // every term in the primary colour (Gouraud and flat shading), or the term an output shows.
@@ -131,6 +140,18 @@ struct Texels {
     alpha: f32,
     // The normal map's tangent-space normal (z 1 without one).
     normal: vec3<f32>,
+    // The occlusion on the ambient terms (1 without a map).
+    occlusion: f32,
+}
+
+// phong-core's `MetalRough::shininess`.
+fn roughness_shininess(roughness: f32) -> f32 {
+    let r = clamp(roughness, 0.0, 1.0);
+    let a = r * r;
+    if (a > 0.0) {
+        return clamp(2.0 / (a * a) - 2.0, 0.0, 10000.0);
+    }
+    return 10000.0;
 }
 
 // Every map sampled at `uv` with the screen derivatives `dx`, `dy` (1 where a map is absent).
@@ -143,6 +164,7 @@ fn texels(uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Texels {
     t.shininess = 1.0;
     t.alpha = 1.0;
     t.normal = vec3<f32>(0.0, 0.0, 1.0);
+    t.occlusion = 1.0;
     if (maps.present.x != 0u) {
         t.diffuse = textureSampleGrad(t_diffuse, s_diffuse, map_uv(0u, uv), map_d(0u, dx), map_d(0u, dy));
     }
@@ -166,6 +188,20 @@ fn texels(uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Texels {
     if (maps.normal.x != 0.0) {
         let n = textureSampleGrad(t_normal, s_normal, map_uv(6u, uv), map_d(6u, dx), map_d(6u, dy)).xyz * 2.0 - 1.0;
         t.normal = vec3<f32>(n.x * maps.normal.y, select(n.y, -n.y, maps.normal.z != 0.0) * maps.normal.y, n.z);
+    }
+    if (maps.pbr.w != 0.0) {
+        let o = textureSampleGrad(t_occlusion, s_occlusion, map_uv(8u, uv), map_d(8u, dx), map_d(8u, dy)).x;
+        t.occlusion = 1.0 + maps.base.w * (o - 1.0);
+    }
+    // A metallic-roughness map: the diffuse, specular and shininess texels of phong-core's
+    // `MetalRough`.
+    if (maps.pbr.x != 0.0) {
+        let s = textureSampleGrad(t_metal_rough, s_metal_rough, map_uv(7u, uv), map_d(7u, dx), map_d(7u, dy));
+        let m = clamp(maps.pbr.y * s.z, 0.0, 1.0);
+        let base = maps.base.xyz * t.diffuse.xyz;
+        t.specular = vec3<f32>(0.04 * (1.0 - m)) + base * m;
+        t.shininess = roughness_shininess(maps.pbr.z * s.y);
+        t.diffuse = vec4<f32>(t.diffuse.xyz * (1.0 - m), t.diffuse.w);
     }
     return t;
 }
@@ -222,9 +258,12 @@ fn textured(f: VsOut, back: bool, t: Texels) -> vec3<f32> {
     } else {
         p += e;
     }
-    if (maps.present.y != 0u) {
-        q += s.ambient * t.ambient;
-        ta = t.ambient;
+    if (maps.present.y != 0u || maps.pbr.w != 0.0) {
+        if (maps.present.y != 0u) {
+            ta = t.ambient;
+        }
+        ta *= t.occlusion;
+        q += s.ambient * ta;
     } else {
         p += s.ambient;
     }

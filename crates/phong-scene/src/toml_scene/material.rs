@@ -135,7 +135,7 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
             channel: None,
             srgb,
             at: format!("{}:{line}: `{k}`", ctx.path.display()),
-            normal_scale: if slot == Slot::Bump { bump_scale } else { normal_scale },
+            scale: if slot == Slot::Bump { bump_scale } else { normal_scale },
             green_down,
         });
     }

@@ -596,6 +596,12 @@ function showProbe(p) {
   html += `<table><tr><th>P</th><td>${vfmt(h.position)}</td><th>N</th><td>${vfmt(h.normal)}</td><th>V</th><td>${vfmt(h.view)}</td></tr>
     <tr><th>a<sub>m</sub></th><td>${rgb(m.ambient)}</td><th>d<sub>m</sub></th><td>${rgb(m.diffuse)}</td><th>s<sub>m</sub></th><td>${rgb(m.specular)}</td></tr>
     <tr><th>e<sub>m</sub></th><td>${rgb(m.emission)}</td><th>s</th><td>${fmt(m.shininess, 2)}</td><th>k<sub>d</sub>, k<sub>s</sub></th><td>${fmt(h.normalization[0])}, ${fmt(h.normalization[1])}</td></tr></table>`;
+  if (h.texture) {
+    const t = h.texture;
+    html += `<table><tr><th>uv</th><td>${vfmt(t.uv, 4)}</td><th>∂uv/∂x</th><td>${vfmt(t.uv_dx, 5)}</td><th>∂uv/∂y</th><td>${vfmt(t.uv_dy, 5)}</td></tr>
+      <tr><th>T<sub>Kd</sub></th><td>${vfmt(t.diffuse, 4)}</td><th>T<sub>Ks</sub></th><td>${rgb(t.specular)}</td><th>T<sub>Ns</sub></th><td>${fmt(t.shininess, 2)}</td></tr>
+      <tr><th>T<sub>AO</sub></th><td>${fmt(t.occlusion)}</td><th>alpha</th><td>${fmt(t.alpha)}${t.discarded ? ' (discarded by the alpha test)' : ''}</td><td colspan="2"></td></tr></table>`;
+  }
   html += '<table><tr><th>light</th><th>L</th><th>R</th><th>H</th><th>N·L</th><th>R·V</th><th>N·H</th><th>att</th><th>spot</th><th>spec</th><th>ambient</th><th>diffuse</th><th>specular</th></tr>';
   h.lights.forEach((l, i) => {
     html += `<tr><td>${i + 1} ${l.kind}</td><td>${vfmt(l.l)}</td><td>${vfmt(l.r)}</td><td>${vfmt(l.h)}</td><td>${fmt(l.n_dot_l)}</td><td>${fmt(l.r_dot_v)}</td>
