@@ -2,8 +2,14 @@
  * phong-raster's tests write to stdin; writes the image (RGB, top row first) to stdout.
  * The reference that phong's `opengl` model is checked against (tests/mesa.rs).
  *
+ * per_fragment = 1 draws with a GLSL 1.20 program that evaluates the same equation per
+ * fragment from the fixed-function state (gl_LightSource, gl_FrontMaterial, gl_LightModel):
+ * the equation of the OpenGL 2.1 specification (2.14.1) as Mesa's fixed-function vertex
+ * program computes it (the specular term only where N·L > 0), with the interpolated normal
+ * normalised per fragment.
+ *
  * Input, whitespace-separated:
- *   W H  local_viewer two_sided
+ *   W H  local_viewer two_sided per_fragment
  *   projection[16] view[16]          (column-major, as glLoadMatrixf)
  *   global_ambient[3]
  *   material: ambient[3] diffuse[3] specular[3] emission[3] shininess
@@ -22,6 +28,62 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+static const char *VS =
+    "#version 120\n"
+    "varying vec3 p; varying vec3 n;\n"
+    "void main() { p = vec3(gl_ModelViewMatrix * gl_Vertex); n = gl_NormalMatrix * gl_Normal;\n"
+    "  gl_TexCoord[0] = gl_MultiTexCoord0; gl_Position = ftransform(); }\n";
+static const char *FS =
+    "#version 120\n"
+    "uniform int nlights; uniform int textured; uniform int local; uniform sampler2D map;\n"
+    "varying vec3 p; varying vec3 n;\n"
+    "void main() {\n"
+    "  vec3 N = normalize(n);\n"
+    "  if (!gl_FrontFacing) N = -N;\n"
+    "  vec3 V = local != 0 ? normalize(-p) : vec3(0.0, 0.0, 1.0);\n"
+    "  vec3 c = gl_FrontMaterial.emission.rgb + gl_FrontMaterial.ambient.rgb * gl_LightModel.ambient.rgb;\n"
+    "  vec3 s = vec3(0.0);\n"
+    "  for (int i = 0; i < 8; i++) {\n"
+    "    if (i >= nlights) break;\n"
+    "    vec4 lp = gl_LightSource[i].position; vec3 L; float att = 1.0;\n"
+    "    if (lp.w != 0.0) {\n"
+    "      vec3 d = lp.xyz / lp.w - p; float dist = length(d); L = d / dist;\n"
+    "      att = 1.0 / (gl_LightSource[i].constantAttenuation + dist * (gl_LightSource[i].linearAttenuation\n"
+    "            + dist * gl_LightSource[i].quadraticAttenuation));\n"
+    "    } else L = normalize(lp.xyz);\n"
+    "    if (gl_LightSource[i].spotCutoff != 180.0) {\n"
+    "      float sd = dot(-L, normalize(gl_LightSource[i].spotDirection));\n"
+    "      att *= sd >= gl_LightSource[i].spotCosCutoff ? pow(max(sd, 0.0), gl_LightSource[i].spotExponent) : 0.0;\n"
+    "    }\n"
+    "    float ndl = dot(N, L);\n"
+    "    c += att * gl_FrontMaterial.ambient.rgb * gl_LightSource[i].ambient.rgb;\n"
+    "    if (ndl > 0.0) {\n"
+    "      c += att * ndl * gl_FrontMaterial.diffuse.rgb * gl_LightSource[i].diffuse.rgb;\n"
+    "      float ndh = max(dot(N, normalize(L + V)), 0.0);\n"
+    "      s += att * pow(ndh, gl_FrontMaterial.shininess) * gl_FrontMaterial.specular.rgb * gl_LightSource[i].specular.rgb;\n"
+    "    }\n"
+    "  }\n"
+    "  if (textured != 0)\n"
+    "    gl_FragColor = vec4(clamp(clamp(c, 0.0, 1.0) * texture2D(map, gl_TexCoord[0].st).rgb + clamp(s, 0.0, 1.0), 0.0, 1.0), 1.0);\n"
+    "  else\n"
+    "    gl_FragColor = vec4(clamp(c + s, 0.0, 1.0), 1.0);\n"
+    "}\n";
+
+static GLuint compile(GLenum kind, const char *src) {
+    GLuint s = glCreateShader(kind);
+    glShaderSource(s, 1, &src, NULL);
+    glCompileShader(s);
+    GLint ok;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[4096];
+        glGetShaderInfoLog(s, sizeof log, NULL, log);
+        fprintf(stderr, "ffp: shader: %s\n", log);
+        exit(1);
+    }
+    return s;
+}
+
 static float rd(void) {
     float x;
     if (scanf("%f", &x) != 1) { fprintf(stderr, "ffp: bad input\n"); exit(2); }
@@ -30,7 +92,7 @@ static float rd(void) {
 static void rdv(float *v, int n) { for (int i = 0; i < n; i++) v[i] = rd(); }
 
 int main(void) {
-    int w = (int)rd(), h = (int)rd(), local = (int)rd(), two = (int)rd();
+    int w = (int)rd(), h = (int)rd(), local = (int)rd(), two = (int)rd(), per_fragment = (int)rd();
     float proj[16], view[16], amb[4] = {0, 0, 0, 1};
     rdv(proj, 16); rdv(view, 16); rdv(amb, 3);
     float ma[4] = {0, 0, 0, 1}, md[4] = {0, 0, 0, 1}, ms[4] = {0, 0, 0, 1}, me[4] = {0, 0, 0, 1};
@@ -88,6 +150,20 @@ int main(void) {
     int *tri = malloc(sizeof(int) * 3 * (nt > 0 ? nt : 1));
     for (int i = 0; i < 3 * nt; i++) tri[i] = (int)rd();
     int tw = (int)rd(), th = (int)rd();
+    if (per_fragment) {
+        GLuint prog = glCreateProgram();
+        glAttachShader(prog, compile(GL_VERTEX_SHADER, VS));
+        glAttachShader(prog, compile(GL_FRAGMENT_SHADER, FS));
+        glLinkProgram(prog);
+        GLint ok;
+        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+        if (!ok) { fprintf(stderr, "ffp: the program does not link\n"); return 1; }
+        glUseProgram(prog);
+        glUniform1i(glGetUniformLocation(prog, "nlights"), nl < 8 ? nl : 8);
+        glUniform1i(glGetUniformLocation(prog, "textured"), tw > 0 && th > 0);
+        glUniform1i(glGetUniformLocation(prog, "local"), local);
+        glUniform1i(glGetUniformLocation(prog, "map"), 0);
+    }
     if (tw > 0 && th > 0) {
         unsigned char *tex = malloc((size_t)tw * th * 4);
         for (size_t i = 0; i < (size_t)tw * th * 4; i++) tex[i] = (unsigned char)rd();
