@@ -273,6 +273,15 @@ rotation = [0.0, 90.0, 0.0]
             o.maps.diffuse = Some(map);
         }
         assert_fast_matches_reference(&scene, &format!("{interpolation}, textured"));
+        // 8 bits, mirrored, bilinear: the vector sampler's (`simd/sampler.rs`).
+        let bytes: Vec<[u8; 4]> = texels.iter().map(|t| t.map(|c| (c / 257) as u8)).collect();
+        let texture = std::sync::Arc::new(Texture::from_rgba8(4, 4, &bytes).unwrap());
+        for o in &mut scene.objects {
+            let map = o.maps.diffuse.as_mut().expect("set above");
+            map.texture = texture.clone();
+            map.sampler = Sampler::bilinear(Wrap::Mirror);
+        }
+        assert_fast_matches_reference(&scene, &format!("{interpolation}, textured, 8 bits"));
         // Clipping happened: some triangles are clipped into polygons.
         let aspect = scene.image.width as f32 / scene.image.height as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);

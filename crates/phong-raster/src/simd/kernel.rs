@@ -27,7 +27,7 @@ const MAX_LANES: usize = 16;
 
 /// Three lanes of vectors.
 #[derive(Clone, Copy)]
-struct V3<V> {
+pub(super) struct V3<V> {
     x: V,
     y: V,
     z: V,
@@ -173,7 +173,7 @@ struct PreparedLight {
 /// What `shade8` needs of one object, computed once per render.
 pub struct Prepared {
     view: View,
-    options: ShadingOptions,
+    pub(super) options: ShadingOptions,
     shininess: f32,
     kd: f32,
     ks: f32,
@@ -244,9 +244,9 @@ pub struct Shaded8 {
 /// The four terms, per channel, in vectors.
 #[derive(Clone, Copy)]
 pub(crate) struct Terms<V> {
-    ambient: [V; 3],
-    diffuse: [V; 3],
-    specular: [V; 3],
+    pub(super) ambient: [V; 3],
+    pub(super) diffuse: [V; 3],
+    pub(super) specular: [V; 3],
     color: [V; 3],
 }
 
@@ -288,7 +288,7 @@ fn acc<V: Vf32>(c: &mut [V; 3], k: Color, f: V, m: V::M) {
 /// Shades 8 points (positions and unnormalised normals by lane) of one object:
 /// `phong_core::shade` with `pow` approximated as documented above.
 #[inline(always)]
-fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
+pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
     let zero = V::splat(0.0);
     let (v, v_ok) = match p.view {
         View::Local { eye } => V3::splat(eye).sub(pos).normalize_or_zero(),
@@ -515,7 +515,7 @@ pub enum Batch<'a> {
 
 /// Interpolated attributes `q` as a position (`q[0..3]`) and a normal (`q[3..6]`).
 #[inline(always)]
-fn position_normal<V: Vf32>(q: [V; 6]) -> (V3<V>, V3<V>) {
+pub(super) fn position_normal<V: Vf32>(q: [V; 6]) -> (V3<V>, V3<V>) {
     let v3 = |k: usize| V3 {
         x: q[k],
         y: q[k + 1],
@@ -564,7 +564,7 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
 /// Pixels `start..` (at most [`V::N`](Vf32::N), `m` of them; the last repeated to fill the
 /// vector) gathered by `lane`, and their first `attrs` attributes interpolated.
 #[inline(always)]
-fn lanes<'p, V: Vf32>(
+pub(super) fn lanes<'p, V: Vf32>(
     lane: &impl Fn(usize) -> (f32, f32, &'p Planes),
     start: usize,
     n: usize,

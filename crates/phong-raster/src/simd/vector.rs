@@ -25,6 +25,9 @@ pub trait Vf32: Copy {
     type M: Copy;
     /// Every lane `x`.
     fn splat(x: f32) -> Self;
+    /// The texels `texels[y·width + x]` of the lanes (`x`, `y` whole numbers, clamped into
+    /// `width × height`; NaN reads 0) as their red, green and blue, each `0.0..=255.0`.
+    fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3];
     /// From an array.
     fn from_array(a: Self::A) -> Self;
     /// To an array.
@@ -97,6 +100,20 @@ impl Vf32 for Portable {
     const N: usize = 8;
     type A = [f32; 8];
     type M = [bool; 8];
+    #[inline(always)]
+    fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+        let mut out = [Portable([0.0; 8]); 3];
+        for i in 0..8 {
+            // `as` saturates and maps NaN to 0.
+            let xi = (x.0[i] as i64).clamp(0, i64::from(width) - 1) as usize;
+            let yi = (y.0[i] as i64).clamp(0, i64::from(height) - 1) as usize;
+            let t = texels.get(yi * width as usize + xi).copied().unwrap_or_default();
+            for (o, c) in out.iter_mut().zip(t) {
+                o.0[i] = f32::from(c);
+            }
+        }
+        out
+    }
     #[inline(always)]
     fn splat(x: f32) -> Self {
         Portable([x; 8])
@@ -237,6 +254,37 @@ mod avx2 {
         const N: usize = 8;
         type A = [f32; 8];
         type M = __m256;
+        #[inline(always)]
+        fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+            let (w, h) = (width as usize, height as usize);
+            assert!(
+                w >= 1 && h >= 1 && texels.len() >= w * h && w * h <= i32::MAX as usize,
+                "a level's texels fit its size"
+            );
+            // SAFETY: AVX2 is present (see above). Every index is `y·w + x` with `x` clamped
+            // into `0..w` and `y` into `0..h` (a NaN or out-of-range conversion gives i32::MIN,
+            // clamped to 0), so below `w·h <= texels.len()` and within i32: each gathered i32
+            // is the 4 bytes of one texel of `texels` (unaligned reads are allowed).
+            unsafe {
+                let zero = _mm256_setzero_si256();
+                let xi = _mm256_min_epi32(
+                    _mm256_max_epi32(_mm256_cvttps_epi32(x.0), zero),
+                    _mm256_set1_epi32(w as i32 - 1),
+                );
+                let yi = _mm256_min_epi32(
+                    _mm256_max_epi32(_mm256_cvttps_epi32(y.0), zero),
+                    _mm256_set1_epi32(h as i32 - 1),
+                );
+                let idx = _mm256_add_epi32(_mm256_mullo_epi32(yi, _mm256_set1_epi32(w as i32)), xi);
+                let g = _mm256_i32gather_epi32::<4>(texels.as_ptr().cast::<i32>(), idx);
+                let byte = _mm256_set1_epi32(0xff);
+                [
+                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(g, byte))),
+                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<8>(g), byte))),
+                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<16>(g), byte))),
+                ]
+            }
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             // SAFETY: AVX is present (see the comment above the impl).
@@ -451,6 +499,12 @@ mod avx2 {
         const N: usize = 16;
         type A = [f32; 16];
         type M = (__m256, __m256);
+        #[inline(always)]
+        fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+            let a = Avx2::gather_rgb8(texels, width, height, x.0, y.0);
+            let b = Avx2::gather_rgb8(texels, width, height, x.1, y.1);
+            [Avx2x2(a[0], b[0]), Avx2x2(a[1], b[1]), Avx2x2(a[2], b[2])]
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             let v = Avx2::splat(x);

@@ -12,7 +12,7 @@ use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
-use crate::simd::{Planes, group_lanes, shade_batch, shade_batch_lit, shade_group};
+use crate::simd::{Planes, VectorMap, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group};
 use crate::stats::Marks;
 use crate::target::{Store, fill, resolve};
 use glam::{Vec2, Vec3};
@@ -202,6 +202,40 @@ impl Frame<'_> {
         let clamp = obj.shading.options.clamp;
         let tinted = !obj.mesh.colors().is_empty();
         let centre = |p: u32| ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
+        // One pixel's colour from its light, its map sampled here (`Lit::modulate`).
+        let per_pixel = |i: usize, primary: [f32; 3], specular: [f32; 3]| {
+            let (p, id) = items[i];
+            let (x, y) = centre(p);
+            let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
+            let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+            if tinted {
+                texels = texels.tinted(rgb);
+            }
+            let lit = Lit {
+                primary: Color::new(primary[0], primary[1], primary[2]),
+                specular: Color::new(specular[0], specular[1], specular[2]),
+                ..Lit::default()
+            };
+            let c = lit.modulate(&texels, clamp);
+            [c.r, c.g, c.b]
+        };
+        if let Some(map) = VectorMap::new(&obj.maps).filter(|_| !tinted) {
+            let out = std::cell::RefCell::new(out);
+            shade_batch_textured(
+                self.isa,
+                prep,
+                &map,
+                items.len(),
+                |i| {
+                    let (p, id) = items[i];
+                    let (x, y) = centre(p);
+                    (x, y, self.planes(id), self.uv_planes(id))
+                },
+                |i, rgb| (out.borrow_mut())(items[i], rgb),
+                |i, primary, specular| (out.borrow_mut())(items[i], per_pixel(i, primary, specular)),
+            );
+            return;
+        }
         shade_batch_lit(
             self.isa,
             prep,
@@ -211,22 +245,7 @@ impl Frame<'_> {
                 let (x, y) = centre(p);
                 (x, y, self.planes(id))
             },
-            |i, primary, specular| {
-                let (p, id) = items[i];
-                let (x, y) = centre(p);
-                let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
-                let mut texels = obj.maps.sample(uv, d_dx, d_dy);
-                if tinted {
-                    texels = texels.tinted(rgb);
-                }
-                let lit = Lit {
-                    primary: Color::new(primary[0], primary[1], primary[2]),
-                    specular: Color::new(specular[0], specular[1], specular[2]),
-                    ..Lit::default()
-                };
-                let c = lit.modulate(&texels, clamp);
-                out(items[i], [c.r, c.g, c.b]);
-            },
+            |i, primary, specular| out(items[i], per_pixel(i, primary, specular)),
         );
     }
 
