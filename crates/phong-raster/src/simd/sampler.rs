@@ -156,11 +156,26 @@ fn half_log2<V: Vf32>(rho2: V) -> V {
 #[inline(always)]
 fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
     let (zero, one, half) = (V::splat(0.0), V::splat(1.0), V::splat(0.5));
-    let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
-    // A level's size: the halved size rounded down, at least 1.
-    let scale = level.mul(V::splat(-1.0)).pow2i();
-    let w = floor(V::splat(w0).mul(scale)).max(one);
-    let h = floor(V::splat(h0).mul(scale)).max(one);
+    let (lo, hi) = {
+        let l = level.to_array();
+        let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+        for &x in l.as_ref() {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+        (lo as usize, (hi as usize).min(map.count - 1))
+    };
+    // A level's size: the halved size rounded down, at least 1 (one level: its own).
+    let (w, h) = if lo == hi {
+        (V::splat(map.levels[lo].0 as f32), V::splat(map.levels[lo].1 as f32))
+    } else {
+        let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
+        let scale = level.mul(V::splat(-1.0)).pow2i();
+        (
+            floor(V::splat(w0).mul(scale)).max(one),
+            floor(V::splat(h0).mul(scale)).max(one),
+        )
+    };
     let (fx, fy) = (u.mul_add(w, V::splat(-0.5)), v.mul_add(h, V::splat(-0.5)));
     let (ix, iy) = (floor(fx), floor(fy));
     let (a, b) = (fx.sub(ix), fy.sub(iy));
@@ -172,15 +187,6 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
         one.sub(a).mul(b),
         a.mul(b),
     ];
-    let (lo, hi) = {
-        let l = level.to_array();
-        let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
-        for &x in l.as_ref() {
-            lo = lo.min(x);
-            hi = hi.max(x);
-        }
-        (lo as usize, (hi as usize).min(map.count - 1))
-    };
     let mut out = [zero; 3];
     for l in lo..=hi {
         let (lw, lh, texels) = map.levels[l];
