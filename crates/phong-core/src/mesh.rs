@@ -94,6 +94,27 @@ impl Mesh {
         &self.tangents
     }
 
+    /// The mesh with a file's tangents, one per vertex (`xyz` finite, `w` the bitangent's
+    /// sign: negative or not); an empty vector removes them. Like computed ones, they are
+    /// dropped by the normals' functions.
+    pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Self, Error> {
+        if !tangents.is_empty() && tangents.len() != self.positions.len() {
+            return Err(Error::OutOfRange {
+                what: "number of tangents",
+                range: "0 or the number of positions",
+                value: tangents.len() as f32,
+            });
+        }
+        if let Some(t) = tangents.iter().find(|t| !t.is_finite()) {
+            return Err(Error::InvalidPosition {
+                what: "tangent",
+                value: [t.x, t.y, t.z],
+            });
+        }
+        self.tangents = tangents;
+        Ok(self)
+    }
+
     /// The mesh with MikkTSpace tangents (the convention of Blender, three.js and glTF's
     /// normal maps), from its normals and texture coordinates; a vertex whose corners get
     /// different tangents is split. Without texture coordinates the mesh is returned as it is.

@@ -24,7 +24,7 @@ use crate::formats::far_origin;
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use crate::{Error, ObjPart};
 use base64::Engine;
-use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3};
+use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
 use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -292,6 +292,30 @@ pub fn read_gltf(
                 }
                 None => (vec![Vec3::ZERO; n], false),
             };
+            // TANGENT (read with normals, as the format pairs them): a direction in the surface,
+            // by the node's matrix itself; a mirror flips the bitangent's sign.
+            let tangents: Vec<Vec4> = match prim.get(&::gltf::Semantic::Tangents) {
+                Some(a) if has_normals => {
+                    check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Vec4], true)
+                        .map_err(|m| fail(format!("{what}: TANGENT (accessor {}): {m}", a.index())))?;
+                    let linear = DMat3::from_mat4(*world);
+                    let t: Vec<Vec4> = reader
+                        .read_tangents()
+                        .into_iter()
+                        .flatten()
+                        .map(|[x, y, z, w]| {
+                            let d = (linear * DVec3::new(x.into(), y.into(), z.into())).normalize_or_zero();
+                            d.as_vec3().extend(if mirrored { -w } else { w })
+                        })
+                        .collect();
+                    if t.len() == n && t.iter().all(|t| t.is_finite()) {
+                        t
+                    } else {
+                        Vec::new()
+                    }
+                }
+                _ => Vec::new(),
+            };
             model.double_sided |= mat.double_sided();
             let mut material = mat.index().map(|_| phong_material(&mat));
             // The textures' coordinates: one set for the mesh (the base colour's, else the
@@ -371,8 +395,11 @@ pub fn read_gltf(
                 mesh.name()
                     .map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
             );
+            // The file's tangents serve a normal map; without one they are not kept.
+            let tangents = if maps.normal.is_some() { tangents } else { Vec::new() };
             pending.push(Pending {
                 name,
+                tangents,
                 world_pos,
                 normals,
                 tris,
@@ -409,6 +436,7 @@ pub fn read_gltf(
     let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
     for Pending {
         name,
+        tangents,
         world_pos,
         normals,
         tris,
@@ -423,6 +451,7 @@ pub fn read_gltf(
         let mesh = Mesh::new(positions, normals, tris)
             .and_then(|m| m.with_uvs(uvs))
             .and_then(|m| m.with_colors(colors))
+            .and_then(|m| m.with_tangents(tangents))
             .map_err(|e| fail(format!("{name}: {e}")))?;
         model.parts.push(ObjPart {
             name,
@@ -517,6 +546,7 @@ fn node_instances<'a>(
 /// A primitive read, in f64 world space, waiting for the model's common origin.
 struct Pending {
     name: String,
+    tangents: Vec<Vec4>,
     uvs: Vec<Vec2>,
     colors: Vec<Color>,
     maps: Maps,

@@ -776,3 +776,62 @@ fn gltf_metal_rough_and_occlusion_textures_are_read() {
     );
     assert!((t.occlusion.unwrap() - (1.0 + 0.5 * (64.0 / 255.0 - 1.0))).abs() < 1e-6);
 }
+
+/// glTF's TANGENT: read where the primitive has normals and a normal map, by the node's matrix
+/// (a mirroring node flips `w`), and kept with the file's normals instead of MikkTSpace's; a
+/// primitive without it gets MikkTSpace's: `T` along `+u` (`+x` here), and `B = w·(N × T)`
+/// along OpenGL's `+v`, which is glTF's `−v`, here `−y`: `w = −1` (what the format's own
+/// definition, `B = w·(N × T)` pointing up the image, gives too).
+#[test]
+fn gltf_tangents_are_read() {
+    let d = dir("gltf_tangents");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
+        .save(d.join("n.png"))
+        .unwrap();
+    let gltf = |tangents: bool, scale: f32| {
+        let mut bin = Vec::new();
+        let floats: [&[f32]; 4] = [
+            &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            &[0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+            &[0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+            &[0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, -1.0],
+        ];
+        for x in floats.concat() {
+            bin.extend_from_slice(&x.to_le_bytes());
+        }
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+        let tangent = if tangents { r#", "TANGENT": 3"# } else { "" };
+        format!(
+            r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": 120, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 36}},
+                  {{"buffer": 0, "byteOffset": 72, "byteLength": 24}}, {{"buffer": 0, "byteOffset": 96, "byteLength": 48}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}},
+    {{"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC4"}}],
+  "images": [{{"uri": "n.png"}}], "textures": [{{"source": 0}}],
+  "materials": [{{"normalTexture": {{"index": 0}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2{tangent}}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0, "scale": [{scale}, 1, 1]}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+        )
+    };
+    for (tangents, scale, want) in [
+        (true, 1.0, [0.0, 1.0, 0.0, -1.0]),
+        (true, -1.0, [0.0, 1.0, 0.0, 1.0]),
+        (false, 1.0, [1.0, 0.0, 0.0, -1.0]),
+    ] {
+        write(&d, "t.gltf", gltf(tangents, scale).as_bytes());
+        let scene = write(&d, "s.toml", b"[[object]]\nmesh = \"t.gltf\"\nfit = false\n");
+        let loaded = load_with(&scene, &ModelOptions::default()).unwrap();
+        let mesh = &loaded.scene.objects[0].mesh;
+        assert!(!mesh.tangents().is_empty(), "tangents {tangents}");
+        for t in mesh.tangents() {
+            assert!(
+                (*t - glam::Vec4::from_array(want)).abs().max_element() < 1e-6,
+                "TANGENT {tangents}, scale {scale}: {t} vs {want:?}"
+            );
+        }
+    }
+}

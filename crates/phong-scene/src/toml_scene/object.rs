@@ -212,6 +212,7 @@ pub(super) fn object(
                     p.mesh = Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec())
                         .and_then(|m| m.with_uvs(p.mesh.uvs().to_vec()))
                         .and_then(|m| m.with_colors(p.mesh.colors().to_vec()))
+                        .and_then(|m| m.with_tangents(p.mesh.tangents().to_vec()))
                         .map_err(|e| Error::Model {
                             path: ctx.path.to_path_buf(),
                             message: format!("{}: {e}", p.name),
@@ -285,9 +286,10 @@ pub(super) fn object(
 }
 
 /// The mesh with MikkTSpace tangents where a normal map needs them (after its normals, which
-/// they are computed from).
+/// they are computed from) and it has none of its own (a glTF's `TANGENT`, kept with the file's
+/// normals).
 fn tangents_for(mesh: Mesh, maps: &Maps) -> Mesh {
-    if maps.normal.is_some() && mesh.has_uvs() {
+    if maps.normal.is_some() && mesh.has_uvs() && mesh.tangents().is_empty() {
         mesh.with_mikktspace_tangents()
     } else {
         mesh
