@@ -273,7 +273,8 @@ rotation = [0.0, 90.0, 0.0]
             o.maps.diffuse = Some(map);
         }
         assert_fast_matches_reference(&scene, &format!("{interpolation}, textured"));
-        // 8 bits, mirrored, bilinear: the vector sampler's (`simd/sampler.rs`).
+        // The vector sampler's cases (`simd/sampler.rs`): above, 16 bits, trilinear; here 8
+        // bits, mirrored, bilinear.
         let bytes: Vec<[u8; 4]> = texels.iter().map(|t| t.map(|c| (c / 257) as u8)).collect();
         let texture = std::sync::Arc::new(Texture::from_rgba8(4, 4, &bytes).unwrap());
         for o in &mut scene.objects {
@@ -282,6 +283,12 @@ rotation = [0.0, 90.0, 0.0]
             map.sampler = Sampler::bilinear(Wrap::Mirror);
         }
         assert_fast_matches_reference(&scene, &format!("{interpolation}, textured, 8 bits"));
+        // With a 16-bit specular map too (the 8-bit diffuse kept).
+        let specular = std::sync::Arc::new(Texture::new(4, 4, &texels, 16).unwrap());
+        for o in &mut scene.objects {
+            o.maps.specular = Some(TextureMap::new(specular.clone()));
+        }
+        assert_fast_matches_reference(&scene, &format!("{interpolation}, diffuse and specular maps"));
         // Clipping happened: some triangles are clipped into polygons.
         let aspect = scene.image.width as f32 / scene.image.height as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);

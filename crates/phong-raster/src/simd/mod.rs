@@ -19,7 +19,7 @@ mod vector;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
 pub use project::WindowVertex;
-pub use sampler::VectorMap;
+pub use sampler::VectorMaps;
 pub(crate) use tile::covered_span;
 pub use tile::{GouraudTri, TilePixel, gouraud_tile};
 
@@ -113,24 +113,24 @@ pub fn shade_batch_lit<'p>(
 #[target_feature(enable = "avx2,fma")]
 fn shade_batch_textured_avx2<'p>(
     prep: &Prepared,
-    map: &VectorMap,
+    maps: &VectorMaps,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     out: impl FnMut(usize, [f32; 3]),
     fallback: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
-    sampler::shade_batch_textured::<vector::Avx2x2>(prep, map, n, lane, out, fallback)
+    sampler::shade_batch_textured::<vector::Avx2x2>(prep, maps, n, lane, out, fallback)
 }
 
-/// Interpolates, lights and textures `n` pixels of an object whose diffuse map the vector
-/// sampler covers ([`VectorMap`]): `lane(i)` gives pixel `i`'s centre, its triangle's planes
+/// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
+/// covers ([`VectorMaps`]): `lane(i)` gives pixel `i`'s centre, its triangle's planes
 /// and its texture coordinates' planes; `out(i, rgb)` takes its colour, `fallback(i, primary,
 /// specular)` its light where the map must be sampled per pixel (see `sampler.rs`).
 #[inline]
 pub fn shade_batch_textured<'p>(
     isa: Isa,
     prep: &Prepared,
-    map: &VectorMap,
+    maps: &VectorMaps,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     out: impl FnMut(usize, [f32; 3]),
@@ -139,11 +139,11 @@ pub fn shade_batch_textured<'p>(
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        unsafe { shade_batch_textured_avx2(prep, map, n, lane, out, fallback) };
+        unsafe { shade_batch_textured_avx2(prep, maps, n, lane, out, fallback) };
         return;
     }
     let _ = isa;
-    sampler::shade_batch_textured::<vector::Portable>(prep, map, n, lane, out, fallback)
+    sampler::shade_batch_textured::<vector::Portable>(prep, maps, n, lane, out, fallback)
 }
 
 #[cfg(target_arch = "x86_64")]

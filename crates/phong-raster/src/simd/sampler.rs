@@ -1,34 +1,83 @@
-//! The vector texture sampler: a textured object's diffuse map sampled for a whole vector of
-//! pixels at once, as `phong_core::Texture::sample` samples one (bilinear in a level, the two
-//! levels of `GL_LINEAR_MIPMAP_LINEAR` blended, repeat/clamp/mirror wrap), with the texels of
-//! every lane fetched by one gather per corner and level ([`Vf32::gather_rgba8`]).
+//! The vector texture sampler: a textured object's diffuse and specular maps sampled for a
+//! whole vector of pixels at once, as `phong_core::Texture::sample` samples one (bilinear in a
+//! level, the two levels of `GL_LINEAR_MIPMAP_LINEAR` blended, repeat/clamp/mirror wrap), the
+//! texels of every lane fetched by gathers, one per corner and level
+//! ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
 //!
-//! It covers the common case, decided once per draw ([`VectorMap::new`]): an 8-bit diffuse map
-//! alone, linear filters, no vertex colours. A batch whose coordinates are too large for exact
-//! `f32` wrapping (or NaN) is left to the caller's per-pixel sampler.
+//! It covers the common cases, decided once per draw ([`VectorMaps::new`]): a diffuse map, a
+//! specular map or both and no other, 8 or 16 bits, linear filters, no vertex colours. A
+//! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
+//! caller's per-pixel sampler.
 
 use super::kernel::{Planes, Prepared, lanes, position_normal, shade};
 use super::vector::Vf32;
-use phong_core::{Filter, Maps, MipFilter, Texture, UvTransform, Wrap};
+use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
 
 /// The most mipmap levels (a 16384 side has 15).
 const MAX_LEVELS: usize = 16;
 
-/// A diffuse map in the form the vector sampler reads: its levels' sizes and 8-bit texels.
+/// One level's texels, in their storage.
+#[derive(Clone, Copy)]
+enum Texels<'a> {
+    Eight(&'a [[u8; 4]]),
+    Sixteen(&'a [[u16; 4]]),
+}
+
+/// A map in the form the vector sampler reads: its levels' sizes and texels.
 #[derive(Clone, Copy)]
 pub struct VectorMap<'a> {
-    levels: [(u32, u32, &'a [[u8; 4]]); MAX_LEVELS],
+    levels: [(u32, u32, Texels<'a>); MAX_LEVELS],
     count: usize,
     wrap: (Wrap, Wrap),
     mipmaps: bool,
     transform: UvTransform,
+    /// From storage units to `[0, 1]`: `1/255` or `1/65535`.
+    unit: f32,
 }
 
 impl<'a> VectorMap<'a> {
-    /// The map of `maps` if the vector sampler covers it: a diffuse map and no other, 8 bits,
-    /// linear magnification and minification, mipmaps blended (`GL_LINEAR_MIPMAP_LINEAR`) or
-    /// none (`GL_LINEAR`).
-    pub fn new(maps: &'a Maps) -> Option<VectorMap<'a>> {
+    /// `map` if the sampler covers it: linear magnification and minification, mipmaps blended
+    /// (`GL_LINEAR_MIPMAP_LINEAR`) or none (`GL_LINEAR`).
+    fn of(map: &'a TextureMap) -> Option<VectorMap<'a>> {
+        let s = map.sampler;
+        if s.mag != Filter::Linear || s.min != Filter::Linear || s.mip == MipFilter::Nearest {
+            return None;
+        }
+        let t = &map.texture;
+        let count = t.level_count();
+        if count > MAX_LEVELS {
+            return None;
+        }
+        let mut levels = [(1, 1, Texels::Eight(&[])); MAX_LEVELS];
+        for (i, l) in levels.iter_mut().enumerate().take(count) {
+            *l = match (t.level8(i), t.level16(i)) {
+                (Some((w, h, texels)), _) => (w, h, Texels::Eight(texels)),
+                (None, Some((w, h, texels))) => (w, h, Texels::Sixteen(texels)),
+                (None, None) => return None,
+            };
+        }
+        Some(VectorMap {
+            levels,
+            count,
+            wrap: (s.wrap_u, s.wrap_v),
+            mipmaps: s.mip == MipFilter::Linear,
+            transform: map.transform,
+            unit: if t.bits() == 8 { 1.0 / 255.0 } else { 1.0 / 65535.0 },
+        })
+    }
+}
+
+/// The maps of an object that the vector sampler covers.
+#[derive(Clone, Copy)]
+pub struct VectorMaps<'a> {
+    diffuse: Option<VectorMap<'a>>,
+    specular: Option<VectorMap<'a>>,
+}
+
+impl<'a> VectorMaps<'a> {
+    /// `maps` if the sampler covers them: a diffuse map, a specular map or both, and no other
+    /// map (each as [`VectorMap`] covers it).
+    pub fn new(maps: &'a Maps) -> Option<VectorMaps<'a>> {
         // Every field named: a new map must be considered here.
         let Maps {
             diffuse,
@@ -44,36 +93,22 @@ impl<'a> VectorMap<'a> {
             blend: _,
         } = maps;
         let others = ambient.is_some()
-            || specular.is_some()
             || emission.is_some()
             || shininess.is_some()
             || alpha.is_some()
             || normal.is_some()
             || metal_rough.is_some()
             || occlusion.is_some();
-        if others {
+        if others || (diffuse.is_none() && specular.is_none()) {
             return None;
         }
-        let map = diffuse.as_ref()?;
-        let s = map.sampler;
-        if s.mag != Filter::Linear || s.min != Filter::Linear || s.mip == MipFilter::Nearest {
-            return None;
-        }
-        let t: &Texture = &map.texture;
-        let count = t.level_count();
-        if count > MAX_LEVELS {
-            return None;
-        }
-        let mut levels = [(1, 1, &[][..]); MAX_LEVELS];
-        for (i, l) in levels.iter_mut().enumerate().take(count) {
-            *l = t.level8(i)?;
-        }
-        Some(VectorMap {
-            levels,
-            count,
-            wrap: (s.wrap_u, s.wrap_v),
-            mipmaps: s.mip == MipFilter::Linear,
-            transform: map.transform,
+        let of = |m: &'a Option<TextureMap>| match m {
+            Some(m) => VectorMap::of(m).map(Some),
+            None => Some(None),
+        };
+        Some(VectorMaps {
+            diffuse: of(diffuse)?,
+            specular: of(specular)?,
         })
     }
 }
@@ -193,7 +228,10 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
         let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
         let mut sum = [zero; 3];
         for ((x, y), wt) in corners.into_iter().zip(weights) {
-            let t = V::gather_rgb8(texels, lw, lh, x, y);
+            let t = match texels {
+                Texels::Eight(t) => V::gather_rgb8(t, lw, lh, x, y),
+                Texels::Sixteen(t) => V::gather_rgb16(t, lw, lh, x, y),
+            };
             for c in 0..3 {
                 sum[c] = t[c].mul_add(wt, sum[c]);
             }
@@ -242,24 +280,49 @@ fn sample<V: Vf32>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
     texel
 }
 
-/// [`super::kernel::shade_batch_lit`] with the diffuse map applied by the vector sampler:
-/// `out(i, rgb)` takes `clamp(clamp(P)⊗T_Kd + clamp(S))` (phong-core's `Lit::modulate`, clamps
+/// A map's RGB (`[0, 1]`) at the mesh's coordinates and their derivatives
+/// `uv = [u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]` (through the map's transform); `None` where a
+/// lane's coordinates are too large for exact `f32` wrapping (beyond ±2^21 texels) or NaN.
+#[inline(always)]
+fn mapped<V: Vf32>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
+    let (l, o) = (map.transform.linear, map.transform.offset);
+    let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
+    let [u, v, ux, vx, uy, vy] = uv;
+    let tu = linear(u, v, l.x_axis.x, l.y_axis.x).add(V::splat(o.x));
+    let tv = linear(u, v, l.x_axis.y, l.y_axis.y).add(V::splat(o.y));
+    let limit = 2_097_152.0;
+    let inside = V::and(within(tu.mul(V::splat(w0)), limit), within(tv.mul(V::splat(h0)), limit));
+    if V::any(V::not(inside)) {
+        return None;
+    }
+    let d = [
+        linear(ux, vx, l.x_axis.x, l.y_axis.x),
+        linear(ux, vx, l.x_axis.y, l.y_axis.y),
+        linear(uy, vy, l.x_axis.x, l.y_axis.x),
+        linear(uy, vy, l.x_axis.y, l.y_axis.y),
+    ];
+    let mut t = sample(map, tu, tv, d);
+    for c in &mut t {
+        *c = c.mul(V::splat(map.unit));
+    }
+    Some(t)
+}
+
+/// [`super::kernel::shade_batch_lit`] with the diffuse and specular maps applied by the vector sampler:
+/// `out(i, rgb)` takes `clamp(clamp(P)⊗T_Kd + clamp(S)⊗T_Ks)` (phong-core's `Lit::modulate`, clamps
 /// where the options clamp). `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of
 /// its texture coordinates. A vector whose coordinates the sampler cannot wrap exactly (NaN,
 /// or beyond ±2^21 texels) goes to `fallback(i, primary, specular)`, lane by lane.
 #[inline(always)]
 pub(crate) fn shade_batch_textured<'p, V: Vf32>(
     prep: &Prepared,
-    map: &VectorMap,
+    maps: &VectorMaps,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     mut out: impl FnMut(usize, [f32; 3]),
     mut fallback: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
-    let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
-    let l = map.transform.linear;
-    let o = map.transform.offset;
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(
@@ -338,14 +401,21 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
         let (u, v) = (p[1].mul(rq), p[2].mul(rq));
         let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
         let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
-        // The map's transform: its linear part on the derivatives too.
-        let tu = linear(u, v, l.x_axis.x, l.y_axis.x).add(V::splat(o.x));
-        let tv = linear(u, v, l.x_axis.y, l.y_axis.y).add(V::splat(o.y));
-        let limit = 2_097_152.0;
-        let inside = V::and(within(tu.mul(V::splat(w0)), limit), within(tv.mul(V::splat(h0)), limit));
+        let uv = [u, v, ux, vx, uy, vy];
+        // (Matches, not closures: see `modulo`.)
+        #[allow(clippy::manual_map)]
+        let td = match &maps.diffuse {
+            Some(m) => Some(mapped(m, uv)),
+            None => None,
+        };
+        #[allow(clippy::manual_map)]
+        let ts = match &maps.specular {
+            Some(m) => Some(mapped(m, uv)),
+            None => None,
+        };
         let mut primary_a = [V::A::default(); 3];
         let mut specular_a = [V::A::default(); 3];
-        if V::any(V::not(inside)) {
+        if matches!(td, Some(None)) || matches!(ts, Some(None)) {
             for c in 0..3 {
                 primary_a[c] = primary[c].to_array();
                 specular_a[c] = specular[c].to_array();
@@ -357,17 +427,18 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             start += m;
             continue;
         }
-        let d = [
-            linear(ux, vx, l.x_axis.x, l.y_axis.x),
-            linear(ux, vx, l.x_axis.y, l.y_axis.y),
-            linear(uy, vy, l.x_axis.x, l.y_axis.x),
-            linear(uy, vy, l.x_axis.y, l.y_axis.y),
-        ];
-        let texel = sample(map, tu, tv, d);
-        let scale = V::splat(1.0 / 255.0);
+        let (td, ts) = (td.flatten(), ts.flatten());
         let mut rgb = [V::A::default(); 3];
         for c in 0..3 {
-            let mut x = primary[c].mul(texel[c].mul(scale)).add(specular[c]);
+            let p = match td {
+                Some(t) => primary[c].mul(t[c]),
+                None => primary[c],
+            };
+            let s = match ts {
+                Some(t) => specular[c].mul(t[c]),
+                None => specular[c],
+            };
+            let mut x = p.add(s);
             x = V::select(x.finite(), x, zero);
             if prep.options.clamp {
                 x = x.max(zero).min(one);
@@ -408,20 +479,27 @@ mod tests {
         [t[0].to_array(), t[1].to_array(), t[2].to_array()]
     }
 
-    /// The vector sampler against `phong_core::Texture::sample` at `Texture::lod`: random 8-bit
-    /// textures of odd and even sizes, every wrap, trilinear and bilinear, coordinates over
+    /// The vector sampler against `phong_core::Texture::sample` at `Texture::lod`: random 8-
+    /// and 16-bit textures of odd and even sizes, every wrap, trilinear and bilinear, coordinates over
     /// several copies of the image and derivatives from magnified to the last level, on both
     /// builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they differ in rounding only.
     #[test]
     fn the_vector_sampler_is_texture_sample() {
         let mut r = Lcg(5);
         let mut worst = 0.0f32;
-        for (w, h) in [(1, 1), (13, 7), (64, 32), (5, 40), (128, 128)] {
-            let texels: Vec<[u8; 4]> = (0..w * h)
-                .map(|_| [0, 0, 0].map(|_: u8| (r.next() * 255.0) as u8))
-                .map(|[a, b, c]| [a, b, c, 255])
+        for (w, h, bits) in [
+            (1, 1, 8),
+            (13, 7, 8),
+            (64, 32, 8),
+            (5, 40, 16),
+            (128, 128, 8),
+            (33, 17, 16),
+        ] {
+            let texels: Vec<[u16; 4]> = (0..w * h)
+                .map(|_| [0, 0, 0].map(|_: u16| (r.next() * 65535.0) as u16))
+                .map(|[a, b, c]| [a, b, c, 65535])
                 .collect();
-            let texture = Arc::new(Texture::from_rgba8(w, h, &texels).unwrap());
+            let texture = Arc::new(phong_core::Texture::new(w, h, &texels, bits).unwrap());
             for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
                 for sampler in [Sampler::trilinear(wrap), Sampler::bilinear(wrap)] {
                     let maps = Maps {
@@ -432,7 +510,7 @@ mod tests {
                         }),
                         ..Maps::default()
                     };
-                    let map = VectorMap::new(&maps).expect("covered");
+                    let map = VectorMap::of(maps.diffuse.as_ref().expect("set")).expect("covered");
                     for _ in 0..200 {
                         let mut u = [0f32; 8];
                         let mut v = [0f32; 8];
@@ -470,7 +548,7 @@ mod tests {
                         for got in builds {
                             for i in 0..8 {
                                 for c in 0..3 {
-                                    let e = (got[c][i] / 255.0 - want[i][c]).abs();
+                                    let e = (got[c][i] * map.unit - want[i][c]).abs();
                                     worst = worst.max(e);
                                     assert!(
                                         e < 1e-4,
@@ -478,7 +556,7 @@ mod tests {
                                         u[i],
                                         v[i],
                                         [d[0][i], d[1][i], d[2][i], d[3][i]],
-                                        got[c][i] / 255.0,
+                                        got[c][i] * map.unit,
                                         want[i][c]
                                     );
                                 }

@@ -28,6 +28,8 @@ pub trait Vf32: Copy {
     /// The texels `texels[y·width + x]` of the lanes (`x`, `y` whole numbers, clamped into
     /// `width × height`; NaN reads 0) as their red, green and blue, each `0.0..=255.0`.
     fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3];
+    /// [`Vf32::gather_rgb8`] of 16-bit texels: each channel `0.0..=65535.0`.
+    fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3];
     /// From an array.
     fn from_array(a: Self::A) -> Self;
     /// To an array.
@@ -102,17 +104,11 @@ impl Vf32 for Portable {
     type M = [bool; 8];
     #[inline(always)]
     fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
-        let mut out = [Portable([0.0; 8]); 3];
-        for i in 0..8 {
-            // `as` saturates and maps NaN to 0.
-            let xi = (x.0[i] as i64).clamp(0, i64::from(width) - 1) as usize;
-            let yi = (y.0[i] as i64).clamp(0, i64::from(height) - 1) as usize;
-            let t = texels.get(yi * width as usize + xi).copied().unwrap_or_default();
-            for (o, c) in out.iter_mut().zip(t) {
-                o.0[i] = f32::from(c);
-            }
-        }
-        out
+        gather_portable(texels, width, height, x, y)
+    }
+    #[inline(always)]
+    fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+        gather_portable(texels, width, height, x, y)
     }
     #[inline(always)]
     fn splat(x: f32) -> Self {
@@ -233,6 +229,28 @@ impl Vf32 for Portable {
     }
 }
 
+/// [`Vf32::gather_rgb8`] and `gather_rgb16` lane by lane.
+#[inline(always)]
+fn gather_portable<T: Copy + Default + Into<f32>>(
+    texels: &[[T; 4]],
+    width: u32,
+    height: u32,
+    x: Portable,
+    y: Portable,
+) -> [Portable; 3] {
+    let mut out = [Portable([0.0; 8]); 3];
+    for i in 0..8 {
+        // `as` saturates and maps NaN to 0.
+        let xi = (x.0[i] as i64).clamp(0, i64::from(width) - 1) as usize;
+        let yi = (y.0[i] as i64).clamp(0, i64::from(height) - 1) as usize;
+        let t = texels.get(yi * width as usize + xi).copied().unwrap_or_default();
+        for (o, c) in out.iter_mut().zip(t) {
+            o.0[i] = c.into();
+        }
+    }
+    out
+}
+
 #[cfg(target_arch = "x86_64")]
 pub use avx2::{Avx2, Avx2x2};
 
@@ -250,6 +268,27 @@ mod avx2 {
     // access beyond the arrays passed by reference). They are sound to execute only on a CPU
     // with AVX2 and FMA: this type is only instantiated by `crate::simd`'s `#[target_feature]`
     // entry points, which are only called when `avx2_available()` returned true.
+    /// `y·w + x` per lane, `x` clamped into `0..w` and `y` into `0..h` (a NaN or out-of-range
+    /// conversion gives i32::MIN, clamped to 0): below `w·h`. Needs AVX2 (callers are the
+    /// gathers below, inside `avx2,fma` functions).
+    #[inline(always)]
+    fn texel_index(w: usize, h: usize, x: __m256, y: __m256) -> __m256i {
+        // SAFETY: AVX2 is present (the callers' contract, see the impl below); register
+        // arithmetic only.
+        unsafe {
+            let zero = _mm256_setzero_si256();
+            let xi = _mm256_min_epi32(
+                _mm256_max_epi32(_mm256_cvttps_epi32(x), zero),
+                _mm256_set1_epi32(w as i32 - 1),
+            );
+            let yi = _mm256_min_epi32(
+                _mm256_max_epi32(_mm256_cvttps_epi32(y), zero),
+                _mm256_set1_epi32(h as i32 - 1),
+            );
+            _mm256_add_epi32(_mm256_mullo_epi32(yi, _mm256_set1_epi32(w as i32)), xi)
+        }
+    }
+
     impl Vf32 for Avx2 {
         const N: usize = 8;
         type A = [f32; 8];
@@ -261,27 +300,40 @@ mod avx2 {
                 w >= 1 && h >= 1 && texels.len() >= w * h && w * h <= i32::MAX as usize,
                 "a level's texels fit its size"
             );
-            // SAFETY: AVX2 is present (see above). Every index is `y·w + x` with `x` clamped
-            // into `0..w` and `y` into `0..h` (a NaN or out-of-range conversion gives i32::MIN,
-            // clamped to 0), so below `w·h <= texels.len()` and within i32: each gathered i32
-            // is the 4 bytes of one texel of `texels` (unaligned reads are allowed).
+            // SAFETY: AVX2 is present (see above). `texel_index` is below `w·h <=
+            // texels.len()`: each gathered i32 is the 4 bytes of one texel of `texels`
+            // (unaligned reads are allowed).
             unsafe {
-                let zero = _mm256_setzero_si256();
-                let xi = _mm256_min_epi32(
-                    _mm256_max_epi32(_mm256_cvttps_epi32(x.0), zero),
-                    _mm256_set1_epi32(w as i32 - 1),
-                );
-                let yi = _mm256_min_epi32(
-                    _mm256_max_epi32(_mm256_cvttps_epi32(y.0), zero),
-                    _mm256_set1_epi32(h as i32 - 1),
-                );
-                let idx = _mm256_add_epi32(_mm256_mullo_epi32(yi, _mm256_set1_epi32(w as i32)), xi);
+                let idx = texel_index(w, h, x.0, y.0);
                 let g = _mm256_i32gather_epi32::<4>(texels.as_ptr().cast::<i32>(), idx);
                 let byte = _mm256_set1_epi32(0xff);
                 [
                     Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(g, byte))),
                     Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<8>(g), byte))),
                     Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<16>(g), byte))),
+                ]
+            }
+        }
+        #[inline(always)]
+        fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+            let (w, h) = (width as usize, height as usize);
+            assert!(
+                w >= 1 && h >= 1 && texels.len() >= w * h && 2 * w * h <= i32::MAX as usize,
+                "a level's texels fit its size"
+            );
+            // SAFETY: AVX2 is present (see above). A texel is two i32: red and green at
+            // `2·index`, blue and alpha at `2·index + 1`, with `index = texel_index(..) < w·h
+            // <= texels.len()`, so both within `texels` and within i32 (checked above).
+            unsafe {
+                let idx = _mm256_slli_epi32::<1>(texel_index(w, h, x.0, y.0));
+                let base = texels.as_ptr().cast::<i32>();
+                let rg = _mm256_i32gather_epi32::<4>(base, idx);
+                let ba = _mm256_i32gather_epi32::<4>(base, _mm256_add_epi32(idx, _mm256_set1_epi32(1)));
+                let low = _mm256_set1_epi32(0xffff);
+                [
+                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(rg, low))),
+                    Avx2(_mm256_cvtepi32_ps(_mm256_srli_epi32::<16>(rg))),
+                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(ba, low))),
                 ]
             }
         }
@@ -503,6 +555,12 @@ mod avx2 {
         fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
             let a = Avx2::gather_rgb8(texels, width, height, x.0, y.0);
             let b = Avx2::gather_rgb8(texels, width, height, x.1, y.1);
+            [Avx2x2(a[0], b[0]), Avx2x2(a[1], b[1]), Avx2x2(a[2], b[2])]
+        }
+        #[inline(always)]
+        fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
+            let a = Avx2::gather_rgb16(texels, width, height, x.0, y.0);
+            let b = Avx2::gather_rgb16(texels, width, height, x.1, y.1);
             [Avx2x2(a[0], b[0]), Avx2x2(a[1], b[1]), Avx2x2(a[2], b[2])]
         }
         #[inline(always)]
