@@ -126,6 +126,7 @@ impl Gpu {
             maps_layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
+            textures: Mutex::new(Vec::new()),
             kernels: std::sync::OnceLock::new(),
             path: GpuPath::Auto,
             item_capacity: ITEM_CAPACITY,

@@ -238,6 +238,9 @@ pub struct Gpu {
     pub(crate) maps_layout: wgpu::BindGroupLayout,
     pub(crate) pipeline_layout: wgpu::PipelineLayout,
     pub(crate) pipelines: Mutex<HashMap<(u32, bool, bool), wgpu::RenderPipeline>>,
+    /// Textures uploaded, kept while the CPU's texture lives (frames of one scene upload each
+    /// texture once; a freed texture's entry is dropped at the next frame).
+    pub(crate) textures: Mutex<Vec<(std::sync::Weak<phong_core::Texture>, wgpu::TextureView)>>,
     pub(crate) kernels: std::sync::OnceLock<Result<Kernels, String>>,
     pub(crate) path: GpuPath,
     pub(crate) item_capacity: u32,

@@ -8,7 +8,6 @@
 
 use crate::{Gpu, GpuMaps};
 use phong_core::{Channel, Filter, Maps, MipFilter, Texture, TextureMap, Wrap};
-use std::collections::HashMap;
 use std::sync::Arc;
 
 /// The maps' order in [`GpuMaps`] and the group's bindings (textures at 1.., samplers at 10..).
@@ -161,7 +160,19 @@ impl Gpu {
         let white = Texture::new(1, 1, &[[u16::MAX; 4]], 8).expect("a 1×1 texture");
         let white_view = self.upload_texture(&white);
         let plain = self.device.create_sampler(&Default::default());
-        let mut views: HashMap<*const Texture, wgpu::TextureView> = HashMap::new();
+        let mut cache = self.textures.lock().unwrap_or_else(|e| e.into_inner());
+        cache.retain(|(t, _)| t.strong_count() > 0);
+        let mut view_of = |t: &Arc<Texture>| -> wgpu::TextureView {
+            let found = cache
+                .iter()
+                .find(|(w, _)| w.upgrade().is_some_and(|u| Arc::ptr_eq(&u, t)));
+            if let Some((_, v)) = found {
+                return v.clone();
+            }
+            let v = self.upload_texture(t);
+            cache.push((Arc::downgrade(t), v.clone()));
+            v
+        };
         objects
             .iter()
             .map(|(maps, blends, colors, alpha)| {
@@ -222,9 +233,7 @@ impl Gpu {
                     let l = m.transform.linear;
                     params.transforms[2 * k] = [l.x_axis.x, l.x_axis.y, l.y_axis.x, l.y_axis.y];
                     params.transforms[2 * k + 1] = [m.transform.offset.x, m.transform.offset.y, 0.0, 0.0];
-                    let key = Arc::as_ptr(&m.texture);
-                    views.entry(key).or_insert_with(|| self.upload_texture(&m.texture));
-                    texture_views.push(Some(key));
+                    texture_views.push(Some(view_of(&m.texture)));
                     samplers.push(Some(self.sampler(m)));
                 }
                 let uniform = self.buffer_init("maps", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
@@ -233,7 +242,7 @@ impl Gpu {
                     resource: uniform.as_entire_binding(),
                 }];
                 for k in 0..SLOTS {
-                    let view = texture_views[k].and_then(|key| views.get(&key)).unwrap_or(&white_view);
+                    let view = texture_views[k].as_ref().unwrap_or(&white_view);
                     entries.push(wgpu::BindGroupEntry {
                         binding: 1 + k as u32,
                         resource: wgpu::BindingResource::TextureView(view),

@@ -720,3 +720,38 @@ fn normal_maps_match_the_cpu() {
     let (g, _) = gpu.render(&scene).unwrap();
     compare("normal maps", &scene, &g, 2, 0.005);
 }
+
+/// Textures are uploaded once per texture, not per frame: a second frame of the same scene is
+/// the same image; a scene whose map is a new texture (the same address possible once the
+/// old one is freed) draws the new one.
+#[test]
+fn textures_are_kept_between_frames_and_replaced_when_new() {
+    let Some(gpu) = gpu() else { return };
+    let mut scene = load("tour.toml");
+    scene.image.width = 64;
+    scene.image.height = 48;
+    let one = |rgb: [u16; 3]| std::sync::Arc::new(Texture::new(1, 1, &[[rgb[0], rgb[1], rgb[2], 65535]], 8).unwrap());
+    let set = |scene: &mut Scene, t: std::sync::Arc<Texture>| {
+        for o in &mut scene.objects {
+            o.maps.diffuse = Some(TextureMap::new(t.clone()));
+        }
+    };
+    set(&mut scene, one([65535, 0, 0]));
+    let (a, _) = gpu.render(&scene).unwrap();
+    let (b, _) = gpu.render(&scene).unwrap();
+    assert_eq!(a.to_bytes(Encoding::Linear, false), b.to_bytes(Encoding::Linear, false));
+    set(&mut scene, one([0, 0, 65535]));
+    let (c, _) = gpu.render(&scene).unwrap();
+    let cpu = phong_raster::render(&scene, &Default::default()).unwrap();
+    let (x, y) = (
+        cpu.to_bytes(Encoding::Linear, false),
+        c.to_bytes(Encoding::Linear, false),
+    );
+    let worst = x.iter().zip(&y).map(|(p, q)| p.abs_diff(*q)).max().unwrap();
+    let red = y.chunks(3).filter(|p| p[0] > 40 && p[2] < 10).count();
+    assert!(
+        red == 0,
+        "{red} pixels still drawn with the old texture (largest difference {worst})"
+    );
+    assert!(y.chunks(3).any(|p| p[2] > 40), "the new texture is drawn");
+}
