@@ -170,6 +170,15 @@ impl NormalMap {
         transform: UvTransform,
     ) -> Result<NormalMap, crate::Error> {
         let (w, h) = (height.width(), height.height());
+        // The 16-bit result with its mipmaps, checked before it is allocated.
+        let bytes = u64::from(w) * u64::from(h) * 8 * 4 / 3;
+        if bytes > crate::limits::MAX_TEXTURE_BYTES {
+            return Err(crate::Error::OutOfRange {
+                what: "normal map made from a bump map, with its mipmaps (bytes)",
+                range: "at most 2 GiB",
+                value: bytes as f32,
+            });
+        }
         let at = |x: u32, y: u32| channel.of(height.texel(0, x, y));
         let step = |i: u32, n: u32, d: i64, wrap: crate::Wrap| -> u32 {
             let j = i64::from(i) + d;
