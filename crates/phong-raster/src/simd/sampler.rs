@@ -113,43 +113,42 @@ impl<'a> VectorMaps<'a> {
     }
 }
 
-/// `x.floor()` for whole-number-safe `|x| < 2^22`: rounded, then one less where that rounded up.
+/// `x.floor()` (for `|x| < 2^22`, where the sampler uses it).
 #[inline(always)]
 fn floor<V: Vf32>(x: V) -> V {
-    let r = x.round();
-    V::select(r.gt(x), r.sub(V::splat(1.0)), r)
+    x.floor()
 }
 
 // No closures below: a closure is not compiled with its caller's AVX2, and its intrinsics
 // become calls.
 
-/// Whole numbers `i` modulo `p` into `0..p` (the quotient's rounding can leave `r` one
-/// period out).
+/// Whole numbers `i` modulo `p` into `0..p`, `inv` about `1/p` (the quotient's rounding can
+/// leave `r` one period out).
 #[inline(always)]
-fn modulo<V: Vf32>(i: V, p: V) -> V {
+fn modulo<V: Vf32>(i: V, p: V, inv: V) -> V {
     let zero = V::splat(0.0);
-    let r = i.sub(p.mul(floor(i.mul(p.recip()))));
+    let r = i.sub(p.mul(floor(i.mul(inv))));
     let r = V::select(r.lt(zero), r.add(p), r);
     V::select(r.ge(p), r.sub(p), r)
 }
 
-/// Mirrored repeat of whole numbers `i` into `0..n`.
+/// Mirrored repeat of whole numbers `i` into `0..n` (`inv` about `1/n`).
 #[inline(always)]
-fn mirror<V: Vf32>(i: V, n: V) -> V {
+fn mirror<V: Vf32>(i: V, n: V, inv: V) -> V {
     let two = n.add(n);
-    let p = modulo(i, two);
+    let p = modulo(i, two, inv.mul(V::splat(0.5)));
     V::select(p.lt(n), p, two.sub(V::splat(1.0)).sub(p))
 }
 
-/// Whole numbers `i` wrapped into `0..n` (`n` per lane), as `phong_core`'s `wrap`: `(wrap(i),
-/// wrap(i + 1))`.
+/// Whole numbers `i` wrapped into `0..n` (`n` per lane, `inv` about `1/n`), as `phong_core`'s
+/// `wrap`: `(wrap(i), wrap(i + 1))`.
 #[inline(always)]
-fn wrap_pair<V: Vf32>(mode: Wrap, i: V, n: V) -> (V, V) {
+fn wrap_pair<V: Vf32>(mode: Wrap, i: V, n: V, inv: V) -> (V, V) {
     let one = V::splat(1.0);
     let zero = V::splat(0.0);
     match mode {
         Wrap::Repeat => {
-            let a = modulo(i, n);
+            let a = modulo(i, n, inv);
             let b = a.add(one);
             (a, V::select(b.ge(n), zero, b))
         }
@@ -157,7 +156,7 @@ fn wrap_pair<V: Vf32>(mode: Wrap, i: V, n: V) -> (V, V) {
             let last = n.sub(one);
             (i.max(zero).min(last), i.add(one).max(zero).min(last))
         }
-        Wrap::Mirror => (mirror(i, n), mirror(i.add(one), n)),
+        Wrap::Mirror => (mirror(i, n, inv), mirror(i.add(one), n, inv)),
     }
 }
 
@@ -201,21 +200,21 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
         (lo as usize, (hi as usize).min(map.count - 1))
     };
     // A level's size: the halved size rounded down, at least 1 (one level: its own).
-    let (w, h) = if lo == hi {
-        (V::splat(map.levels[lo].0 as f32), V::splat(map.levels[lo].1 as f32))
+    let (w, h, inv_w, inv_h) = if lo == hi {
+        let (w, h) = (map.levels[lo].0 as f32, map.levels[lo].1 as f32);
+        (V::splat(w), V::splat(h), V::splat(1.0 / w), V::splat(1.0 / h))
     } else {
         let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
         let scale = level.mul(V::splat(-1.0)).pow2i();
-        (
-            floor(V::splat(w0).mul(scale)).max(one),
-            floor(V::splat(h0).mul(scale)).max(one),
-        )
+        let w = floor(V::splat(w0).mul(scale)).max(one);
+        let h = floor(V::splat(h0).mul(scale)).max(one);
+        (w, h, w.recip(), h.recip())
     };
     let (fx, fy) = (u.mul_add(w, V::splat(-0.5)), v.mul_add(h, V::splat(-0.5)));
     let (ix, iy) = (floor(fx), floor(fy));
     let (a, b) = (fx.sub(ix), fy.sub(iy));
-    let (x0, x1) = wrap_pair(map.wrap.0, ix, w);
-    let (y0, y1) = wrap_pair(map.wrap.1, iy, h);
+    let (x0, x1) = wrap_pair(map.wrap.0, ix, w, inv_w);
+    let (y0, y1) = wrap_pair(map.wrap.1, iy, h, inv_h);
     let weights = [
         one.sub(a).mul(one.sub(b)),
         a.mul(one.sub(b)),

@@ -78,6 +78,8 @@ pub trait Vf32: Copy {
     fn pow2i(self) -> Self;
     /// Round to the nearest integer, ties to even.
     fn round(self) -> Self;
+    /// Round down (`|x| < 2^22`: larger values are whole already, or kept).
+    fn floor(self) -> Self;
     /// Transposes `N` rows of 8 floats (lane `i` takes row `i`) into 8 vectors: vector `j`
     /// holds element `j` of every row. How a batch gathers its lanes' plane coefficients
     /// (8 loads and 24 shuffles per 8 lanes in the AVX2 build, instead of 64 scalar stores and
@@ -216,6 +218,11 @@ impl Vf32 for Portable {
             let x = self.0[i];
             if x.abs() < 4_194_304.0 { (x + MAGIC) - MAGIC } else { x }
         }))
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        let r = self.round();
+        Portable(lanes(|i| if r.0[i] > self.0[i] { r.0[i] - 1.0 } else { r.0[i] }))
     }
     #[inline(always)]
     fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
@@ -495,6 +502,11 @@ mod avx2 {
             Avx2(unsafe { _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0) })
         }
         #[inline(always)]
+        fn floor(self) -> Self {
+            // SAFETY: AVX is present (see above).
+            Avx2(unsafe { _mm256_round_ps::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(self.0) })
+        }
+        #[inline(always)]
         fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
             let rows: &[&[f32; 8]; 8] = rows.try_into().expect("8 rows for 8 lanes");
             // SAFETY: AVX is present (see above); each row is 8 readable f32 (unaligned loads).
@@ -672,6 +684,10 @@ mod avx2 {
         #[inline(always)]
         fn round(self) -> Self {
             both!(self, round)
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            both!(self, floor)
         }
         #[inline(always)]
         fn transpose(rows: &[&[f32; 8]]) -> [Self; 8] {
