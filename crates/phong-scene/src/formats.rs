@@ -117,6 +117,7 @@ pub fn load_model_full(
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
 ) -> Result<LoadedModel, Error> {
+    let _budget = crate::texture_file::TextureBudget::start();
     let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
     sources.push(path.to_path_buf());
     let format = model_format(path, &bytes)?;
@@ -192,6 +193,7 @@ pub fn parse_model_bytes_with(
     bytes: &[u8],
     resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
 ) -> Result<LoadedModel, Error> {
+    let _budget = crate::texture_file::TextureBudget::start();
     read_bytes(path, bytes, model_format(path, bytes)?, resource, &mut Vec::new())
 }
 

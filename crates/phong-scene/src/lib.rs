@@ -76,6 +76,7 @@ pub fn is_model_path(path: &Path) -> bool {
 
 /// [`load`], a model alone viewed as `options` says (a scene file ignores them).
 pub fn load_with(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
+    let _budget = texture_file::TextureBudget::start();
     texture_file::take_stats();
     let mut loaded = load_without_stats(path, options)?;
     loaded.textures = texture_file::take_stats();

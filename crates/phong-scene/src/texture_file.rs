@@ -37,6 +37,58 @@ pub fn take_stats() -> TextureStats {
     STATS.with(|s| s.replace(TextureStats::default()))
 }
 
+thread_local! {
+    /// Bytes of textures the load under way on this thread may still decode (`None`: no load
+    /// keeps count; each texture is still held to its own limit).
+    static BUDGET: Cell<Option<u64>> = const { Cell::new(None) };
+}
+
+/// One scene's texture memory, mipmaps included, held to `MAX_TEXTURE_BYTES` across all its
+/// loaders (scene keys, OBJs, glTFs): the loaders' entry points hold one while they read; a
+/// nested one (a scene's model) shares the outer one's count.
+pub(crate) struct TextureBudget {
+    owner: bool,
+}
+
+impl TextureBudget {
+    /// Counts this thread's textures from here until it is dropped (unless a count is running).
+    pub(crate) fn start() -> TextureBudget {
+        TextureBudget::with_limit(MAX_TEXTURE_BYTES)
+    }
+
+    fn with_limit(limit: u64) -> TextureBudget {
+        let owner = BUDGET.with(|b| b.get().is_none());
+        if owner {
+            BUDGET.with(|b| b.set(Some(limit)));
+        }
+        TextureBudget { owner }
+    }
+}
+
+impl Drop for TextureBudget {
+    fn drop(&mut self) {
+        if self.owner {
+            BUDGET.with(|b| b.set(None));
+        }
+    }
+}
+
+/// Takes `bytes` from the running count; an error where they do not fit.
+fn spend(bytes: u64) -> Result<(), String> {
+    BUDGET.with(|b| match b.get() {
+        Some(left) if bytes > left => Err(format!(
+            "the scene's textures would pass {} MiB with its {} MiB (MAX_TEXTURE_BYTES counts them all, mipmaps included)",
+            MAX_TEXTURE_BYTES >> 20,
+            bytes >> 20
+        )),
+        Some(left) => {
+            b.set(Some(left - bytes));
+            Ok(())
+        }
+        None => Ok(()),
+    })
+}
+
 /// Which map of a material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
@@ -131,7 +183,9 @@ impl TextureCache {
             Source::File(f) => read(f),
             Source::Bytes(b, _) => Ok(b.to_vec()),
         };
-        let r = bytes.and_then(|b| decode_timed(&b, srgb, start)).map(Arc::new);
+        let r = bytes
+            .and_then(|b| decode_timed(&b, srgb, start))
+            .and_then(|t| spend(t.bytes()).map(|()| Arc::new(t)));
         self.done.insert(key, r.clone());
         r
     }
@@ -277,7 +331,10 @@ pub fn resolve(
             }
             Slot::Bump => {
                 let channel = r.channel.unwrap_or(Channel::Luminance);
-                match NormalMap::from_height(&map.texture, channel, r.scale, r.sampler, r.transform) {
+                let made = NormalMap::from_height(&map.texture, channel, r.scale, r.sampler, r.transform)
+                    .map_err(|e| e.to_string())
+                    .and_then(|n| spend(n.map.texture.bytes()).map(|()| n));
+                match made {
                     Ok(n) => maps.normal = Some(n),
                     Err(why) => warnings.push(format!(
                         "{}: material {name}: bump map {} not used: {why}",
@@ -437,6 +494,38 @@ mod tests {
         assert!(parse_mtl_map("map_Kd", &["-clamp", "maybe", "a.png"]).is_err());
         assert!(parse_mtl_map("map_Kd", &["-s", "2"]).is_err());
         assert!(parse_mtl_map("refl", &["a.png"]).unwrap().is_none());
+    }
+
+    /// A scene's textures are held to one budget across its loaders: past it, a texture is
+    /// refused with a message naming the limit, and a texture already read is not counted
+    /// twice; nested budgets share the outer count, and none runs after the outer one ends.
+    #[test]
+    fn the_scenes_textures_share_one_budget() {
+        let mut png = Vec::new();
+        image::RgbImage::from_pixel(8, 8, image::Rgb([1, 2, 3]))
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let read = |_: &str| Ok(png.clone());
+        let bytes = decode(&png, false).unwrap().bytes();
+        {
+            let _outer = TextureBudget::with_limit(2 * bytes);
+            let _inner = TextureBudget::start();
+            let mut cache = TextureCache::default();
+            assert!(cache.load(&Source::File("a.png".into()), false, &read).is_ok());
+            assert!(
+                cache.load(&Source::File("a.png".into()), false, &read).is_ok(),
+                "read once"
+            );
+            let mut other = TextureCache::default();
+            assert!(other.load(&Source::File("b.png".into()), false, &read).is_ok());
+            let e = other.load(&Source::File("c.png".into()), false, &read).unwrap_err();
+            assert!(e.contains("MAX_TEXTURE_BYTES"), "{e}");
+        }
+        let mut cache = TextureCache::default();
+        assert!(
+            cache.load(&Source::File("d.png".into()), false, &read).is_ok(),
+            "no count left running"
+        );
     }
 
     #[test]

@@ -181,6 +181,7 @@ pub fn load_obj_text(
     read_texture: &ReadFile,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ObjPart>, Error> {
+    let _budget = crate::texture_file::TextureBudget::start();
     let prepared = prepare_obj(path, src)?;
     warnings.extend(prepared.notes.iter().cloned());
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();

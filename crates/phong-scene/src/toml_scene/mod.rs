@@ -39,6 +39,7 @@ pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
 
 /// [`parse_scene`] with meshes from `meshes` instead of the file system (when given).
 pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, Error> {
+    let _budget = crate::texture_file::TextureBudget::start();
     let raw: RawScene = toml::from_str(src).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
         // The whole line the error is on (an error at a key's start, as "duplicate key", has
