@@ -857,6 +857,52 @@ fn loading_an_obj_renders_it() {
             s.idle().await
         })
         .await;
+        s.step("a textured OBJ: the probe shows its texels", async {
+            let dir = obj.parent().context("dir")?;
+            std::fs::write(
+                dir.join("quad.obj"),
+                "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3 4/4\n",
+            )?;
+            std::fs::write(dir.join("quad.mtl"), "newmtl t\nKa 1 1 1\nKd 1 1 1\nmap_Kd green.png\n")?;
+            let f = std::fs::File::create(dir.join("green.png"))?;
+            let mut e = png::Encoder::new(std::io::BufWriter::new(f), 2, 2);
+            e.set_color(png::ColorType::Rgb);
+            e.write_header()?.write_image_data(&[0, 200, 0].repeat(4))?;
+            s.client
+                .find(Locator::Id("load-model"))
+                .await?
+                .send_keys(&format!(
+                    "{}\n{}\n{}",
+                    dir.join("quad.obj").display(),
+                    dir.join("quad.mtl").display(),
+                    dir.join("green.png").display()
+                ))
+                .await?;
+            let t0 = Instant::now();
+            while s.js("return (window.phong.loaded || {}).name || null;").await? != json!("quad.obj") {
+                ensure!(t0.elapsed() < Duration::from_secs(10), "quad.obj not loaded");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            s.idle().await?;
+            s.js("window.phong.probe = null; return true;").await?;
+            let frame = s.client.find(Locator::Id("frame")).await?;
+            s.gesture(frame, (0.0, 0.0), &[], 0).await?;
+            let t0 = Instant::now();
+            loop {
+                let p = s.js("return window.phong.probe || null;").await?;
+                if !p.is_null() {
+                    let t = &p["hit"]["texture"];
+                    ensure!(t["diffuse"][1].as_f64().is_some_and(|g| (g - 200.0 / 255.0).abs() < 1e-3), "texels {t}");
+                    let body = s.js("return document.getElementById('probe-body').textContent;").await?;
+                    let body = body.as_str().unwrap_or("");
+                    ensure!(body.contains("TKd") && body.contains("uv"), "the panel shows the texels: {body}");
+                    return Ok(());
+                }
+                ensure!(t0.elapsed() < Duration::from_secs(10), "no probe answer");
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+        })
+        .await;
         s.step("a broken OBJ says why", async {
             let bad = obj.with_file_name("bad.obj");
             std::fs::write(&bad, "v 1 2\nf 1 2 3\n")?;
