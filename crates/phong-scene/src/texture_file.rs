@@ -234,10 +234,12 @@ fn decode_with(bytes: &[u8], srgb: bool, mipmaps: &mut Duration) -> Result<Textu
     };
     let (w, h) = (img.width(), img.height());
     if bits == 8 && !srgb {
-        let rgba = img.into_rgba8();
-        let texels: &[[u8; 4]] = rgba.as_raw().as_chunks().0;
+        let rgba = img.into_rgba8().into_raw();
         let start = Instant::now();
-        let t = Texture::from_rgba8(w, h, texels).map_err(|e| e.to_string());
+        // The decoder's buffer becomes level 0 where its allocation allows (no copy).
+        let texels: Vec<[u8; 4]> =
+            bytemuck::allocation::try_cast_vec(rgba).unwrap_or_else(|(_, bytes)| bytes.as_chunks::<4>().0.to_vec());
+        let t = Texture::from_rgba8_vec(w, h, texels).map_err(|e| e.to_string());
         *mipmaps += start.elapsed();
         return t;
     }
