@@ -452,6 +452,27 @@ fn random_texture(r: &mut Rng, w: u32, h: u32, cell: u32) -> std::sync::Arc<Text
     std::sync::Arc::new(Texture::new(w, h, &texels, 8).unwrap())
 }
 
+/// A sphere and a floor below it, each with `material` and `maps`, shaded as `scene`'s first
+/// object: the textured tests' objects.
+fn sphere_and_floor(scene: &Scene, material: Material, maps: &Maps) -> Vec<Object> {
+    let floor = primitives::plane(8).transformed(&glam::Mat4::from_scale_rotation_translation(
+        Vec3::splat(4.0),
+        glam::Quat::IDENTITY,
+        Vec3::new(0.0, -1.0, 0.0),
+    ));
+    let shading = scene.objects[0].shading;
+    [primitives::sphere(48), floor]
+        .into_iter()
+        .map(|mesh| Object {
+            name: "textured".into(),
+            mesh,
+            material,
+            shading,
+            maps: maps.clone(),
+        })
+        .collect()
+}
+
 /// Textured objects on the GPU (the render pipeline, its textures, samplers and the CPU's
 /// mipmaps) against the CPU: a sphere and a floor with a diffuse and a specular map, each
 /// interpolation, magnified with bilinear filtering and minified with trilinear. Where the
@@ -467,13 +488,6 @@ fn textured_objects_match_the_cpu() {
     let mut scene = load("tour.toml");
     scene.image.width = 200;
     scene.image.height = 150;
-    let sphere = primitives::sphere(48);
-    let floor = primitives::plane(8).transformed(&glam::Mat4::from_scale_rotation_translation(
-        Vec3::splat(4.0),
-        glam::Quat::IDENTITY,
-        Vec3::new(0.0, -1.0, 0.0),
-    ));
-    let shading = scene.objects[0].shading;
     let material = Material::new(
         Color::splat(0.3),
         Color::splat(0.9),
@@ -498,16 +512,7 @@ fn textured_objects_match_the_cpu() {
             specular: Some(map(&specular)),
             ..Maps::default()
         };
-        scene.objects = [sphere.clone(), floor.clone()]
-            .into_iter()
-            .map(|mesh| Object {
-                name: "textured".into(),
-                mesh,
-                material,
-                shading,
-                maps: maps.clone(),
-            })
-            .collect();
+        scene.objects = sphere_and_floor(&scene, material, &maps);
         for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
             for o in &mut scene.objects {
                 o.shading.interpolation = interp;
@@ -532,12 +537,6 @@ fn metal_rough_and_occlusion_match_the_cpu() {
     let mut scene = load("tour.toml");
     scene.image.width = 200;
     scene.image.height = 150;
-    let floor = primitives::plane(8).transformed(&glam::Mat4::from_scale_rotation_translation(
-        Vec3::splat(4.0),
-        glam::Quat::IDENTITY,
-        Vec3::new(0.0, -1.0, 0.0),
-    ));
-    let shading = scene.objects[0].shading;
     let map = |t: std::sync::Arc<Texture>| TextureMap {
         texture: t,
         sampler: Sampler::bilinear(Wrap::Repeat),
@@ -561,16 +560,7 @@ fn metal_rough_and_occlusion_match_the_cpu() {
         ..Maps::default()
     };
     let material = mr.material(Color::new(0.05, 0.0, 0.0), 1.0);
-    scene.objects = [primitives::sphere(48), floor]
-        .into_iter()
-        .map(|mesh| Object {
-            name: "pbr".into(),
-            mesh,
-            material,
-            shading,
-            maps: maps.clone(),
-        })
-        .collect();
+    scene.objects = sphere_and_floor(&scene, material, &maps);
     for interp in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong] {
         for o in &mut scene.objects {
             o.shading.interpolation = interp;

@@ -142,6 +142,18 @@ fn mesa(exe: &PathBuf, scene: &Scene) -> Vec<u8> {
     out.stdout
 }
 
+/// Per pixel, the largest channel difference between phong's image of `scene` and Mesa's.
+fn differences(exe: &PathBuf, scene: &Scene) -> Vec<u8> {
+    let ours = render(scene, &RenderOptions::default())
+        .unwrap()
+        .to_bytes(Encoding::Linear, false);
+    let theirs = mesa(exe, scene);
+    ours.chunks(3)
+        .zip(theirs.chunks(3))
+        .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0))
+        .collect()
+}
+
 fn scene_with(
     mesh: Mesh,
     m: Material,
@@ -278,18 +290,10 @@ fn lighting_cases(interpolation: Interpolation, share: f64, largest: u8) {
         let viewer = if case % 2 == 0 { Viewer::Local } else { Viewer::Infinite };
         let mut scene = scene_with(geometry(), m, lights, r.c() * 0.3, eye, viewer, two_sided);
         scene.objects[0].shading.interpolation = interpolation;
-        let ours = render(&scene, &RenderOptions::default())
-            .unwrap()
-            .to_bytes(Encoding::Linear, false);
-        let theirs = mesa(&exe, &scene);
-        let n = ours.len() / 3;
-        let mut off = 0;
-        let mut max = 0u8;
-        for (a, b) in ours.chunks(3).zip(theirs.chunks(3)) {
-            let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-            max = max.max(d);
-            off += usize::from(d > 1);
-        }
+        let diffs = differences(&exe, &scene);
+        let n = diffs.len();
+        let max = diffs.iter().copied().max().unwrap_or(0);
+        let off = diffs.iter().filter(|&&d| d > 1).count();
         let frac = off as f64 / n as f64;
         worst_frac = worst_frac.max(frac);
         eprintln!("{interpolation:?} case {case}: {off} of {n} pixels differ by more than 1/255 (largest {max}/255)");
@@ -380,15 +384,11 @@ fn textured_opengl_model_matches_mesa() {
         scene.objects[0].maps.diffuse = Some(map);
         for interpolation in [Interpolation::Gouraud, Interpolation::Phong] {
             scene.objects[0].shading.interpolation = interpolation;
-            let ours = render(&scene, &RenderOptions::default())
-                .unwrap()
-                .to_bytes(Encoding::Linear, false);
-            let theirs = mesa(&exe, &scene);
-            let n = ours.len() / 3;
+            let diffs = differences(&exe, &scene);
+            let n = diffs.len();
             let (mut off, mut max) = (0usize, 0u8);
             let mut hist = [0usize; 4];
-            for (a, b) in ours.chunks(3).zip(theirs.chunks(3)) {
-                let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+            for &d in &diffs {
                 max = max.max(d);
                 off += usize::from(d > 2);
                 hist[match d {
