@@ -289,6 +289,17 @@ rotation = [0.0, 90.0, 0.0]
             o.maps.specular = Some(TextureMap::new(specular.clone()));
         }
         assert_fast_matches_reference(&scene, &format!("{interpolation}, diffuse and specular maps"));
+        // And vertex colours tinting the diffuse texel.
+        for o in &mut scene.objects {
+            let colors = o
+                .mesh
+                .positions()
+                .iter()
+                .map(|p| Color::new(0.5 + 0.5 * p.x.sin(), 0.5 + 0.5 * p.z.cos(), 0.7))
+                .collect();
+            o.mesh = o.mesh.clone().with_colors(colors).unwrap();
+        }
+        assert_fast_matches_reference(&scene, &format!("{interpolation}, maps and vertex colours"));
         // Clipping happened: some triangles are clipped into polygons.
         let aspect = scene.image.width as f32 / scene.image.height as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);

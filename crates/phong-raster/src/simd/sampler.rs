@@ -5,7 +5,7 @@
 //! ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
 //!
 //! It covers the common cases, decided once per draw ([`VectorMaps::new`]): a diffuse map, a
-//! specular map or both and no other, 8 or 16 bits, linear filters, no vertex colours. A
+//! specular map or both and no other, 8 or 16 bits, linear filters, vertex colours or not. A
 //! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
 //! caller's per-pixel sampler.
 
@@ -72,6 +72,8 @@ impl<'a> VectorMap<'a> {
 pub struct VectorMaps<'a> {
     diffuse: Option<VectorMap<'a>>,
     specular: Option<VectorMap<'a>>,
+    /// Vertex colours multiply the diffuse texel (`Texels::tinted`).
+    tinted: bool,
 }
 
 impl<'a> VectorMaps<'a> {
@@ -109,7 +111,14 @@ impl<'a> VectorMaps<'a> {
         Some(VectorMaps {
             diffuse: of(diffuse)?,
             specular: of(specular)?,
+            tinted: false,
         })
+    }
+
+    /// These maps, the diffuse texel tinted by the mesh's vertex colours where `tinted` (their
+    /// planes are the coordinates' planes' `attr[2..5]`).
+    pub fn tinted(self, tinted: bool) -> VectorMaps<'a> {
+        VectorMaps { tinted, ..self }
     }
 }
 
@@ -361,6 +370,15 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
                 p.attr[1][0],
                 p.attr[1][1],
                 p.attr[1][2],
+                p.attr[2][0],
+                p.attr[2][1],
+                p.attr[2][2],
+                p.attr[3][0],
+                p.attr[3][1],
+                p.attr[3][2],
+                p.attr[4][0],
+                p.attr[4][1],
+                p.attr[4][2],
             ]
         };
         let mut xs = V::A::default();
@@ -373,13 +391,13 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             ys.as_mut()[i] = y;
             shared &= std::ptr::eq(p, first);
         }
-        let mut k = [zero; 11];
+        let mut k = [zero; 20];
         if shared {
             for (v, c) in k.iter_mut().zip(coefficients(first)) {
                 *v = V::splat(c);
             }
         } else {
-            let mut a = [V::A::default(); 11];
+            let mut a = [V::A::default(); 20];
             for i in 0..V::N {
                 let f = coefficients(lane(start + i.min(m - 1)).3);
                 for (kk, v) in a.iter_mut().zip(f) {
@@ -412,6 +430,14 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             Some(m) => Some(mapped(m, uv)),
             None => None,
         };
+        // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
+        let mut tint = [one; 3];
+        if maps.tinted {
+            for (c, t) in tint.iter_mut().enumerate() {
+                let i = 11 + 3 * c;
+                *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
+            }
+        }
         let mut primary_a = [V::A::default(); 3];
         let mut specular_a = [V::A::default(); 3];
         if matches!(td, Some(None)) || matches!(ts, Some(None)) {
@@ -430,7 +456,8 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
         let mut rgb = [V::A::default(); 3];
         for c in 0..3 {
             let p = match td {
-                Some(t) => primary[c].mul(t[c]),
+                Some(t) => primary[c].mul(t[c].mul(tint[c])),
+                None if maps.tinted => primary[c].mul(tint[c]),
                 None => primary[c],
             };
             let s = match ts {

@@ -219,7 +219,7 @@ impl Frame<'_> {
             let c = lit.modulate(&texels, clamp);
             [c.r, c.g, c.b]
         };
-        if let Some(maps) = VectorMaps::new(&obj.maps).filter(|_| !tinted) {
+        if let Some(maps) = VectorMaps::new(&obj.maps).map(|m| m.tinted(tinted)) {
             let out = std::cell::RefCell::new(out);
             shade_batch_textured(
                 self.isa,
