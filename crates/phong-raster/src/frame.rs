@@ -4,7 +4,7 @@
 
 use crate::fixed::pattern;
 use crate::setup::{Chunk, Corners, ID_INDEX_BITS, SampleSpan, Scratch, Tri};
-use crate::simd::{Batch, Isa, Planes, Prepared, Term};
+use crate::simd::{Batch, Isa, Planes, Prepared, Term, VectorMaps};
 use crate::stats::{RenderStats, StageClock};
 use crate::target::{Pixel, resolve};
 use crate::{Error, RenderOptions};
@@ -28,10 +28,10 @@ pub(crate) enum Mode {
     Phong(Prepared, Term),
     /// Interpolated vertex colours.
     Gouraud,
-    /// A textured object's colour with one sample a pixel, Phong-interpolated: its light by
-    /// the vector kernel (`shade_batch_lit`), its maps sampled per pixel from the planes of its
-    /// texture coordinates (the ambient, emission and shininess maps, which change the light,
-    /// are [`Mode::Scalar`]'s).
+    /// A textured object's colour with one sample a pixel, Phong-interpolated: light and maps
+    /// by the vector sampler where it covers the maps ([`Frame::vector_maps`]), else the light
+    /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
+    /// of its texture coordinates (maps that change the light are [`Mode::Scalar`]'s).
     Textured(Prepared),
     /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
     /// depth outputs).
@@ -66,6 +66,9 @@ pub(crate) struct Frame<'a> {
     pub isa: Isa,
     /// Per object: how the fast path shades it.
     pub modes: Vec<Mode>,
+    /// Per object: its maps as the vector sampler reads them, for a [`Mode::Textured`] object
+    /// whose maps it covers (decided once per frame).
+    pub vector_maps: Vec<Option<VectorMaps<'a>>>,
     /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
     pub gouraud_only: bool,
     /// Per object: its view vector rule.
@@ -143,6 +146,15 @@ impl<'a> Frame<'a> {
             path,
             isa,
             gouraud_only: path == Path::Fast && modes.iter().all(|m| matches!(m, Mode::Gouraud)),
+            vector_maps: scene
+                .objects
+                .iter()
+                .zip(&modes)
+                .map(|(o, m)| match m {
+                    Mode::Textured(_) => VectorMaps::new(&o.maps).map(|v| v.tinted(!o.mesh.colors().is_empty())),
+                    _ => None,
+                })
+                .collect(),
             modes,
             views,
             w,

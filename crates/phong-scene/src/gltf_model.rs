@@ -130,6 +130,10 @@ pub fn read_gltf(
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut colours) = (0usize, 0usize);
     let mut cache = TextureCache::default();
+    // The white emission map below, one for the file (uploaded once by the GPU).
+    let white = std::sync::LazyLock::new(|| {
+        std::sync::Arc::new(phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture"))
+    });
     // Positions in f64 world space for all parts, re-centred together below.
     let mut pending: Vec<Pending> = Vec::new();
     let mut triangles_total: u64 = 0;
@@ -368,8 +372,7 @@ pub fn read_gltf(
                 // a white emission map keeps it apart.
                 let modulated = maps.diffuse.is_some() || maps.metal_rough.is_some();
                 if maps.emission.is_none() && modulated && material.is_some_and(|m| m.emission() != Color::BLACK) {
-                    let white = phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture");
-                    maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::new(white)));
+                    maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::clone(&white)));
                 }
                 maps
             } else {

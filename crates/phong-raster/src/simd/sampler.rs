@@ -122,12 +122,6 @@ impl<'a> VectorMaps<'a> {
     }
 }
 
-/// `x.floor()` (for `|x| < 2^22`, where the sampler uses it).
-#[inline(always)]
-fn floor<V: Vf32>(x: V) -> V {
-    x.floor()
-}
-
 // No closures below: a closure is not compiled with its caller's AVX2, and its intrinsics
 // become calls.
 
@@ -136,7 +130,7 @@ fn floor<V: Vf32>(x: V) -> V {
 #[inline(always)]
 fn modulo<V: Vf32>(i: V, p: V, inv: V) -> V {
     let zero = V::splat(0.0);
-    let r = i.sub(p.mul(floor(i.mul(inv))));
+    let r = i.sub(p.mul(i.mul(inv).floor()));
     let r = V::select(r.lt(zero), r.add(p), r);
     V::select(r.ge(p), r.sub(p), r)
 }
@@ -215,12 +209,12 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
     } else {
         let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
         let scale = level.mul(V::splat(-1.0)).pow2i();
-        let w = floor(V::splat(w0).mul(scale)).max(one);
-        let h = floor(V::splat(h0).mul(scale)).max(one);
+        let w = V::splat(w0).mul(scale).floor().max(one);
+        let h = V::splat(h0).mul(scale).floor().max(one);
         (w, h, w.recip(), h.recip())
     };
     let (fx, fy) = (u.mul_add(w, V::splat(-0.5)), v.mul_add(h, V::splat(-0.5)));
-    let (ix, iy) = (floor(fx), floor(fy));
+    let (ix, iy) = (fx.floor(), fy.floor());
     let (a, b) = (fx.sub(ix), fy.sub(iy));
     let (x0, x1) = wrap_pair(map.wrap.0, ix, w, inv_w);
     let (y0, y1) = wrap_pair(map.wrap.1, iy, h, inv_h);
@@ -273,7 +267,7 @@ fn sample<V: Vf32>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
         // λ > 0 exactly where ρ² > 1 (and not for NaN): minified.
         let minify = rho2.gt(one);
         let lod = half_log2(rho2).min(V::splat(last));
-        let whole = floor(lod);
+        let whole = lod.floor();
         (V::select(minify, whole, zero), V::select(minify, lod.sub(whole), zero))
     } else {
         (zero, zero)

@@ -12,7 +12,7 @@ use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
-use crate::simd::{Planes, VectorMaps, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group};
+use crate::simd::{Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group};
 use crate::stats::Marks;
 use crate::target::{Store, fill, resolve};
 use glam::{Vec2, Vec3};
@@ -219,12 +219,12 @@ impl Frame<'_> {
             let c = lit.modulate(&texels, clamp);
             [c.r, c.g, c.b]
         };
-        if let Some(maps) = VectorMaps::new(&obj.maps).map(|m| m.tinted(tinted)) {
+        if let Some(maps) = &self.vector_maps[object] {
             let out = std::cell::RefCell::new(out);
             shade_batch_textured(
                 self.isa,
                 prep,
-                &maps,
+                maps,
                 items.len(),
                 |i| {
                     let (p, id) = items[i];
