@@ -300,6 +300,13 @@ rotation = [0.0, 90.0, 0.0]
             o.mesh = o.mesh.clone().with_colors(colors).unwrap();
         }
         assert_fast_matches_reference(&scene, &format!("{interpolation}, maps and vertex colours"));
+        // Coordinates beyond the vector sampler's exact wrapping (2^21 texels): every vector
+        // is left to the per-pixel sampler, with the light the vector kernel gave it.
+        for o in &mut scene.objects {
+            let map = o.maps.diffuse.as_mut().expect("set above");
+            map.transform = UvTransform::scale_offset(glam::Vec2::splat(50.0), glam::Vec2::new(600_000.0, 0.0));
+        }
+        assert_fast_matches_reference(&scene, &format!("{interpolation}, coordinates past 2^21 texels"));
         // Clipping happened: some triangles are clipped into polygons.
         let aspect = scene.image.width as f32 / scene.image.height as f32;
         let clip_from_world = scene.camera.clip_from_world(aspect);

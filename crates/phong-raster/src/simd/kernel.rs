@@ -648,34 +648,67 @@ pub(crate) fn shade_group<V: Vf32>(
         Batch::Phong(..) => 6,
         Batch::Gouraud => 3,
     };
-    let coefficients = |[c, gx, gy]: [f32; 3]| (V::splat(c), V::splat(gx), V::splat(gy));
-    let inv_w = coefficients(planes.inv_w);
-    let mut attr = [(V::splat(0.0), V::splat(0.0), V::splat(0.0)); 6];
-    for (a, k) in attr.iter_mut().zip(&planes.attr).take(attrs) {
-        *a = coefficients(*k);
-    }
-    // The pixel centre relative to the planes' origin, as in `shade_batch`: (x + ½) − ox.
-    let (ox, oy) = (V::splat(planes.origin[0]), V::splat(planes.origin[1]));
+    let planes = Broadcast::<V>::new(planes, attrs);
     for chunk in pixels[..full].chunks_exact(V::N) {
-        let mut xs = V::A::default();
-        let mut ys = V::A::default();
-        for (i, &p) in chunk.iter().enumerate() {
-            xs.as_mut()[i] = (x0 + (p & 0xffff)) as f32 + 0.5;
-            ys.as_mut()[i] = (y0 + (p >> 16)) as f32 + 0.5;
-        }
-        let (dx, dy) = (V::from_array(xs).sub(ox), V::from_array(ys).sub(oy));
-        let eval = |(c, gx, gy): (V, V, V)| gy.mul_add(dy, gx.mul_add(dx, c));
-        let w = eval(inv_w).recip();
-        let mut q = [V::splat(0.0); 6];
-        for (o, k) in q.iter_mut().zip(attr).take(attrs) {
-            *o = eval(k).mul(w);
-        }
+        let (x, y) = centres::<V>((x0, y0), chunk);
+        let q = planes.at(x, y, attrs);
         let rgb = batch_color(batch, q).map(V::to_array);
         for (i, &p) in chunk.iter().enumerate() {
             out(p, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
         }
     }
     full
+}
+
+/// The centres of `pixels` (`row << 16 | column` from `(x0, y0)`), one per lane.
+#[inline(always)]
+pub(super) fn centres<V: Vf32>((x0, y0): (u32, u32), pixels: &[u32]) -> (V, V) {
+    let mut xs = V::A::default();
+    let mut ys = V::A::default();
+    for (i, &p) in pixels.iter().enumerate().take(V::N) {
+        xs.as_mut()[i] = (x0 + (p & 0xffff)) as f32 + 0.5;
+        ys.as_mut()[i] = (y0 + (p >> 16)) as f32 + 0.5;
+    }
+    (V::from_array(xs), V::from_array(ys))
+}
+
+/// One triangle's planes broadcast to every lane: its pixels interpolated without gathering
+/// coefficients lane by lane.
+pub(super) struct Broadcast<V> {
+    origin: (V, V),
+    inv_w: [V; 3],
+    attr: [[V; 3]; 6],
+}
+
+impl<V: Vf32> Broadcast<V> {
+    /// `planes`' origin, `1/w` and first `attrs` attributes, broadcast.
+    #[inline(always)]
+    pub(super) fn new(planes: &Planes, attrs: usize) -> Broadcast<V> {
+        let mut attr = [[V::splat(0.0); 3]; 6];
+        for (a, k) in attr.iter_mut().zip(&planes.attr).take(attrs) {
+            *a = [V::splat(k[0]), V::splat(k[1]), V::splat(k[2])];
+        }
+        let [c, gx, gy] = planes.inv_w;
+        Broadcast {
+            origin: (V::splat(planes.origin[0]), V::splat(planes.origin[1])),
+            inv_w: [V::splat(c), V::splat(gx), V::splat(gy)],
+            attr,
+        }
+    }
+
+    /// The first `attrs` attributes at pixel centres `(x, y)`, as [`interpolate`] computes them.
+    #[inline(always)]
+    pub(super) fn at(&self, x: V, y: V, attrs: usize) -> [V; 6] {
+        let (dx, dy) = (x.sub(self.origin.0), y.sub(self.origin.1));
+        let w = self.inv_w[2]
+            .mul_add(dy, self.inv_w[1].mul_add(dx, self.inv_w[0]))
+            .recip();
+        let mut q = [V::splat(0.0); 6];
+        for (o, k) in q.iter_mut().zip(&self.attr).take(attrs) {
+            *o = k[2].mul_add(dy, k[1].mul_add(dx, k[0])).mul(w);
+        }
+        q
+    }
 }
 
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.

@@ -19,7 +19,7 @@ mod vector;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
 pub use project::WindowVertex;
-pub use sampler::VectorMaps;
+pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
 pub use tile::{GouraudTri, TilePixel, gouraud_tile};
 
@@ -117,15 +117,15 @@ fn shade_batch_textured_avx2<'p>(
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     out: impl FnMut(usize, [f32; 3]),
-    fallback: impl FnMut(usize, [f32; 3], [f32; 3]),
+    unsampled: &mut Vec<Unsampled<usize>>,
 ) {
-    sampler::shade_batch_textured::<vector::Avx2x2>(prep, maps, n, lane, out, fallback)
+    sampler::shade_batch_textured::<vector::Avx2x2>(prep, maps, n, lane, out, unsampled)
 }
 
 /// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
-/// covers ([`VectorMaps`]): `lane(i)` gives pixel `i`'s centre, its triangle's planes
-/// and its texture coordinates' planes; `out(i, rgb)` takes its colour, `fallback(i, primary,
-/// specular)` its light where the map must be sampled per pixel (see `sampler.rs`).
+/// covers ([`VectorMaps`]): `lane(i)` gives pixel `i`'s centre, its triangle's planes and its
+/// texture coordinates' planes; `out(i, rgb)` takes its colour, or `unsampled` its light where
+/// the maps must be sampled per pixel ([`Unsampled`]).
 #[inline]
 pub fn shade_batch_textured<'p>(
     isa: Isa,
@@ -134,16 +134,53 @@ pub fn shade_batch_textured<'p>(
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     out: impl FnMut(usize, [f32; 3]),
-    fallback: impl FnMut(usize, [f32; 3], [f32; 3]),
+    unsampled: &mut Vec<Unsampled<usize>>,
 ) {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        unsafe { shade_batch_textured_avx2(prep, maps, n, lane, out, fallback) };
+        unsafe { shade_batch_textured_avx2(prep, maps, n, lane, out, unsampled) };
         return;
     }
     let _ = isa;
-    sampler::shade_batch_textured::<vector::Portable>(prep, maps, n, lane, out, fallback)
+    sampler::shade_batch_textured::<vector::Portable>(prep, maps, n, lane, out, unsampled)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn shade_group_textured_avx2(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    planes: (&Planes, &Planes),
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, [f32; 3]),
+    unsampled: &mut Vec<Unsampled<u32>>,
+) -> usize {
+    sampler::shade_group_textured::<vector::Avx2x2>(prep, maps, planes, origin, pixels, out, unsampled)
+}
+
+/// [`shade_batch_textured`] for the pixels of one triangle, its planes and its coordinates'
+/// planes broadcast (as [`shade_group`]): whole vectors only; returns how many of `pixels`
+/// (from the start) were shaded.
+#[inline]
+pub fn shade_group_textured(
+    isa: Isa,
+    prep: &Prepared,
+    maps: &VectorMaps,
+    planes: (&Planes, &Planes),
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, [f32; 3]),
+    unsampled: &mut Vec<Unsampled<u32>>,
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        return unsafe { shade_group_textured_avx2(prep, maps, planes, origin, pixels, out, unsampled) };
+    }
+    let _ = isa;
+    sampler::shade_group_textured::<vector::Portable>(prep, maps, planes, origin, pixels, out, unsampled)
 }
 
 #[cfg(target_arch = "x86_64")]

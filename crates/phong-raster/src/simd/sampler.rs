@@ -9,7 +9,7 @@
 //! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
 //! caller's per-pixel sampler.
 
-use super::kernel::{Planes, Prepared, lanes, position_normal, shade};
+use super::kernel::{Broadcast, Planes, Prepared, centres, lanes, position_normal, shade};
 use super::vector::Vf32;
 use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
 
@@ -310,11 +310,154 @@ fn mapped<V: Vf32>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
     Some(t)
 }
 
-/// [`super::kernel::shade_batch_lit`] with the diffuse and specular maps applied by the vector sampler:
-/// `out(i, rgb)` takes `clamp(clamp(P)⊗T_Kd + clamp(S)⊗T_Ks)` (phong-core's `Lit::modulate`, clamps
-/// where the options clamp). `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of
-/// its texture coordinates. A vector whose coordinates the sampler cannot wrap exactly (NaN,
-/// or beyond ±2^21 texels) goes to `fallback(i, primary, specular)`, lane by lane.
+/// A pixel the vector sampler leaves to the caller's per-pixel sampler, with its light
+/// (primary, specular: clamped where the options clamp): its vector's coordinates could not
+/// be wrapped exactly (NaN, or beyond ±2^21 texels).
+pub type Unsampled<I> = (I, [f32; 3], [f32; 3]);
+
+/// The coordinates' planes (`origin`, `1/w`, `u/w`, `v/w`, then the vertex colours over `w`)
+/// as 20 floats.
+#[inline(always)]
+fn uv_coefficients(p: &Planes) -> [f32; 20] {
+    let a = &p.attr;
+    [
+        p.origin[0],
+        p.origin[1],
+        p.inv_w[0],
+        p.inv_w[1],
+        p.inv_w[2],
+        a[0][0],
+        a[0][1],
+        a[0][2],
+        a[1][0],
+        a[1][1],
+        a[1][2],
+        a[2][0],
+        a[2][1],
+        a[2][2],
+        a[3][0],
+        a[3][1],
+        a[3][2],
+        a[4][0],
+        a[4][1],
+        a[4][2],
+    ]
+}
+
+/// One vector of pixels at centres `(x, y)`, with interpolated position and normal `q` and the
+/// coordinates' planes `k` ([`uv_coefficients`] per lane): lit, textured and combined; `Err`
+/// with the light where the sampler cannot wrap the coordinates exactly.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn textured<V: Vf32>(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    q: [V; 6],
+    (x, y): (V, V),
+    k: &[V; 20],
+) -> Result<[V; 3], ([V; 3], [V; 3])> {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let (pos, nrm) = position_normal(q);
+    let t = shade(prep, pos, nrm);
+    let mut primary = [zero; 3];
+    let mut specular = [zero; 3];
+    for c in 0..3 {
+        let (mut p, mut s) = (t.ambient[c].add(t.diffuse[c]), t.specular[c]);
+        if prep.options.clamp {
+            p = p.max(zero).min(one);
+            s = s.max(zero).min(one);
+        }
+        primary[c] = p;
+        specular[c] = s;
+    }
+    let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
+    // `c + gx·dx + gy·dy` of the planes at 2 (1/w), 5 (u/w) and 8 (v/w).
+    let mut p = [zero; 3];
+    for (j, i) in [2, 5, 8].into_iter().enumerate() {
+        p[j] = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy));
+    }
+    let rq = p[0].recip();
+    let (u, v) = (p[1].mul(rq), p[2].mul(rq));
+    let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
+    let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
+    let uv = [u, v, ux, vx, uy, vy];
+    // (Matches, not closures: see `modulo`.)
+    #[allow(clippy::manual_map)]
+    let td = match &maps.diffuse {
+        Some(m) => Some(mapped(m, uv)),
+        None => None,
+    };
+    #[allow(clippy::manual_map)]
+    let ts = match &maps.specular {
+        Some(m) => Some(mapped(m, uv)),
+        None => None,
+    };
+    if matches!(td, Some(None)) || matches!(ts, Some(None)) {
+        return Err((primary, specular));
+    }
+    // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
+    let mut tint = [one; 3];
+    if maps.tinted {
+        for (c, t) in tint.iter_mut().enumerate() {
+            let i = 11 + 3 * c;
+            *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
+        }
+    }
+    let (td, ts) = (td.flatten(), ts.flatten());
+    let mut rgb = [zero; 3];
+    for c in 0..3 {
+        let p = match td {
+            Some(t) => primary[c].mul(t[c].mul(tint[c])),
+            None if maps.tinted => primary[c].mul(tint[c]),
+            None => primary[c],
+        };
+        let s = match ts {
+            Some(t) => specular[c].mul(t[c]),
+            None => specular[c],
+        };
+        let mut x = p.add(s);
+        x = V::select(x.finite(), x, zero);
+        if prep.options.clamp {
+            x = x.max(zero).min(one);
+        }
+        rgb[c] = x;
+    }
+    Ok(rgb)
+}
+
+/// Hands the first `m` lanes of a [`textured`] result to `out(lane, rgb)`, or their light to
+/// `unsampled` with their index `at(lane)`.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn emit<V: Vf32, I>(
+    r: Result<[V; 3], ([V; 3], [V; 3])>,
+    m: usize,
+    at: impl Fn(usize) -> I,
+    mut out: impl FnMut(I, [f32; 3]),
+    unsampled: &mut Vec<Unsampled<I>>,
+) {
+    match r {
+        Ok(rgb) => {
+            let rgb = rgb.map(V::to_array);
+            for i in 0..m {
+                out(at(i), [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
+            }
+        }
+        Err((p, s)) => {
+            let (p, s) = (p.map(V::to_array), s.map(V::to_array));
+            for i in 0..m {
+                let (p, s) = ([0, 1, 2].map(|c| p[c].as_ref()[i]), [0, 1, 2].map(|c| s[c].as_ref()[i]));
+                unsampled.push((at(i), p, s));
+            }
+        }
+    }
+}
+
+/// [`super::kernel::shade_batch_lit`] with the diffuse and specular maps applied by the vector
+/// sampler: `out(i, rgb)` takes pixel `i`'s colour, `clamp(clamp(P)⊗T_Kd + clamp(S)⊗T_Ks)`
+/// (phong-core's `Lit::modulate`, clamps where the options clamp), or `unsampled` its light.
+/// `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of its texture
+/// coordinates.
 #[inline(always)]
 pub(crate) fn shade_batch_textured<'p, V: Vf32>(
     prep: &Prepared,
@@ -322,9 +465,8 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
     mut out: impl FnMut(usize, [f32; 3]),
-    mut fallback: impl FnMut(usize, [f32; 3], [f32; 3]),
+    unsampled: &mut Vec<Unsampled<usize>>,
 ) {
-    let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(
@@ -336,45 +478,7 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             n,
             6,
         );
-        let (pos, nrm) = position_normal(q);
-        let t = shade(prep, pos, nrm);
-        let mut primary = [zero; 3];
-        let mut specular = [zero; 3];
-        for c in 0..3 {
-            let (mut p, mut s) = (t.ambient[c].add(t.diffuse[c]), t.specular[c]);
-            if prep.options.clamp {
-                p = p.max(zero).min(one);
-                s = s.max(zero).min(one);
-            }
-            primary[c] = p;
-            specular[c] = s;
-        }
-        // The texture coordinates and their screen derivatives, from each lane's planes:
-        // broadcast where one triangle has every lane (large triangles), else gathered.
-        let coefficients = |p: &Planes| {
-            [
-                p.origin[0],
-                p.origin[1],
-                p.inv_w[0],
-                p.inv_w[1],
-                p.inv_w[2],
-                p.attr[0][0],
-                p.attr[0][1],
-                p.attr[0][2],
-                p.attr[1][0],
-                p.attr[1][1],
-                p.attr[1][2],
-                p.attr[2][0],
-                p.attr[2][1],
-                p.attr[2][2],
-                p.attr[3][0],
-                p.attr[3][1],
-                p.attr[3][2],
-                p.attr[4][0],
-                p.attr[4][1],
-                p.attr[4][2],
-            ]
-        };
+        // The coordinates' planes: broadcast where one triangle has every lane, else gathered.
         let mut xs = V::A::default();
         let mut ys = V::A::default();
         let first = lane(start).3;
@@ -385,15 +489,15 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             ys.as_mut()[i] = y;
             shared &= std::ptr::eq(p, first);
         }
-        let mut k = [zero; 20];
+        let mut k = [V::splat(0.0); 20];
         if shared {
-            for (v, c) in k.iter_mut().zip(coefficients(first)) {
+            for (v, c) in k.iter_mut().zip(uv_coefficients(first)) {
                 *v = V::splat(c);
             }
         } else {
             let mut a = [V::A::default(); 20];
             for i in 0..V::N {
-                let f = coefficients(lane(start + i.min(m - 1)).3);
+                let f = uv_coefficients(lane(start + i.min(m - 1)).3);
                 for (kk, v) in a.iter_mut().zip(f) {
                     kk.as_mut()[i] = v;
                 }
@@ -402,74 +506,38 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
                 *v = V::from_array(a);
             }
         }
-        let (dx, dy) = (V::from_array(xs).sub(k[0]), V::from_array(ys).sub(k[1]));
-        // `c + gx·dx + gy·dy` of the planes at 2 (1/w), 5 (u/w) and 8 (v/w).
-        let mut p = [zero; 3];
-        for (j, i) in [2, 5, 8].into_iter().enumerate() {
-            p[j] = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy));
-        }
-        let rq = p[0].recip();
-        let (u, v) = (p[1].mul(rq), p[2].mul(rq));
-        let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
-        let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
-        let uv = [u, v, ux, vx, uy, vy];
-        // (Matches, not closures: see `modulo`.)
-        #[allow(clippy::manual_map)]
-        let td = match &maps.diffuse {
-            Some(m) => Some(mapped(m, uv)),
-            None => None,
-        };
-        #[allow(clippy::manual_map)]
-        let ts = match &maps.specular {
-            Some(m) => Some(mapped(m, uv)),
-            None => None,
-        };
-        // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
-        let mut tint = [one; 3];
-        if maps.tinted {
-            for (c, t) in tint.iter_mut().enumerate() {
-                let i = 11 + 3 * c;
-                *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
-            }
-        }
-        let mut primary_a = [V::A::default(); 3];
-        let mut specular_a = [V::A::default(); 3];
-        if matches!(td, Some(None)) || matches!(ts, Some(None)) {
-            for c in 0..3 {
-                primary_a[c] = primary[c].to_array();
-                specular_a[c] = specular[c].to_array();
-            }
-            for i in 0..m {
-                let at = |a: &[V::A; 3]| [0, 1, 2].map(|c| a[c].as_ref()[i]);
-                fallback(start + i, at(&primary_a), at(&specular_a));
-            }
-            start += m;
-            continue;
-        }
-        let (td, ts) = (td.flatten(), ts.flatten());
-        let mut rgb = [V::A::default(); 3];
-        for c in 0..3 {
-            let p = match td {
-                Some(t) => primary[c].mul(t[c].mul(tint[c])),
-                None if maps.tinted => primary[c].mul(tint[c]),
-                None => primary[c],
-            };
-            let s = match ts {
-                Some(t) => specular[c].mul(t[c]),
-                None => specular[c],
-            };
-            let mut x = p.add(s);
-            x = V::select(x.finite(), x, zero);
-            if prep.options.clamp {
-                x = x.max(zero).min(one);
-            }
-            rgb[c] = x.to_array();
-        }
-        for i in 0..m {
-            out(start + i, [0, 1, 2].map(|c| rgb[c].as_ref()[i]));
-        }
+        let r = textured(prep, maps, q, (V::from_array(xs), V::from_array(ys)), &k);
+        emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
+}
+
+/// [`shade_batch_textured`] for the pixels of one triangle, its `planes` and coordinates'
+/// planes `uv` broadcast (as [`super::kernel::shade_group`]): `pixels` are `row << 16 |
+/// column` from `origin`, `out(pixel, rgb)` takes each one's colour or `unsampled` its light.
+/// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
+#[inline(always)]
+pub(crate) fn shade_group_textured<V: Vf32>(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    (planes, uv): (&Planes, &Planes),
+    origin: (u32, u32),
+    pixels: &[u32],
+    mut out: impl FnMut(u32, [f32; 3]),
+    unsampled: &mut Vec<Unsampled<u32>>,
+) -> usize {
+    let full = pixels.len() / V::N * V::N;
+    if full == 0 {
+        return 0;
+    }
+    let planes = Broadcast::<V>::new(planes, 6);
+    let k = uv_coefficients(uv).map(V::splat);
+    for chunk in pixels[..full].chunks_exact(V::N) {
+        let (x, y) = centres::<V>(origin, chunk);
+        let r = textured(prep, maps, planes.at(x, y, 6), (x, y), &k);
+        emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
+    }
+    full
 }
 
 #[cfg(test)]

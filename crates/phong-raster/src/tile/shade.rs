@@ -12,7 +12,9 @@ use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
-use crate::simd::{Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group};
+use crate::simd::{
+    Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group, shade_group_textured,
+};
 use crate::stats::Marks;
 use crate::target::{Store, fill, resolve};
 use glam::{Vec2, Vec3};
@@ -126,14 +128,38 @@ impl Frame<'_> {
         let mut textured: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
         let group = group_lanes(self.isa);
+        let mut unsampled = Vec::new();
         for (k, &id) in bin.iter().enumerate() {
             let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
             if pixels.is_empty() {
                 continue;
             }
             let object = self.object(id);
-            if let Mode::Textured(_) = self.modes[object] {
-                textured[object].extend(pixels.iter().map(|&p| (p, id)));
+            if let Mode::Textured(prep) = &self.modes[object] {
+                // Whole vectors of one triangle with its planes broadcast where the vector
+                // sampler covers the maps; the rest batched with the object's other pixels.
+                let done = match &self.vector_maps[object] {
+                    Some(maps) if pixels.len() >= group => shade_group_textured(
+                        self.isa,
+                        prep,
+                        maps,
+                        (self.planes(id), self.uv_planes(id)),
+                        (x0, y0),
+                        pixels,
+                        |p, rgb| {
+                            let (r, c) = at(p);
+                            out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                        },
+                        &mut unsampled,
+                    ),
+                    _ => 0,
+                };
+                for (p, primary, specular) in unsampled.drain(..) {
+                    let (r, c) = at(p);
+                    let rgb = self.textured_color(object, (p, id), (x0, y0), primary, specular);
+                    out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                }
+                textured[object].extend(pixels[done..].iter().map(|&p| (p, id)));
                 continue;
             }
             let Some(kind) = self.modes[object].batch() else {
@@ -186,9 +212,8 @@ impl Frame<'_> {
     }
 
     /// Shades a textured object's pixels `items` (`(row << 16 | column, triangle id)` in the
-    /// tile at `(x0, y0)`): their light by the vector kernel, then per pixel the texture
-    /// coordinates and their exact derivatives from the triangle's planes, the maps sampled and
-    /// applied as phong-core's `Lit::modulate`.
+    /// tile at `(x0, y0)`): by the vector sampler where it covers the maps, else their light by
+    /// the vector kernel and their maps sampled per pixel ([`Frame::textured_color`]).
     fn shade_textured_batch(
         &self,
         object: usize,
@@ -198,29 +223,9 @@ impl Frame<'_> {
         y0: u32,
         mut out: impl FnMut((u32, u32), [f32; 3]),
     ) {
-        let obj = &self.scene.objects[object];
-        let clamp = obj.shading.options.clamp;
-        let tinted = !obj.mesh.colors().is_empty();
         let centre = |p: u32| ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
-        // One pixel's colour from its light, its map sampled here (`Lit::modulate`).
-        let per_pixel = |i: usize, primary: [f32; 3], specular: [f32; 3]| {
-            let (p, id) = items[i];
-            let (x, y) = centre(p);
-            let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
-            let mut texels = obj.maps.sample(uv, d_dx, d_dy);
-            if tinted {
-                texels = texels.tinted(rgb);
-            }
-            let lit = Lit {
-                primary: Color::new(primary[0], primary[1], primary[2]),
-                specular: Color::new(specular[0], specular[1], specular[2]),
-                ..Lit::default()
-            };
-            let c = lit.modulate(&texels, clamp);
-            [c.r, c.g, c.b]
-        };
         if let Some(maps) = &self.vector_maps[object] {
-            let out = std::cell::RefCell::new(out);
+            let mut unsampled = Vec::new();
             shade_batch_textured(
                 self.isa,
                 prep,
@@ -231,9 +236,15 @@ impl Frame<'_> {
                     let (x, y) = centre(p);
                     (x, y, self.planes(id), self.uv_planes(id))
                 },
-                |i, rgb| (out.borrow_mut())(items[i], rgb),
-                |i, primary, specular| (out.borrow_mut())(items[i], per_pixel(i, primary, specular)),
+                |i, rgb| out(items[i], rgb),
+                &mut unsampled,
             );
+            for (i, primary, specular) in unsampled {
+                out(
+                    items[i],
+                    self.textured_color(object, items[i], (x0, y0), primary, specular),
+                );
+            }
             return;
         }
         shade_batch_lit(
@@ -245,8 +256,40 @@ impl Frame<'_> {
                 let (x, y) = centre(p);
                 (x, y, self.planes(id))
             },
-            |i, primary, specular| out(items[i], per_pixel(i, primary, specular)),
+            |i, primary, specular| {
+                out(
+                    items[i],
+                    self.textured_color(object, items[i], (x0, y0), primary, specular),
+                )
+            },
         );
+    }
+
+    /// The colour of a textured pixel (`(row << 16 | column, triangle id)` in the tile at
+    /// `(x0, y0)`) from its light (primary, specular): its maps sampled at the coordinates and
+    /// exact derivatives of the triangle's planes and applied (`Lit::modulate`).
+    fn textured_color(
+        &self,
+        object: usize,
+        (p, id): (u32, u32),
+        (x0, y0): (u32, u32),
+        primary: [f32; 3],
+        specular: [f32; 3],
+    ) -> [f32; 3] {
+        let obj = &self.scene.objects[object];
+        let (x, y) = ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
+        let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
+        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        if !obj.mesh.colors().is_empty() {
+            texels = texels.tinted(rgb);
+        }
+        let lit = Lit {
+            primary: Color::new(primary[0], primary[1], primary[2]),
+            specular: Color::new(specular[0], specular[1], specular[2]),
+            ..Lit::default()
+        };
+        let c = lit.modulate(&texels, obj.shading.options.clamp);
+        [c.r, c.g, c.b]
     }
 
     /// The shading of a tile of several samples a pixel after visibility (`ids`: per sample,
