@@ -166,8 +166,7 @@ fn shade_group_textured_avx2(
 #[inline]
 pub fn shade_group_textured(
     isa: Isa,
-    prep: &Prepared,
-    maps: &VectorMaps,
+    (prep, maps): (&Prepared, &VectorMaps),
     planes: (&Planes, &Planes),
     origin: (u32, u32),
     pixels: &[u32],

@@ -141,8 +141,7 @@ impl Frame<'_> {
                 let done = match &self.vector_maps[object] {
                     Some(maps) if pixels.len() >= group => shade_group_textured(
                         self.isa,
-                        prep,
-                        maps,
+                        (prep, maps),
                         (self.planes(id), self.uv_planes(id)),
                         (x0, y0),
                         pixels,
