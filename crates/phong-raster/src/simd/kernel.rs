@@ -23,7 +23,7 @@ use phong_core::{Color, Light, Lighting, LyonLambda, Material, Normalization, Sh
 /// Lanes of `shade8`.
 pub const LANES: usize = 8;
 /// The most lanes of any `Vf32` implementation.
-const MAX_LANES: usize = 16;
+pub(super) const MAX_LANES: usize = 16;
 
 /// Three lanes of vectors.
 #[derive(Clone, Copy)]
@@ -711,13 +711,12 @@ impl<V: Vf32> Broadcast<V> {
     }
 }
 
-/// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
+/// The first `rows` rows of 8 of the lanes' planes' 24 floats as vectors (the rest 0):
+/// broadcast when one triangle has every lane (the usual case in large triangles), else
+/// gathered by transposing each lane's rows.
 #[inline(always)]
-fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
-    // The planes' 24 floats as vectors: broadcast when one triangle has all lanes (the usual
-    // case in large triangles), else gathered by transposing each lane's rows.
+pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], rows: usize) -> [V; 24] {
     let mut k = [V::splat(0.0); 24];
-    let rows = if attrs > 3 { 3 } else { 2 };
     if planes.iter().all(|p| std::ptr::eq(*p, planes[0])) {
         let f = bytemuck::cast_ref::<_, [f32; 24]>(planes[0]);
         for (v, &c) in k.iter_mut().zip(f).take(rows * 8) {
@@ -732,6 +731,13 @@ fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] 
             k[r * 8..r * 8 + 8].copy_from_slice(&V::transpose(&lanes[..V::N]));
         }
     }
+    k
+}
+
+/// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
+#[inline(always)]
+fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
+    let k = coefficients::<V>(planes, if attrs > 3 { 3 } else { 2 });
     let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
     // `c + gx·dx + gy·dy` from floats `i..i + 3`.
     let plane = |i: usize| k[i + 2].mul_add(dy, k[i + 1].mul_add(dx, k[i]));

@@ -9,7 +9,7 @@
 //! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
 //! caller's per-pixel sampler.
 
-use super::kernel::{Broadcast, Planes, Prepared, centres, lanes, position_normal, shade};
+use super::kernel::{Broadcast, MAX_LANES, Planes, Prepared, centres, coefficients, lanes, position_normal, shade};
 use super::vector::Vf32;
 use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
 
@@ -31,6 +31,9 @@ pub struct VectorMap<'a> {
     wrap: (Wrap, Wrap),
     mipmaps: bool,
     transform: UvTransform,
+    /// 8-bit, repeated both ways, level 0 a power of two each way (and so every level):
+    /// [`Vf32::gather_quad_rgb8`] wraps and fetches.
+    quad8: bool,
     /// From storage units to `[0, 1]`: `1/255` or `1/65535`.
     unit: f32,
 }
@@ -62,6 +65,11 @@ impl<'a> VectorMap<'a> {
             wrap: (s.wrap_u, s.wrap_v),
             mipmaps: s.mip == MipFilter::Linear,
             transform: map.transform,
+            quad8: matches!(levels[0].2, Texels::Eight(_))
+                && s.wrap_u == Wrap::Repeat
+                && s.wrap_v == Wrap::Repeat
+                && levels[0].0.is_power_of_two()
+                && levels[0].1.is_power_of_two(),
             unit: if t.bits() == 8 { 1.0 / 255.0 } else { 1.0 / 65535.0 },
         })
     }
@@ -193,8 +201,14 @@ fn half_log2<V: Vf32>(rho2: V) -> V {
 #[inline(always)]
 fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
     let (zero, one, half) = (V::splat(0.0), V::splat(1.0), V::splat(0.5));
-    let (lo, hi) = {
-        let l = level.to_array();
+    // The lanes' levels: usually one (checked by vector), else scanned.
+    let l = level.to_array();
+    let first = l.as_ref()[0];
+    let one_level = !V::any(V::or(level.lt(V::splat(first)), level.gt(V::splat(first))));
+    let (lo, hi) = if one_level {
+        let f = (first as usize).min(map.count - 1);
+        (f, f)
+    } else {
         let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
         for &x in l.as_ref() {
             lo = lo.min(x);
@@ -216,14 +230,24 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
     let (fx, fy) = (u.mul_add(w, V::splat(-0.5)), v.mul_add(h, V::splat(-0.5)));
     let (ix, iy) = (fx.floor(), fy.floor());
     let (a, b) = (fx.sub(ix), fy.sub(iy));
-    let (x0, x1) = wrap_pair(map.wrap.0, ix, w, inv_w);
-    let (y0, y1) = wrap_pair(map.wrap.1, iy, h, inv_h);
     let weights = [
         one.sub(a).mul(one.sub(b)),
         a.mul(one.sub(b)),
         one.sub(a).mul(b),
         a.mul(b),
     ];
+    if let (true, true, Texels::Eight(t)) = (map.quad8, lo == hi, map.levels[lo].2) {
+        let (lw, lh) = (map.levels[lo].0, map.levels[lo].1);
+        let mut sum = [zero; 3];
+        for (texel, wt) in V::gather_quad_rgb8(t, lw, lh, ix, iy).into_iter().zip(weights) {
+            for c in 0..3 {
+                sum[c] = texel[c].mul_add(wt, sum[c]);
+            }
+        }
+        return sum;
+    }
+    let (x0, x1) = wrap_pair(map.wrap.0, ix, w, inv_w);
+    let (y0, y1) = wrap_pair(map.wrap.1, iy, h, inv_h);
     let mut out = [zero; 3];
     for l in lo..=hi {
         let (lw, lh, texels) = map.levels[l];
@@ -315,37 +339,8 @@ fn mapped<V: Vf32>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
 /// be wrapped exactly (NaN, or beyond ±2^21 texels).
 pub type Unsampled<I> = (I, [f32; 3], [f32; 3]);
 
-/// The coordinates' planes (`origin`, `1/w`, `u/w`, `v/w`, then the vertex colours over `w`)
-/// as 20 floats.
-#[inline(always)]
-fn uv_coefficients(p: &Planes) -> [f32; 20] {
-    let a = &p.attr;
-    [
-        p.origin[0],
-        p.origin[1],
-        p.inv_w[0],
-        p.inv_w[1],
-        p.inv_w[2],
-        a[0][0],
-        a[0][1],
-        a[0][2],
-        a[1][0],
-        a[1][1],
-        a[1][2],
-        a[2][0],
-        a[2][1],
-        a[2][2],
-        a[3][0],
-        a[3][1],
-        a[3][2],
-        a[4][0],
-        a[4][1],
-        a[4][2],
-    ]
-}
-
 /// One vector of pixels at centres `(x, y)`, with interpolated position and normal `q` and the
-/// coordinates' planes `k` ([`uv_coefficients`] per lane): lit, textured and combined; `Err`
+/// coordinates' planes `k` ([`coefficients`]): lit, textured and combined; `Err`
 /// with the light where the sampler cannot wrap the coordinates exactly.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
@@ -354,7 +349,7 @@ fn textured<V: Vf32>(
     maps: &VectorMaps,
     q: [V; 6],
     (x, y): (V, V),
-    k: &[V; 20],
+    k: &[V; 24],
 ) -> Result<[V; 3], ([V; 3], [V; 3])> {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (pos, nrm) = position_normal(q);
@@ -478,34 +473,18 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
             n,
             6,
         );
-        // The coordinates' planes: broadcast where one triangle has every lane, else gathered.
+        // The coordinates' planes (their `origin`, `1/w`, `u/w`, `v/w` and, tinted, the vertex
+        // colours over `w`: the planes' first 20 floats).
         let mut xs = V::A::default();
         let mut ys = V::A::default();
-        let first = lane(start).3;
-        let mut shared = true;
-        for i in 0..V::N {
-            let (x, y, _, p) = lane(start + i.min(m - 1));
+        let mut uv: [&Planes; MAX_LANES] = [lane(start).3; MAX_LANES];
+        for (i, p) in uv.iter_mut().enumerate().take(V::N) {
+            let (x, y, _, q) = lane(start + i.min(m - 1));
             xs.as_mut()[i] = x;
             ys.as_mut()[i] = y;
-            shared &= std::ptr::eq(p, first);
+            *p = q;
         }
-        let mut k = [V::splat(0.0); 20];
-        if shared {
-            for (v, c) in k.iter_mut().zip(uv_coefficients(first)) {
-                *v = V::splat(c);
-            }
-        } else {
-            let mut a = [V::A::default(); 20];
-            for i in 0..V::N {
-                let f = uv_coefficients(lane(start + i.min(m - 1)).3);
-                for (kk, v) in a.iter_mut().zip(f) {
-                    kk.as_mut()[i] = v;
-                }
-            }
-            for (v, a) in k.iter_mut().zip(a) {
-                *v = V::from_array(a);
-            }
-        }
+        let k = coefficients::<V>(&uv[..V::N], if maps.tinted { 3 } else { 2 });
         let r = textured(prep, maps, q, (V::from_array(xs), V::from_array(ys)), &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
@@ -531,7 +510,7 @@ pub(crate) fn shade_group_textured<V: Vf32>(
         return 0;
     }
     let planes = Broadcast::<V>::new(planes, 6);
-    let k = uv_coefficients(uv).map(V::splat);
+    let k = coefficients::<V>(&[uv], if maps.tinted { 3 } else { 2 });
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
         let r = textured(prep, maps, planes.at(x, y, 6), (x, y), &k);

@@ -28,6 +28,11 @@ pub trait Vf32: Copy {
     /// The texels `texels[y·width + x]` of the lanes (`x`, `y` whole numbers, clamped into
     /// `width × height`; NaN reads 0) as their red, green and blue, each `0.0..=255.0`.
     fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3];
+    /// The 2×2 texels from `(x, y)` of the lanes (`x`, `y` whole numbers of magnitude below
+    /// 2^31; NaN reads column or row 0) in a `width × height` image, both powers of two,
+    /// wrapped by repeat: `[(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]`, each as
+    /// [`Vf32::gather_rgb8`] gives it. The wrap is a mask, the row a shift.
+    fn gather_quad_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [[Self; 3]; 4];
     /// [`Vf32::gather_rgb8`] of 16-bit texels: each channel `0.0..=65535.0`.
     fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3];
     /// From an array.
@@ -111,6 +116,30 @@ impl Vf32 for Portable {
     #[inline(always)]
     fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
         gather_portable(texels, width, height, x, y)
+    }
+    #[inline(always)]
+    fn gather_quad_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [[Self; 3]; 4] {
+        assert!(
+            width.is_power_of_two() && height.is_power_of_two(),
+            "a repeated power-of-two image"
+        );
+        let mut out = [[Portable([0.0; 8]); 3]; 4];
+        let (wm, hm) = (width as i32 - 1, height as i32 - 1);
+        for i in 0..8 {
+            // `as` saturates and maps NaN to 0; the masks wrap two's complement by repeat.
+            let (xi, yi) = (x.0[i] as i32, y.0[i] as i32);
+            for (k, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+                let (xk, yk) = (xi.wrapping_add(dx) & wm, yi.wrapping_add(dy) & hm);
+                let t = texels
+                    .get(yk as usize * width as usize + xk as usize)
+                    .copied()
+                    .unwrap_or_default();
+                for (o, c) in out[k].iter_mut().zip(t) {
+                    o.0[i] = c.into();
+                }
+            }
+        }
+        out
     }
     #[inline(always)]
     fn splat(x: f32) -> Self {
@@ -296,6 +325,21 @@ mod avx2 {
         }
     }
 
+    /// Eight RGBA8 texels' red, green and blue as floats. Needs AVX2 (callers are the gathers
+    /// below, inside `avx2,fma` functions).
+    #[inline(always)]
+    fn rgb8(g: __m256i) -> [Avx2; 3] {
+        // SAFETY: AVX2 is present (the callers' contract); register arithmetic only.
+        unsafe {
+            let byte = _mm256_set1_epi32(0xff);
+            [
+                Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(g, byte))),
+                Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<8>(g), byte))),
+                Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<16>(g), byte))),
+            ]
+        }
+    }
+
     impl Vf32 for Avx2 {
         const N: usize = 8;
         type A = [f32; 8];
@@ -312,12 +356,35 @@ mod avx2 {
             // (unaligned reads are allowed).
             unsafe {
                 let idx = texel_index(w, h, x.0, y.0);
-                let g = _mm256_i32gather_epi32::<4>(texels.as_ptr().cast::<i32>(), idx);
-                let byte = _mm256_set1_epi32(0xff);
+                rgb8(_mm256_i32gather_epi32::<4>(texels.as_ptr().cast::<i32>(), idx))
+            }
+        }
+        #[inline(always)]
+        fn gather_quad_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [[Self; 3]; 4] {
+            let (w, h) = (width as usize, height as usize);
+            assert!(
+                w.is_power_of_two() && h.is_power_of_two() && texels.len() >= w * h && w * h <= i32::MAX as usize,
+                "a repeated power-of-two image within its texels"
+            );
+            // SAFETY: AVX2 is present (see above). Each index is `(y & (h − 1)) << log2 w |
+            // (x & (w − 1))`, below `w·h <= texels.len()` whatever the lanes hold (a NaN or
+            // out-of-range conversion gives i32::MIN, masked like any other): each gathered i32
+            // is the 4 bytes of one texel of `texels`.
+            unsafe {
+                let (xi, yi) = (_mm256_cvttps_epi32(x.0), _mm256_cvttps_epi32(y.0));
+                let one = _mm256_set1_epi32(1);
+                let (wm, hm) = (_mm256_set1_epi32(w as i32 - 1), _mm256_set1_epi32(h as i32 - 1));
+                let shift = _mm_cvtsi32_si128(w.trailing_zeros() as i32);
+                let x0 = _mm256_and_si256(xi, wm);
+                let x1 = _mm256_and_si256(_mm256_add_epi32(xi, one), wm);
+                let y0 = _mm256_sll_epi32(_mm256_and_si256(yi, hm), shift);
+                let y1 = _mm256_sll_epi32(_mm256_and_si256(_mm256_add_epi32(yi, one), hm), shift);
+                let base = texels.as_ptr().cast::<i32>();
                 [
-                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(g, byte))),
-                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<8>(g), byte))),
-                    Avx2(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<16>(g), byte))),
+                    rgb8(_mm256_i32gather_epi32::<4>(base, _mm256_or_si256(y0, x0))),
+                    rgb8(_mm256_i32gather_epi32::<4>(base, _mm256_or_si256(y0, x1))),
+                    rgb8(_mm256_i32gather_epi32::<4>(base, _mm256_or_si256(y1, x0))),
+                    rgb8(_mm256_i32gather_epi32::<4>(base, _mm256_or_si256(y1, x1))),
                 ]
             }
         }
@@ -568,6 +635,18 @@ mod avx2 {
             let a = Avx2::gather_rgb8(texels, width, height, x.0, y.0);
             let b = Avx2::gather_rgb8(texels, width, height, x.1, y.1);
             [Avx2x2(a[0], b[0]), Avx2x2(a[1], b[1]), Avx2x2(a[2], b[2])]
+        }
+        #[inline(always)]
+        fn gather_quad_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [[Self; 3]; 4] {
+            let a = Avx2::gather_quad_rgb8(texels, width, height, x.0, y.0);
+            let b = Avx2::gather_quad_rgb8(texels, width, height, x.1, y.1);
+            let mut out = [[Avx2x2::splat(0.0); 3]; 4];
+            for k in 0..4 {
+                for c in 0..3 {
+                    out[k][c] = Avx2x2(a[k][c], b[k][c]);
+                }
+            }
+            out
         }
         #[inline(always)]
         fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
