@@ -736,7 +736,7 @@ pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], rows: usize) -> [V; 24] 
 
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
 #[inline(always)]
-fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
+pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
     let k = coefficients::<V>(planes, if attrs > 3 { 3 } else { 2 });
     let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
     // `c + gx·dx + gy·dy` from floats `i..i + 3`.

@@ -9,7 +9,9 @@
 //! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
 //! caller's per-pixel sampler.
 
-use super::kernel::{Broadcast, MAX_LANES, Planes, Prepared, centres, coefficients, lanes, position_normal, shade};
+use super::kernel::{
+    Broadcast, MAX_LANES, Planes, Prepared, centres, coefficients, interpolate, position_normal, shade,
+};
 use super::vector::Vf32;
 use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
 
@@ -464,28 +466,25 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
 ) {
     let mut start = 0;
     while start < n {
-        let (m, q) = lanes::<V>(
-            &|i| {
-                let (x, y, p, _) = lane(i);
-                (x, y, p)
-            },
-            start,
-            n,
-            6,
-        );
-        // The coordinates' planes (their `origin`, `1/w`, `u/w`, `v/w` and, tinted, the vertex
-        // colours over `w`: the planes' first 20 floats).
+        // Each lane's centre, planes and coordinates' planes (`origin`, `1/w`, `u/w`, `v/w`
+        // and, tinted, the vertex colours over `w`: the planes' first 20 floats).
+        let m = (n - start).min(V::N);
         let mut xs = V::A::default();
         let mut ys = V::A::default();
-        let mut uv: [&Planes; MAX_LANES] = [lane(start).3; MAX_LANES];
-        for (i, p) in uv.iter_mut().enumerate().take(V::N) {
-            let (x, y, _, q) = lane(start + i.min(m - 1));
+        let (_, _, p0, uv0) = lane(start);
+        let mut planes: [&Planes; MAX_LANES] = [p0; MAX_LANES];
+        let mut uv: [&Planes; MAX_LANES] = [uv0; MAX_LANES];
+        for i in 0..V::N {
+            let (x, y, p, q) = lane(start + i.min(m - 1));
             xs.as_mut()[i] = x;
             ys.as_mut()[i] = y;
-            *p = q;
+            planes[i] = p;
+            uv[i] = q;
         }
+        let (xs, ys) = (V::from_array(xs), V::from_array(ys));
+        let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
         let k = coefficients::<V>(&uv[..V::N], if maps.tinted { 3 } else { 2 });
-        let r = textured(prep, maps, q, (V::from_array(xs), V::from_array(ys)), &k);
+        let r = textured(prep, maps, q, (xs, ys), &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
