@@ -292,3 +292,17 @@ impl Gpu {
         Ok((prepared, drawn, upload))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// render.wgsl's shininess cap is phong-core's: the WGSL constant parsed back.
+    #[test]
+    fn wgsl_shininess_cap_is_phong_core_s() {
+        let line = super::RENDER_WGSL
+            .lines()
+            .find_map(|l| l.strip_prefix("const MAX_SHININESS: f32 = "))
+            .expect("render.wgsl declares MAX_SHININESS");
+        let value: f32 = line.trim_end_matches(';').parse().expect("a number");
+        assert_eq!(value, phong_core::MetalRough::MAX_SHININESS);
+    }
+}

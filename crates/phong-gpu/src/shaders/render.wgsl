@@ -144,14 +144,17 @@ struct Texels {
     occlusion: f32,
 }
 
+// phong-core's `MetalRough::MAX_SHININESS` (a test in lib.rs holds them equal).
+const MAX_SHININESS: f32 = 10000.0;
+
 // phong-core's `MetalRough::shininess`.
 fn roughness_shininess(roughness: f32) -> f32 {
     let r = clamp(roughness, 0.0, 1.0);
     let a = r * r;
     if (a > 0.0) {
-        return clamp(2.0 / (a * a) - 2.0, 0.0, 10000.0);
+        return clamp(2.0 / (a * a) - 2.0, 0.0, MAX_SHININESS);
     }
-    return 10000.0;
+    return MAX_SHININESS;
 }
 
 // Every map sampled at `uv` with the screen derivatives `dx`, `dy` (1 where a map is absent).
