@@ -12,7 +12,7 @@
 use super::kernel::{
     Broadcast, MAX_LANES, Planes, Prepared, centres, coefficients, interpolate, position_normal, shade,
 };
-use super::vector::Vf32;
+use super::vector::{Portable, Vf32};
 use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
 
 /// The most mipmap levels (a 16384 side has 15).
@@ -135,6 +135,66 @@ impl<'a> VectorMaps<'a> {
 // No closures below: a closure is not compiled with its caller's AVX2, and its intrinsics
 // become calls.
 
+/// How each build calls its largest steps, [`Sampling::bilinear`] and [`Sampling::textured`]:
+/// inlined where the lanes are AVX2 registers (a call is compiled without the caller's AVX2,
+/// and its intrinsics become calls), called in the portable build, whose lane loops inlined
+/// at every map, level and entry point took minutes to compile (BENCHMARKS.md).
+pub(crate) trait Sampling: Vf32 {
+    /// [`bilinear_lanes`].
+    fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3];
+    /// [`textured_lanes`].
+    #[allow(clippy::type_complexity)]
+    fn textured(
+        prep: &Prepared,
+        maps: &VectorMaps,
+        q: [Self; 6],
+        xy: (Self, Self),
+        k: &[Self; 24],
+    ) -> Result<[Self; 3], ([Self; 3], [Self; 3])>;
+}
+
+impl Sampling for Portable {
+    #[inline(never)]
+    fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3] {
+        bilinear_lanes(map, level, u, v)
+    }
+    #[inline(never)]
+    fn textured(
+        prep: &Prepared,
+        maps: &VectorMaps,
+        q: [Self; 6],
+        xy: (Self, Self),
+        k: &[Self; 24],
+    ) -> Result<[Self; 3], ([Self; 3], [Self; 3])> {
+        textured_lanes(prep, maps, q, xy, k)
+    }
+}
+
+/// The AVX2 builds: inlined.
+#[cfg(target_arch = "x86_64")]
+macro_rules! inlined_sampling {
+    ($($v:ty),*) => {$(
+        impl Sampling for $v {
+            #[inline(always)]
+            fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3] {
+                bilinear_lanes(map, level, u, v)
+            }
+            #[inline(always)]
+            fn textured(
+                prep: &Prepared,
+                maps: &VectorMaps,
+                q: [Self; 6],
+                xy: (Self, Self),
+                k: &[Self; 24],
+            ) -> Result<[Self; 3], ([Self; 3], [Self; 3])> {
+                textured_lanes(prep, maps, q, xy, k)
+            }
+        }
+    )*};
+}
+#[cfg(target_arch = "x86_64")]
+inlined_sampling!(super::vector::Avx2, super::vector::Avx2x2);
+
 /// Whole numbers `i` modulo `p` into `0..p`, `inv` about `1/p` (the quotient's rounding can
 /// leave `r` one period out).
 #[inline(always)]
@@ -201,7 +261,7 @@ fn half_log2<V: Vf32>(rho2: V) -> V {
 /// RGB in texel units (0 to 255): the levels present gathered one by one, each lane keeping
 /// its own.
 #[inline(always)]
-fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
+fn bilinear_lanes<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
     let (zero, one, half) = (V::splat(0.0), V::splat(1.0), V::splat(0.5));
     // The lanes' levels: usually one (checked by vector), else scanned.
     let l = level.to_array();
@@ -282,7 +342,7 @@ fn bilinear<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
 /// `d = [∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`: `phong_core::Texture::sample` at
 /// `phong_core::Texture::lod`, for every lane.
 #[inline(always)]
-fn sample<V: Vf32>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
+fn sample<V: Sampling>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let last = (map.count - 1) as f32;
@@ -298,9 +358,9 @@ fn sample<V: Vf32>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
     } else {
         (zero, zero)
     };
-    let mut texel = bilinear(map, level, u, v);
+    let mut texel = V::bilinear(map, level, u, v);
     if V::any(t.gt(zero)) {
-        let b = bilinear(map, level.add(one).min(V::splat(last)), u, v);
+        let b = V::bilinear(map, level.add(one).min(V::splat(last)), u, v);
         for c in 0..3 {
             texel[c] = b[c].sub(texel[c]).mul_add(t, texel[c]);
         }
@@ -312,7 +372,7 @@ fn sample<V: Vf32>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
 /// `uv = [u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]` (through the map's transform); `None` where a
 /// lane's coordinates are too large for exact `f32` wrapping (beyond ±2^21 texels) or NaN.
 #[inline(always)]
-fn mapped<V: Vf32>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
+fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
     let (l, o) = (map.transform.linear, map.transform.offset);
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let [u, v, ux, vx, uy, vy] = uv;
@@ -346,7 +406,7 @@ pub type Unsampled<I> = (I, [f32; 3], [f32; 3]);
 /// with the light where the sampler cannot wrap the coordinates exactly.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn textured<V: Vf32>(
+fn textured_lanes<V: Sampling>(
     prep: &Prepared,
     maps: &VectorMaps,
     q: [V; 6],
@@ -422,7 +482,7 @@ fn textured<V: Vf32>(
     Ok(rgb)
 }
 
-/// Hands the first `m` lanes of a [`textured`] result to `out(lane, rgb)`, or their light to
+/// Hands the first `m` lanes of a [`Sampling::textured`] result to `out(lane, rgb)`, or their light to
 /// `unsampled` with their index `at(lane)`.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
@@ -456,7 +516,7 @@ fn emit<V: Vf32, I>(
 /// `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of its texture
 /// coordinates.
 #[inline(always)]
-pub(crate) fn shade_batch_textured<'p, V: Vf32>(
+pub(crate) fn shade_batch_textured<'p, V: Sampling>(
     prep: &Prepared,
     maps: &VectorMaps,
     n: usize,
@@ -484,7 +544,7 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
         let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
         let k = coefficients::<V>(&uv[..V::N], if maps.tinted { 3 } else { 2 });
-        let r = textured(prep, maps, q, (xs, ys), &k);
+        let r = V::textured(prep, maps, q, (xs, ys), &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
@@ -495,7 +555,7 @@ pub(crate) fn shade_batch_textured<'p, V: Vf32>(
 /// column` from `origin`, `out(pixel, rgb)` takes each one's colour or `unsampled` its light.
 /// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline(always)]
-pub(crate) fn shade_group_textured<V: Vf32>(
+pub(crate) fn shade_group_textured<V: Sampling>(
     prep: &Prepared,
     maps: &VectorMaps,
     (planes, uv): (&Planes, &Planes),
@@ -512,7 +572,7 @@ pub(crate) fn shade_group_textured<V: Vf32>(
     let k = coefficients::<V>(&[uv], if maps.tinted { 3 } else { 2 });
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
-        let r = textured(prep, maps, planes.at(x, y, 6), (x, y), &k);
+        let r = V::textured(prep, maps, planes.at(x, y, 6), (x, y), &k);
         emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
     }
     full
@@ -521,7 +581,6 @@ pub(crate) fn shade_group_textured<V: Vf32>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::simd::vector::Portable;
     use phong_core::{Sampler, TextureMap};
     use std::sync::Arc;
 

@@ -109,15 +109,17 @@ impl Vf32 for Portable {
     const N: usize = 8;
     type A = [f32; 8];
     type M = [bool; 8];
-    #[inline(always)]
+    // The portable gathers are calls: 8 scalar loads a channel gain nothing from inlining,
+    // and inlined into the textured kernels they made them minutes to compile (BENCHMARKS.md).
+    #[inline(never)]
     fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
         gather_portable(texels, width, height, x, y)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn gather_rgb16(texels: &[[u16; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
         gather_portable(texels, width, height, x, y)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn gather_quad_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [[Self; 3]; 4] {
         assert!(
             width.is_power_of_two() && height.is_power_of_two(),
