@@ -660,14 +660,20 @@ pub(crate) fn shade_group<V: Vf32>(
     full
 }
 
-/// The centres of `pixels` (`row << 16 | column` from `(x0, y0)`), one per lane.
+/// The centre of pixel `p` (`row << 16 | column` from `(x0, y0)`, the tiles' packing) in the
+/// frame.
 #[inline(always)]
-pub(super) fn centres<V: Vf32>((x0, y0): (u32, u32), pixels: &[u32]) -> (V, V) {
+pub fn pixel_centre((x0, y0): (u32, u32), p: u32) -> (f32, f32) {
+    ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5)
+}
+
+/// The centres of `pixels` ([`pixel_centre`]), one per lane.
+#[inline(always)]
+pub(super) fn centres<V: Vf32>(origin: (u32, u32), pixels: &[u32]) -> (V, V) {
     let mut xs = V::A::default();
     let mut ys = V::A::default();
     for (i, &p) in pixels.iter().enumerate().take(V::N) {
-        xs.as_mut()[i] = (x0 + (p & 0xffff)) as f32 + 0.5;
-        ys.as_mut()[i] = (y0 + (p >> 16)) as f32 + 0.5;
+        (xs.as_mut()[i], ys.as_mut()[i]) = pixel_centre(origin, p);
     }
     (V::from_array(xs), V::from_array(ys))
 }

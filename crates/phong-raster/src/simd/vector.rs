@@ -110,7 +110,7 @@ impl Vf32 for Portable {
     type A = [f32; 8];
     type M = [bool; 8];
     // The portable gathers are calls: 8 scalar loads a channel gain nothing from inlining,
-    // and inlined into the textured kernels they made them minutes to compile (BENCHMARKS.md).
+    // and inlined into the textured kernels they made them minutes to compile (BENCHMARKS.md, C10).
     #[inline(never)]
     fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
         gather_portable(texels, width, height, x, y)
