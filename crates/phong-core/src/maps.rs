@@ -87,6 +87,9 @@ pub struct TextureMap {
     pub sampler: Sampler,
     /// Applied to the mesh's coordinates before sampling.
     pub transform: UvTransform,
+    /// The mesh's texture coordinates it reads: 0 [`crate::Mesh::uvs`], 1
+    /// [`crate::Mesh::uvs1`] (glTF's `texCoord`).
+    pub set: u8,
 }
 
 impl TextureMap {
@@ -96,6 +99,7 @@ impl TextureMap {
             texture,
             sampler: Sampler::default(),
             transform: UvTransform::default(),
+            set: 0,
         }
     }
 
@@ -204,6 +208,7 @@ impl NormalMap {
                 texture: Arc::new(Texture::new(w, h, &top_first, 16)?),
                 sampler,
                 transform,
+                set: 0,
             },
             scale: 1.0,
             green_down: false,
@@ -361,9 +366,24 @@ impl Maps {
             .chain(self.occlusion.iter().map(|o| &o.map))
     }
 
-    /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy`.
+    /// Whether a map reads the mesh's second set of texture coordinates.
+    pub fn uses_second_set(&self) -> bool {
+        self.each().any(|m| m.set == 1)
+    }
+
+    /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy` (one set of
+    /// coordinates for every map).
     pub fn sample(&self, uv: Vec2, d_dx: Vec2, d_dy: Vec2) -> Texels {
-        let at = |m: &TextureMap| m.sample(uv, d_dx, d_dy);
+        self.sample_sets(&[[uv, d_dx, d_dy]; 2])
+    }
+
+    /// Samples every map at its set of coordinates ([`TextureMap::set`]): `sets[k]` is set
+    /// `k`'s `[uv, ∂uv/∂x, ∂uv/∂y]`.
+    pub fn sample_sets(&self, sets: &[[Vec2; 3]; 2]) -> Texels {
+        let at = |m: &TextureMap| {
+            let [uv, d_dx, d_dy] = sets[usize::from(m.set.min(1))];
+            m.sample(uv, d_dx, d_dy)
+        };
         let mut t = Texels {
             diffuse: self.diffuse.as_ref().map_or([1.0; 4], at),
             ambient: self.ambient.as_ref().map(|m| rgb(at(m))),

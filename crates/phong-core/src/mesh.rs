@@ -16,6 +16,8 @@ pub struct Mesh {
     triangles: Vec<[u32; 3]>,
     /// Empty, or one per position.
     uvs: Vec<Vec2>,
+    /// A second set of texture coordinates (glTF's `TEXCOORD_1`): empty, or one per position.
+    uvs1: Vec<Vec2>,
     /// Vertex colours: empty, or one per position.
     colors: Vec<Color>,
     /// Tangents (`xyz`, and in `w` the bitangent's sign): empty, or one per position.
@@ -58,6 +60,7 @@ impl Mesh {
             normals,
             triangles,
             uvs: Vec::new(),
+            uvs1: Vec::new(),
             colors: Vec::new(),
             tangents: Vec::new(),
         })
@@ -171,6 +174,9 @@ impl Mesh {
                     m.positions.push(self.positions[i]);
                     m.normals.push(self.normals[i]);
                     m.uvs.push(self.uvs[i]);
+                    if let Some(uv) = self.uvs1.get(i) {
+                        m.uvs1.push(*uv);
+                    }
                     if let Some(c) = self.colors.get(i) {
                         m.colors.push(*c);
                     }
@@ -186,6 +192,34 @@ impl Mesh {
     /// The mesh with texture coordinates, one per vertex, finite (`v = 0` is the image's
     /// bottom, as OBJ's `vt` and OpenGL); an empty vector removes them.
     pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
+        self.uvs = self.checked_uvs(uvs)?;
+        Ok(self)
+    }
+
+    /// The mesh with its vertices moved to `positions` (one per vertex, finite), every other
+    /// attribute kept.
+    pub fn with_positions(mut self, positions: Vec<Vec3>) -> Result<Self, Error> {
+        let moved = Mesh::new(positions, std::mem::take(&mut self.normals), Vec::new())?;
+        if moved.positions.len() != self.positions.len() {
+            return Err(Error::OutOfRange {
+                what: "number of positions",
+                range: "the mesh's number of vertices",
+                value: moved.positions.len() as f32,
+            });
+        }
+        self.positions = moved.positions;
+        self.normals = moved.normals;
+        Ok(self)
+    }
+
+    /// The mesh with a second set of texture coordinates (glTF's `TEXCOORD_1`, read by the
+    /// maps whose [`crate::TextureMap::set`] is 1), as [`Mesh::with_uvs`].
+    pub fn with_uvs1(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
+        self.uvs1 = self.checked_uvs(uvs)?;
+        Ok(self)
+    }
+
+    fn checked_uvs(&self, uvs: Vec<Vec2>) -> Result<Vec<Vec2>, Error> {
         if !uvs.is_empty() && uvs.len() != self.positions.len() {
             return Err(Error::OutOfRange {
                 what: "number of texture coordinates",
@@ -199,8 +233,7 @@ impl Mesh {
                 value: [uv.x, uv.y, 0.0],
             });
         }
-        self.uvs = uvs;
-        Ok(self)
+        Ok(uvs)
     }
 
     /// A mesh whose normals are then computed: area-weighted smooth normals over shared vertices.
@@ -229,6 +262,10 @@ impl Mesh {
     pub fn has_uvs(&self) -> bool {
         !self.uvs.is_empty()
     }
+    /// The second set of texture coordinates per vertex; empty where the mesh has none.
+    pub fn uvs1(&self) -> &[Vec2] {
+        &self.uvs1
+    }
     /// The three corners of triangle `t`.
     pub fn corners(&self, t: usize) -> [Vec3; 3] {
         self.triangles[t].map(|i| self.positions[i as usize])
@@ -240,6 +277,7 @@ impl Mesh {
         let base = self.positions.len() as u32;
         let (mine, theirs) = (self.positions.len(), other.positions.len());
         append_attribute(&mut self.uvs, &other.uvs, mine, theirs, Vec2::ZERO);
+        append_attribute(&mut self.uvs1, &other.uvs1, mine, theirs, Vec2::ZERO);
         append_attribute(&mut self.tangents, &other.tangents, mine, theirs, Vec4::ZERO);
         append_attribute(&mut self.colors, &other.colors, mine, theirs, Color::WHITE);
         self.positions.extend_from_slice(&other.positions);
@@ -273,6 +311,7 @@ impl Mesh {
                 self.triangles.clone()
             },
             uvs: self.uvs.clone(),
+            uvs1: self.uvs1.clone(),
             colors: self.colors.clone(),
             // A tangent is a direction in the surface: transformed by `m` itself; a mirror
             // flips the bitangent.
@@ -293,6 +332,7 @@ impl Mesh {
         let mut normals = Vec::with_capacity(self.triangles.len() * 3);
         let mut triangles = Vec::with_capacity(self.triangles.len());
         let mut uvs = Vec::new();
+        let mut uvs1 = Vec::new();
         let mut colors = Vec::new();
         for (t, corners) in self.triangles.iter().enumerate() {
             let [a, b, c] = self.corners(t);
@@ -304,6 +344,9 @@ impl Mesh {
             if !self.uvs.is_empty() {
                 uvs.extend(corners.map(|k| self.uvs[k as usize]));
             }
+            if !self.uvs1.is_empty() {
+                uvs1.extend(corners.map(|k| self.uvs1[k as usize]));
+            }
             if !self.colors.is_empty() {
                 colors.extend(corners.map(|k| self.colors[k as usize]));
             }
@@ -313,6 +356,7 @@ impl Mesh {
             normals,
             triangles,
             uvs,
+            uvs1,
             colors,
             tangents: Vec::new(),
         }
@@ -347,6 +391,7 @@ impl Mesh {
             normals,
             triangles,
             uvs: Vec::new(),
+            uvs1: Vec::new(),
             colors: Vec::new(),
             tangents: Vec::new(),
         };
@@ -369,7 +414,7 @@ impl Mesh {
             }
         }
         m.normals = acc.into_iter().map(|n| n.normalize_or_zero()).collect();
-        if self.uvs.is_empty() && self.colors.is_empty() {
+        if self.uvs.is_empty() && self.uvs1.is_empty() && self.colors.is_empty() {
             return m;
         }
         Mesh {
@@ -377,6 +422,7 @@ impl Mesh {
             normals: remap.iter().map(|&r| m.normals[r as usize]).collect(),
             triangles: self.triangles.clone(),
             uvs: self.uvs.clone(),
+            uvs1: self.uvs1.clone(),
             colors: self.colors.clone(),
             tangents: Vec::new(),
         }
@@ -474,8 +520,9 @@ impl Mesh {
         let mut positions = Vec::new();
         let mut normals = Vec::new();
         let mut uvs = Vec::new();
+        let mut uvs1 = Vec::new();
         let mut colors = Vec::new();
-        type Key = (u32, [u32; 3], [u32; 2], [u32; 3]);
+        type Key = (u32, [u32; 3], [[u32; 2]; 2], [u32; 3]);
         let mut dedup: FxHashMap<Key, u32> = FxHashMap::default();
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
@@ -484,6 +531,7 @@ impl Mesh {
             let tri = t.map(|v| {
                 // A corner keeps its own texture coordinates: vertices split where they differ.
                 let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
+                let uv1 = self.uvs1.get(self.triangles[f][corner] as usize).copied();
                 let color = self.colors.get(self.triangles[f][corner] as usize).copied();
                 corner += 1;
                 let n = match &vertex_rule[v as usize] {
@@ -507,13 +555,14 @@ impl Mesh {
                 let key = (
                     v,
                     n.to_array().map(f32::to_bits),
-                    uv.unwrap_or_default().to_array().map(f32::to_bits),
+                    [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
                     color.unwrap_or_default().to_array().map(f32::to_bits),
                 );
                 *dedup.entry(key).or_insert_with(|| {
                     positions.push(w.positions[v as usize]);
                     normals.push(n);
                     uvs.extend(uv);
+                    uvs1.extend(uv1);
                     colors.extend(color);
                     (positions.len() - 1) as u32
                 })
@@ -525,6 +574,7 @@ impl Mesh {
             normals,
             triangles,
             uvs,
+            uvs1,
             colors,
             tangents: Vec::new(),
         };

@@ -137,8 +137,8 @@ pub struct GpuVertex {
     pub normal: [f32; 3],
     /// Flat shading: the triangle's centroid.
     pub centroid: [f32; 3],
-    /// Texture coordinates (0 where the mesh has none).
-    pub uv: [f32; 2],
+    /// Texture coordinates: the mesh's first set, then its second (0 where it has none).
+    pub uv: [f32; 4],
     /// The vertex colour (white where the mesh has none).
     pub color: [f32; 3],
     /// The tangent, `w` the bitangent's sign (zero where the mesh has none).
@@ -167,7 +167,8 @@ pub struct GpuMaps {
     /// The metallic-roughness map's base colour factor (RGB); w the occlusion's strength.
     pub base: [f32; 4],
     /// Per map (diffuse, ambient, specular, emission, shininess, alpha, normal,
-    /// metallic-roughness, occlusion): its transform's linear part by columns, then its offset.
+    /// metallic-roughness, occlusion): its transform's linear part by columns, then its offset
+    /// (xy) and the set of coordinates it reads (z).
     pub transforms: [[f32; 4]; 18],
 }
 

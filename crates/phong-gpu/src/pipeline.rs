@@ -60,7 +60,7 @@ impl Gpu {
             .entry((samples, cull, blend))
             .or_insert_with(|| {
                 let attributes =
-                    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2, 4 => Float32x3, 5 => Float32x4];
+                    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32x3, 5 => Float32x4];
                 self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some("phong"),
                     layout: Some(&self.pipeline_layout),

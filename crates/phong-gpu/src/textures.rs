@@ -232,7 +232,8 @@ impl Gpu {
                     };
                     let l = m.transform.linear;
                     params.transforms[2 * k] = [l.x_axis.x, l.x_axis.y, l.y_axis.x, l.y_axis.y];
-                    params.transforms[2 * k + 1] = [m.transform.offset.x, m.transform.offset.y, 0.0, 0.0];
+                    let set = f32::from(m.set.min(1));
+                    params.transforms[2 * k + 1] = [m.transform.offset.x, m.transform.offset.y, set, 0.0];
                     texture_views.push(Some(view_of(&m.texture)));
                     samplers.push(Some(self.sampler(m)));
                 }

@@ -61,7 +61,11 @@ impl Geometry {
             let m = &o.mesh;
             let base = g.vertices.len();
             let first = g.indices.len() as u32;
-            let uv = |k: u32| m.uvs().get(k as usize).map_or([0.0; 2], |u| u.to_array());
+            let uv = |k: u32| {
+                let set = |s: &[glam::Vec2]| s.get(k as usize).map_or([0.0; 2], |u| u.to_array());
+                let ([a, b], [c, d]) = (set(m.uvs()), set(m.uvs1()));
+                [a, b, c, d]
+            };
             let color = |k: u32| m.colors().get(k as usize).map_or([1.0; 3], |c| c.to_array());
             let tangent = |k: u32| m.tangents().get(k as usize).map_or([0.0; 4], |t| t.to_array());
             if o.shading.interpolation == Interpolation::Flat {

@@ -26,6 +26,8 @@ pub struct ClipVertex {
     pub spec: [Vec3; 2],
     /// Texture coordinates.
     pub uv: Vec2,
+    /// The second set of texture coordinates (zero where the mesh has none).
+    pub uv1: Vec2,
     /// The vertex colour (white where the mesh has none).
     pub rgb: Vec3,
     /// The tangent (`w`: the bitangent's sign; zero where the mesh has none).
@@ -45,6 +47,7 @@ impl ClipVertex {
             color_back: self.color_back.lerp(b.color_back, t),
             spec: [0, 1].map(|k| self.spec[k].lerp(b.spec[k], t)),
             uv: self.uv.lerp(b.uv, t),
+            uv1: self.uv1.lerp(b.uv1, t),
             rgb: self.rgb.lerp(b.rgb, t),
             tangent: self.tangent.lerp(b.tangent, t),
         }
@@ -171,6 +174,7 @@ mod tests {
             color_back: Vec3::ZERO,
             spec: [Vec3::ZERO; 2],
             uv: Vec2::ZERO,
+            uv1: Vec2::ZERO,
             rgb: Vec3::ONE,
             tangent: Vec4::ZERO,
         }

@@ -117,7 +117,9 @@ impl<'a> Frame<'a> {
                         || m.shininess.is_some()
                         || m.normal.is_some()
                         || m.metal_rough.is_some()
-                        || m.occlusion.is_some();
+                        || m.occlusion.is_some()
+                        // The fast path's planes carry one set of coordinates.
+                        || m.uses_second_set();
                     let one_sample = scene.image.samples == phong_core::Samples::One;
                     if o.shading.interpolation == Interpolation::Phong
                         && term == Term::Color

@@ -325,6 +325,7 @@ rotation = [0.0, 90.0, 0.0]
                             color_back: Vec3::ZERO,
                             spec: [Vec3::ZERO; 2],
                             uv: glam::Vec2::ZERO,
+                            uv1: glam::Vec2::ZERO,
                             rgb: Vec3::ONE,
                             tangent: glam::Vec4::ZERO,
                         }

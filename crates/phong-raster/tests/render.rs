@@ -859,6 +859,50 @@ fn a_diffuse_map_is_sampled_at_each_pixel() {
     }
 }
 
+/// A map on the mesh's second set of texture coordinates (glTF's `TEXCOORD_1`) reads that
+/// set, not the first: the quad's first set is one point (a single texel), its second the
+/// quad's mapping; each pixel is its texel by hand as above, on every CPU path and
+/// interpolation.
+#[test]
+fn a_map_on_the_second_set_reads_it() {
+    let n = 32u32;
+    let m = Material::new(Color::BLACK, Color::WHITE, Color::BLACK, Color::BLACK, 1.0).unwrap();
+    let (texels, texture) = texture_4x4(|_, _| 65535);
+    let quad = textured_quad(0.0);
+    let mapping = quad.uvs().to_vec();
+    let mesh = quad
+        .with_uvs(vec![glam::Vec2::splat(0.9); 4])
+        .unwrap()
+        .with_uvs1(mapping)
+        .unwrap();
+    let mut o = obj(mesh, m);
+    let mut map = TextureMap::new(texture);
+    map.sampler = Sampler::nearest(Wrap::Clamp);
+    map.set = 1;
+    o.maps.diffuse = Some(map);
+    for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
+        let s = scene(n, n, ortho_camera(2.0), vec![o.clone()], one_light(-Vec3::Z), interp);
+        for path in common::paths() {
+            let img = path.render(&s);
+            for y in 0..n {
+                for x in 0..n {
+                    let (wx, wy) = ortho_world(x, y, n, 2.0);
+                    let (u, v) = ((wx + 1.0) / 2.0, (wy + 1.0) / 2.0);
+                    let (col, row) = ((u * 4.0) as usize, 3 - (v * 4.0) as usize);
+                    let t = texels[row * 4 + col];
+                    let want = Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
+                    let got = px(&img, x, y);
+                    assert!(
+                        (got - want).abs().max_element() < 1e-6,
+                        "{} {interp:?} ({x}, {y}): {got} vs {want}",
+                        path.name
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// The alpha test: where the diffuse map's alpha is below the cutoff, the quad is not drawn
 /// (neither colour nor depth), and the red quad behind it shows.
 #[test]

@@ -322,33 +322,58 @@ pub fn read_gltf(
             };
             model.double_sided |= mat.double_sided();
             let mut material = mat.index().map(|_| phong_material(&mat));
-            // The textures' coordinates: one set for the mesh (the base colour's, else the
-            // first used), v flipped to OpenGL's.
-            let infos = texture_infos(&mat);
-            let set = infos.first().map(|t| t.set);
-            let uvs: Vec<Vec2> = match set.and_then(|s| reader.read_tex_coords(s)) {
-                Some(t) => {
-                    let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
-                    if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
-                        uv
-                    } else {
-                        Vec::new()
+            // The textures' coordinates, v flipped to OpenGL's: the mesh's first set is the
+            // normal texture's (its tangents are made from it), else the base colour's (else
+            // the first used); its second, the other set used, if any. Sets past TEXCOORD_1
+            // are not read.
+            let mut infos = texture_infos(&mat);
+            let first = infos
+                .iter()
+                .find(|t| t.slot == Slot::Normal)
+                .or(infos.first())
+                .map(|t| t.set);
+            let second = infos.iter().map(|t| t.set).find(|&s| Some(s) != first && s <= 1);
+            let read_set = |set: Option<u32>| -> Vec<Vec2> {
+                match set.and_then(|s| reader.read_tex_coords(s)) {
+                    Some(t) => {
+                        let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
+                        if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
+                            uv
+                        } else {
+                            Vec::new()
+                        }
                     }
+                    None => Vec::new(),
                 }
-                None => Vec::new(),
             };
+            let (uvs, uvs1) = (read_set(first), read_set(second));
+            let beyond = infos
+                .iter()
+                .filter(|t| Some(t.set) != first && Some(t.set) != second)
+                .count();
+            if beyond > 0 {
+                warnings.push(format!(
+                    "{}: {what}: {beyond} textures on texture coordinate sets past TEXCOORD_1 are not used",
+                    path.display()
+                ));
+            }
+            if second.is_some() && uvs1.is_empty() && !uvs.is_empty() {
+                warnings.push(format!(
+                    "{}: {what}: textures on TEXCOORD_{} not used: the primitive has no usable TEXCOORD_{0}",
+                    path.display(),
+                    second.unwrap_or(1)
+                ));
+            }
+            // Each texture's set as the mesh's: 0 the first, 1 the second.
+            infos.retain(|t| Some(t.set) == first || (Some(t.set) == second && !uvs1.is_empty()));
+            for t in &mut infos {
+                t.set = u32::from(Some(t.set) != first);
+            }
             let maps = if mat.index().is_some() && !uvs.is_empty() {
                 let requests: Vec<MapRequest> = infos
                     .iter()
-                    .filter(|t| Some(t.set) == set)
                     .filter_map(|t| texture_request(t, &buffers, &what))
                     .collect();
-                if infos.iter().any(|t| Some(t.set) != set) {
-                    warnings.push(format!(
-                        "{}: {what}: textures on a second texture coordinate set are not used",
-                        path.display()
-                    ));
-                }
                 let mut maps = resolve(
                     &requests,
                     mat.name().unwrap_or("(unnamed)"),
@@ -380,7 +405,7 @@ pub fn read_gltf(
                     warnings.push(format!(
                         "{}: {what}: textures not used: the primitive has no usable TEXCOORD_{}",
                         path.display(),
-                        set.unwrap_or(0)
+                        first.unwrap_or(0)
                     ));
                 }
                 Maps::default()
@@ -409,6 +434,7 @@ pub fn read_gltf(
                 material,
                 has_normals,
                 uvs,
+                uvs1,
                 colors,
                 maps,
             });
@@ -446,6 +472,7 @@ pub fn read_gltf(
         material,
         has_normals,
         uvs,
+        uvs1,
         colors,
         maps,
     } in pending
@@ -453,6 +480,7 @@ pub fn read_gltf(
         let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
         let mesh = Mesh::new(positions, normals, tris)
             .and_then(|m| m.with_uvs(uvs))
+            .and_then(|m| m.with_uvs1(uvs1))
             .and_then(|m| m.with_colors(colors))
             .and_then(|m| m.with_tangents(tangents))
             .map_err(|e| fail(format!("{name}: {e}")))?;
@@ -551,6 +579,8 @@ struct Pending {
     name: String,
     tangents: Vec<Vec4>,
     uvs: Vec<Vec2>,
+    /// The second set of texture coordinates, where a texture reads it.
+    uvs1: Vec<Vec2>,
     colors: Vec<Color>,
     maps: Maps,
     world_pos: Vec<DVec3>,
@@ -689,11 +719,16 @@ struct Tex<'a> {
 
 impl<'a> Tex<'a> {
     fn of(slot: Slot, info: ::gltf::texture::Info<'a>) -> Tex<'a> {
+        let transform = info.texture_transform();
         Tex {
             slot,
             texture: info.texture(),
-            set: info.tex_coord(),
-            transform: info.texture_transform(),
+            // KHR_texture_transform's own `texCoord` overrides the texture info's.
+            set: transform
+                .as_ref()
+                .and_then(|t| t.tex_coord())
+                .unwrap_or(info.tex_coord()),
+            transform,
             scale: 1.0,
         }
     }
@@ -810,5 +845,6 @@ fn texture_request(tex: &Tex, buffers: &[Vec<u8>], what: &str) -> Option<MapRequ
         at: what.to_string(),
         scale: tex.scale,
         green_down: false,
+        set: u8::from(tex.set == 1),
     })
 }

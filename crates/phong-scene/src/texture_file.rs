@@ -161,6 +161,8 @@ pub struct MapRequest {
     pub scale: f32,
     /// A normal map: green along `−v` (DirectX's convention).
     pub green_down: bool,
+    /// The mesh's texture coordinates the map reads ([`TextureMap::set`]).
+    pub set: u8,
 }
 
 /// Decoded textures by (name, sRGB), so that a file named by several materials is read once.
@@ -313,6 +315,7 @@ pub fn resolve(
             texture,
             sampler: r.sampler,
             transform: r.transform,
+            set: r.set,
         };
         match r.slot {
             Slot::Diffuse => maps.diffuse = Some(map),
@@ -466,6 +469,7 @@ pub fn parse_mtl_map(kw: &str, args: &[&str]) -> Result<Option<(MapRequest, Vec<
         at: String::new(),
         scale: bump,
         green_down: false,
+        set: 0,
     };
     Ok(Some((request, unused)))
 }

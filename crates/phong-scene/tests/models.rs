@@ -593,6 +593,24 @@ fn shared_gltf_samples() {
         assert!(parts[0].mesh.has_uvs(), "{f}");
         assert!(!w.iter().any(|w| w.contains("Texture")), "{f}: {w:?}");
     }
+    // assimp's box with two coordinate sets: the metallic-roughness texture on TEXCOORD_1, read
+    // (no warning), the base colour on TEXCOORD_0.
+    let mut w = Vec::new();
+    let parts = load_model(&g.join("BoxTexcoords-glTF/boxTexcoords.gltf"), &mut w).unwrap();
+    let (mesh, maps) = (&parts[0].mesh, &parts[0].maps);
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(
+        (mesh.uvs().len(), mesh.uvs1().len()),
+        (mesh.positions().len(), mesh.positions().len())
+    );
+    assert_ne!(mesh.uvs(), mesh.uvs1());
+    assert_eq!(
+        (
+            maps.diffuse.as_ref().map(|m| m.set),
+            maps.metal_rough.as_ref().map(|m| m.map.set)
+        ),
+        (Some(0), Some(1))
+    );
     let engine = load_model(
         &g.join("2CylinderEngine-glTF-Binary/2CylinderEngine.glb"),
         &mut Vec::new(),
@@ -834,4 +852,91 @@ fn gltf_tangents_are_read() {
             );
         }
     }
+}
+
+/// glTF's second texture coordinate set: each texture reads the set its `texCoord` (or its
+/// KHR_texture_transform's `texCoord`) names, both sets read with v flipped to OpenGL's; the
+/// normal texture's set is the mesh's first (its tangents are made from it); a texture on a
+/// set past TEXCOORD_1 is dropped with a warning naming it.
+#[test]
+fn gltf_second_texture_coordinate_set_is_read() {
+    let d = dir("gltf_texcoord1");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(d.join("t.png"))
+        .unwrap();
+    let set0 = [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    let set1 = [[0.25f32, 0.5], [0.75, 0.5], [0.25, 1.0]];
+    let mut bin = Vec::new();
+    let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    for x in positions
+        .into_iter()
+        .chain(set0.into_iter().flatten())
+        .chain(set1.into_iter().flatten())
+    {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let flipped = |s: [[f32; 2]; 3]| s.map(|[u, v]| Vec2::new(u, 1.0 - v)).to_vec();
+    let gltf = |material: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_texture_transform"],
+  "buffers": [{{"byteLength": 84, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}},
+                  {{"buffer": 0, "byteOffset": 60, "byteLength": 24}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}}],
+  "images": [{{"uri": "t.png"}}],
+  "textures": [{{"source": 0}}],
+  "materials": [{material}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+        )
+    };
+    // Base colour on set 0; occlusion on set 1; emission on set 0 but moved to set 1 by its
+    // transform; metallic-roughness on set 2.
+    let p = write(
+        &d,
+        "sets.gltf",
+        gltf(
+            r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+                "metallicRoughnessTexture": {"index": 0, "texCoord": 2}},
+              "occlusionTexture": {"index": 0, "texCoord": 1},
+              "emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}}}"#,
+        )
+        .as_bytes(),
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    let (mesh, maps) = (&parts[0].mesh, &parts[0].maps);
+    assert_eq!(
+        (mesh.uvs().to_vec(), mesh.uvs1().to_vec()),
+        (flipped(set0), flipped(set1))
+    );
+    assert_eq!(maps.diffuse.as_ref().map(|m| m.set), Some(0));
+    assert_eq!(maps.occlusion.as_ref().map(|m| m.map.set), Some(1));
+    assert_eq!(maps.emission.as_ref().map(|m| m.set), Some(1));
+    assert!(maps.metal_rough.is_none());
+    assert!(
+        w.len() == 1 && w[0].contains("past TEXCOORD_1") && w[0].contains("1 textures"),
+        "{w:?}"
+    );
+    // A normal texture on set 1: that set is the mesh's first, the base colour's its second.
+    let p = write(
+        &d,
+        "normal.gltf",
+        gltf(r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 0, "texCoord": 1}}"#)
+            .as_bytes(),
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    let (mesh, maps) = (&parts[0].mesh, &parts[0].maps);
+    assert_eq!(
+        (mesh.uvs().to_vec(), mesh.uvs1().to_vec()),
+        (flipped(set1), flipped(set0))
+    );
+    assert_eq!(maps.diffuse.as_ref().map(|m| m.set), Some(1));
+    assert_eq!(maps.normal.as_ref().map(|n| n.map.set), Some(0));
+    assert!(w.is_empty(), "{w:?}");
 }

@@ -305,28 +305,29 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     };
     let lit_output = !matches!(output, Output::Normal | Output::Depth);
     let texture = (obj.textured() && lit_output).then(|| {
-        let uv_at = |bary: [f64; 3]| {
-            let uvs = tri.map(|i| mesh.uvs().get(i as usize).copied().unwrap_or_default().as_dvec2());
-            (uvs[0] * bary[0] + uvs[1] * bary[1] + uvs[2] * bary[2]).as_vec2()
+        // Set `k`'s coordinates at barycentrics `b`.
+        let uv_at = |k: usize, b: [f64; 3]| {
+            let set = if k == 0 { mesh.uvs() } else { mesh.uvs1() };
+            let uvs = tri.map(|i| set.get(i as usize).copied().unwrap_or_default().as_dvec2());
+            uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
         };
         let corners = ps.map(|p| p.as_dvec3());
         let (fx, fy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
-        let uv = uv_at(bary);
-        // The derivatives as the renderer's (exact at the centre), by central differences
-        // over 1/16 pixel on the triangle's plane.
+        // Each set's coordinates and their derivatives as the renderer's (exact at the centre),
+        // by central differences over 1/16 pixel on the triangle's plane.
         let h = 1.0 / 16.0;
-        let at = |dx: f64, dy: f64| {
-            plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| {
-                let uvs = tri.map(|i| mesh.uvs().get(i as usize).copied().unwrap_or_default().as_dvec2());
-                uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
-            })
+        let set = |k: usize| {
+            let at = |dx: f64, dy: f64| plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| uv_at(k, b));
+            let derivative = |dx: f64, dy: f64| match (at(dx * h, dy * h), at(-dx * h, -dy * h)) {
+                (Some(a), Some(b)) => ((a - b) / (2.0 * h)).as_vec2(),
+                _ => Vec2::ZERO,
+            };
+            [uv_at(k, bary).as_vec2(), derivative(1.0, 0.0), derivative(0.0, 1.0)]
         };
-        let derivative = |dx: f64, dy: f64| match (at(dx * h, dy * h), at(-dx * h, -dy * h)) {
-            (Some(a), Some(b)) => ((a - b) / (2.0 * h)).as_vec2(),
-            _ => Vec2::ZERO,
-        };
-        let (d_dx, d_dy) = (derivative(1.0, 0.0), derivative(0.0, 1.0));
-        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        let first = set(0);
+        let second = if obj.maps.uses_second_set() { set(1) } else { first };
+        let [uv, d_dx, d_dy] = first;
+        let mut texels = obj.maps.sample_sets(&[first, second]);
         if !mesh.colors().is_empty() {
             let c = tri.map(|i| mesh.colors()[i as usize]);
             let w = bary.map(|w| w as f32);

@@ -693,7 +693,8 @@ async fn ply_stl_and_gltf_uploads() {
 
 /// A textured scene (a sphere and a floor with a diffuse and a specular map, each
 /// interpolation): the probe's value is the rendered pixel, within 1/255, bilinear and
-/// trilinear (the probe's derivatives are central differences of rays, the renderer's exact).
+/// trilinear (the probe's derivatives are central differences of rays, the renderer's exact),
+/// and with the diffuse map on a second set of coordinates (the first scaled and shifted).
 #[test]
 fn the_probe_samples_textures_as_the_renderer() {
     use phong_core::glam::{Mat4, Quat, Vec2, Vec3};
@@ -717,9 +718,10 @@ fn the_probe_samples_textures_as_the_renderer() {
     )
     .unwrap()
     .scene;
-    for (sampler, repeat, tolerance) in [
-        (Sampler::bilinear(Wrap::Repeat), 1.0, 1),
-        (Sampler::trilinear(Wrap::Repeat), 6.0, 1),
+    for (sampler, repeat, tolerance, second) in [
+        (Sampler::bilinear(Wrap::Repeat), 1.0, 1, false),
+        (Sampler::trilinear(Wrap::Repeat), 6.0, 1, false),
+        (Sampler::trilinear(Wrap::Repeat), 2.0, 1, true),
     ] {
         for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
             let mut scene = base.clone();
@@ -727,18 +729,24 @@ fn the_probe_samples_textures_as_the_renderer() {
             scene.objects = [sphere.clone(), floor.clone()]
                 .into_iter()
                 .map(|mesh| {
-                    let map = |t: &std::sync::Arc<Texture>| TextureMap {
+                    let map = |t: &std::sync::Arc<Texture>, set: u8| TextureMap {
                         texture: t.clone(),
                         sampler,
                         transform: UvTransform::scale_offset(Vec2::splat(repeat), Vec2::ZERO),
+                        set,
                     };
                     let mut o = template.clone();
-                    o.mesh = mesh;
+                    let uvs1 = if second {
+                        mesh.uvs().iter().map(|uv| *uv * Vec2::new(3.0, 2.0) + 0.25).collect()
+                    } else {
+                        Vec::new()
+                    };
+                    o.mesh = mesh.with_uvs1(uvs1).unwrap();
                     o.material = Material::named("pearl").unwrap();
                     o.shading.interpolation = interp;
                     o.maps = Maps {
-                        diffuse: Some(map(&texture)),
-                        specular: Some(map(&texture)),
+                        diffuse: Some(map(&texture, u8::from(second))),
+                        specular: Some(map(&texture, 0)),
                         ..Maps::default()
                     };
                     o

@@ -29,7 +29,7 @@ struct VsOut {
     @location(6) @interpolate(flat) flat_back: vec3<f32>,
     // Textured objects (render.wgsl): texture coordinates, and Gouraud's and flat shading's
     // specular colours, added after the texture (front, back).
-    @location(7) uv: vec2<f32>,
+    @location(7) uv: vec4<f32>,
     @location(8) spec: vec3<f32>,
     @location(9) spec_back: vec3<f32>,
     @location(10) @interpolate(flat) flat_spec: vec3<f32>,

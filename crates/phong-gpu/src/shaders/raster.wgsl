@@ -38,7 +38,7 @@ struct Colors {
 }
 
 @group(0) @binding(3) var<uniform> raster: Raster;
-// GpuVertex: position, normal, centroid, uv, color, tangent (18 floats).
+// GpuVertex: position, normal, centroid, uv (two sets), color, tangent (20 floats).
 @group(0) @binding(4) var<storage, read> vertices: array<f32>;
 @group(0) @binding(5) var<storage, read> vertex_object: array<u32>;
 @group(0) @binding(6) var<storage, read> indices: array<u32>;
@@ -66,7 +66,7 @@ const TILE: i32 = 16;
 const MAX_GROUPS: u32 = 65535u;
 
 fn load_vec3(v: u32, k: u32) -> vec3<f32> {
-    let b = v * 18u + k * 3u;
+    let b = v * 20u + k * 3u;
     return vec3<f32>(vertices[b], vertices[b + 1u], vertices[b + 2u]);
 }
 

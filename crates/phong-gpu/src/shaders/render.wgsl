@@ -7,7 +7,8 @@ struct VsIn {
     @location(1) normal: vec3<f32>,
     // Flat shading: the triangle's centroid (its normal is then the facet normal).
     @location(2) centroid: vec3<f32>,
-    @location(3) uv: vec2<f32>,
+    // Texture coordinates: the mesh's first set in xy, its second in zw.
+    @location(3) uv: vec4<f32>,
     @location(4) color: vec3<f32>,
     @location(5) tangent: vec4<f32>,
 }
@@ -29,7 +30,8 @@ struct Maps {
     pbr: vec4<f32>,
     // The base colour factor; w the occlusion's strength.
     base: vec4<f32>,
-    // Per map: the transform's linear part by columns, then its offset.
+    // Per map: the transform's linear part by columns, then its offset (xy) and the set of
+    // coordinates it reads (z: 0 or 1).
     transforms: array<vec4<f32>, 18>,
 }
 
@@ -109,15 +111,18 @@ fn vs_main(v: VsIn, @builtin(instance_index) object: u32) -> VsOut {
     return out;
 }
 
-// Map `k`'s coordinates for the mesh's `uv`, and its derivatives.
-fn map_uv(k: u32, uv: vec2<f32>) -> vec2<f32> {
+// Map `k`'s coordinates from the mesh's two sets `uvs` (its set's, transformed), and its
+// derivatives from theirs.
+fn map_uv(k: u32, uvs: vec4<f32>) -> vec2<f32> {
     let a = maps.transforms[2u * k];
     let o = maps.transforms[2u * k + 1u];
+    let uv = select(uvs.xy, uvs.zw, o.z != 0.0);
     return vec2<f32>(a.x * uv.x + a.z * uv.y + o.x, a.y * uv.x + a.w * uv.y + o.y);
 }
 
-fn map_d(k: u32, d: vec2<f32>) -> vec2<f32> {
+fn map_d(k: u32, ds: vec4<f32>) -> vec2<f32> {
     let a = maps.transforms[2u * k];
+    let d = select(ds.xy, ds.zw, maps.transforms[2u * k + 1u].z != 0.0);
     return vec2<f32>(a.x * d.x + a.z * d.y, a.y * d.x + a.w * d.y);
 }
 
@@ -157,8 +162,9 @@ fn roughness_shininess(roughness: f32) -> f32 {
     return MAX_SHININESS;
 }
 
-// Every map sampled at `uv` with the screen derivatives `dx`, `dy` (1 where a map is absent).
-fn texels(uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Texels {
+// Every map sampled at its set of `uv` with the screen derivatives `dx`, `dy` (both sets,
+// as `uv`; 1 where a map is absent).
+fn texels(uv: vec4<f32>, dx: vec4<f32>, dy: vec4<f32>) -> Texels {
     var t: Texels;
     t.diffuse = vec4<f32>(1.0);
     t.ambient = vec3<f32>(1.0);

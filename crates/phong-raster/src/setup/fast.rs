@@ -130,6 +130,8 @@ impl Frame<'_> {
                         color_back: lit3[1][k],
                         spec: [Vec3::ZERO; 2],
                         uv: uv_of(tri[k]),
+                        // Objects whose maps read a second set are the scalar path's.
+                        uv1: glam::Vec2::ZERO,
                         rgb: rgb_of(tri[k]),
                         tangent: Vec4::ZERO,
                     }

@@ -23,7 +23,7 @@ impl Frame<'_> {
         let view = self.views[oi];
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
-        let uvs = mesh.uvs();
+        let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
         let colors = mesh.colors();
         let tangents = mesh.tangents();
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
@@ -52,6 +52,7 @@ impl Frame<'_> {
                     color_back: vec3(back.0),
                     spec: [vec3(front.1), vec3(back.1)],
                     uv: uvs.get(i).copied().unwrap_or_default(),
+                    uv1: uvs1.get(i).copied().unwrap_or_default(),
                     rgb: colors.get(i).map_or(Vec3::ONE, |c| Vec3::from(c.to_array())),
                     tangent: tangents.get(i).copied().unwrap_or(Vec4::ZERO),
                 }

@@ -138,7 +138,7 @@ impl<'a> VectorMaps<'a> {
 /// How each build calls its largest steps, [`Sampling::bilinear`] and [`Sampling::textured`]:
 /// inlined where the lanes are AVX2 registers (a call is compiled without the caller's AVX2,
 /// and its intrinsics become calls), called in the portable build, whose lane loops inlined
-/// at every map, level and entry point took minutes to compile (BENCHMARKS.md).
+/// at every map, level and entry point took minutes to compile (BENCHMARKS.md, C10).
 pub(crate) trait Sampling: Vf32 {
     /// [`bilinear_lanes`].
     fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3];
@@ -632,6 +632,7 @@ mod tests {
                             texture: texture.clone(),
                             sampler,
                             transform: UvTransform::default(),
+                            set: 0,
                         }),
                         ..Maps::default()
                     };

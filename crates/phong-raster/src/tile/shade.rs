@@ -12,6 +12,7 @@ use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
 use crate::frame::{Frame, Mode, lit_term};
 use crate::setup::{Corners, Tri};
+use crate::simd::kernel::pixel_centre;
 use crate::simd::{
     Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group, shade_group_textured,
 };
@@ -153,9 +154,10 @@ impl Frame<'_> {
                     ),
                     _ => 0,
                 };
+                let tinted = !self.scene.objects[object].mesh.colors().is_empty();
                 for (p, primary, specular) in unsampled.drain(..) {
                     let (r, c) = at(p);
-                    let rgb = self.textured_color(object, (p, id), (x0, y0), primary, specular);
+                    let rgb = self.textured_color(object, (p, id), (x0, y0), tinted, (primary, specular));
                     out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
                 }
                 textured[object].extend(pixels[done..].iter().map(|&p| (p, id)));
@@ -185,12 +187,8 @@ impl Frame<'_> {
         self.shade_gathered(
             &rest,
             |(p, id)| {
-                let (r, c) = at(p);
-                (
-                    (x0 + c as u32) as f32 + 0.5,
-                    (y0 + r as u32) as f32 + 0.5,
-                    self.planes(id),
-                )
+                let (x, y) = pixel_centre((x0, y0), p);
+                (x, y, self.planes(id))
             },
             |(p, _), rgb| {
                 let (r, c) = at(p);
@@ -222,7 +220,7 @@ impl Frame<'_> {
         y0: u32,
         mut out: impl FnMut((u32, u32), [f32; 3]),
     ) {
-        let centre = |p: u32| ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
+        let tinted = !self.scene.objects[object].mesh.colors().is_empty();
         if let Some(maps) = &self.vector_maps[object] {
             let mut unsampled = Vec::new();
             shade_batch_textured(
@@ -232,7 +230,7 @@ impl Frame<'_> {
                 items.len(),
                 |i| {
                     let (p, id) = items[i];
-                    let (x, y) = centre(p);
+                    let (x, y) = pixel_centre((x0, y0), p);
                     (x, y, self.planes(id), self.uv_planes(id))
                 },
                 |i, rgb| out(items[i], rgb),
@@ -241,7 +239,7 @@ impl Frame<'_> {
             for (i, primary, specular) in unsampled {
                 out(
                     items[i],
-                    self.textured_color(object, items[i], (x0, y0), primary, specular),
+                    self.textured_color(object, items[i], (x0, y0), tinted, (primary, specular)),
                 );
             }
             return;
@@ -252,34 +250,35 @@ impl Frame<'_> {
             items.len(),
             |i| {
                 let (p, id) = items[i];
-                let (x, y) = centre(p);
+                let (x, y) = pixel_centre((x0, y0), p);
                 (x, y, self.planes(id))
             },
             |i, primary, specular| {
                 out(
                     items[i],
-                    self.textured_color(object, items[i], (x0, y0), primary, specular),
+                    self.textured_color(object, items[i], (x0, y0), tinted, (primary, specular)),
                 )
             },
         );
     }
 
     /// The colour of a textured pixel (`(row << 16 | column, triangle id)` in the tile at
-    /// `(x0, y0)`) from its light (primary, specular): its maps sampled at the coordinates and
-    /// exact derivatives of the triangle's planes and applied (`Lit::modulate`).
+    /// `origin`) from its light (primary, specular): its maps sampled at the coordinates and
+    /// exact derivatives of the triangle's planes and applied (`Lit::modulate`), the diffuse
+    /// texel `tinted` by the vertex colours where the mesh has them.
     fn textured_color(
         &self,
         object: usize,
         (p, id): (u32, u32),
-        (x0, y0): (u32, u32),
-        primary: [f32; 3],
-        specular: [f32; 3],
+        origin: (u32, u32),
+        tinted: bool,
+        (primary, specular): ([f32; 3], [f32; 3]),
     ) -> [f32; 3] {
         let obj = &self.scene.objects[object];
-        let (x, y) = ((x0 + (p & 0xffff)) as f32 + 0.5, (y0 + (p >> 16)) as f32 + 0.5);
+        let (x, y) = pixel_centre(origin, p);
         let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
         let mut texels = obj.maps.sample(uv, d_dx, d_dy);
-        if !obj.mesh.colors().is_empty() {
+        if tinted {
             texels = texels.tinted(rgb);
         }
         let lit = Lit {
@@ -345,8 +344,8 @@ impl Frame<'_> {
             &batches,
             |k| {
                 let (pixel, ti) = jobs[k as usize];
-                let (px, py) = at(pixel);
-                (px as f32 + 0.5, py as f32 + 0.5, self.planes(ti))
+                let (x, y) = pixel_centre((x0, y0), pixel);
+                (x, y, self.planes(ti))
             },
             |k, rgb| colors[k as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
         );
@@ -379,17 +378,17 @@ impl Frame<'_> {
         map3(q, |x| x / sum)
     }
 
-    /// (See [`uv_from_planes`] for the fast path's.) Perspective-correct texture coordinates of
-    /// triangle `t` at the centre of pixel
-    /// `(px, py)` and their exact screen derivatives `[uv, ∂uv/∂x, ∂uv/∂y]` (per pixel), in
+    /// (See [`uv_from_planes`] for the fast path's.) Perspective-correct texture coordinates
+    /// (the set that `set` reads) of triangle `t` at the centre of pixel `(px, py)` and their
+    /// exact screen derivatives `[uv, ∂uv/∂x, ∂uv/∂y]` (per pixel), in
     /// `f64`: with `q_i = λ_i/w_i`, `uv = Σ q_i uv_i / Σ q_i` and
     /// `∂uv = (Σ ∂q_i uv_i − uv Σ ∂q_i) / Σ q_i`.
-    fn uv_at(t: &Tri, corners: &Corners, px: u32, py: u32) -> [Vec2; 3] {
+    fn uv_at(t: &Tri, corners: &Corners, px: u32, py: u32, set: fn(&ClipVertex) -> Vec2) -> [Vec2; 3] {
         let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
         let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
         let step = f64::from(1u32 << SUBPIXEL_BITS) * t.inv_area;
         let inv_w = corners.inv_w.map(f64::from);
-        let uv = corners.v.map(|v| v.uv.as_dvec2());
+        let uv = corners.v.map(|v| set(&v).as_dvec2());
         let q = each3(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area * inv_w[i]);
         let qx = each3(|i| t.a(i) as f64 * step * inv_w[i]);
         let qy = each3(|i| t.b(i) as f64 * step * inv_w[i]);
@@ -454,11 +453,16 @@ impl Frame<'_> {
     fn shade_textured_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
         let (t, corners) = (self.tri(id), self.corners(id));
         let obj = &self.scene.objects[self.object(id)];
-        let [uv, d_dx, d_dy] = Self::uv_at(t, corners, px, py);
+        let first = Self::uv_at(t, corners, px, py, |v| v.uv);
+        let second = if obj.maps.uses_second_set() {
+            Self::uv_at(t, corners, px, py, |v| v.uv1)
+        } else {
+            first
+        };
         let q = Self::weights(t, corners, px, py);
         let v = &corners.v;
         let lerp3 = |f: &dyn Fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
-        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        let mut texels = obj.maps.sample_sets(&[first, second]);
         if !obj.mesh.colors().is_empty() {
             let c = lerp3(&|v| v.rgb);
             texels = texels.tinted(Color::new(c.x, c.y, c.z));

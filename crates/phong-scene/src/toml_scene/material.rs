@@ -137,6 +137,7 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
             at: format!("{}:{line}: `{k}`", ctx.path.display()),
             scale: if slot == Slot::Bump { bump_scale } else { normal_scale },
             green_down,
+            set: 0,
         });
     }
     let dir = ctx.path.parent().unwrap_or(std::path::Path::new("")).to_path_buf();

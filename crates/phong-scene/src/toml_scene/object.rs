@@ -209,10 +209,8 @@ pub(super) fn object(
                         .iter()
                         .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
                         .collect();
-                    p.mesh = Mesh::new(positions, p.mesh.normals().to_vec(), p.mesh.triangles().to_vec())
-                        .and_then(|m| m.with_uvs(p.mesh.uvs().to_vec()))
-                        .and_then(|m| m.with_colors(p.mesh.colors().to_vec()))
-                        .and_then(|m| m.with_tangents(p.mesh.tangents().to_vec()))
+                    p.mesh = std::mem::take(&mut p.mesh)
+                        .with_positions(positions)
                         .map_err(|e| Error::Model {
                             path: ctx.path.to_path_buf(),
                             message: format!("{}: {e}", p.name),
