@@ -324,8 +324,8 @@ pub fn read_gltf(
             let mut material = mat.index().map(|_| phong_material(&mat));
             // The textures' coordinates, v flipped to OpenGL's: the mesh's first set is the
             // normal texture's (its tangents are made from it), else the base colour's (else
-            // the first used); its second, the other set used, if any. Sets past TEXCOORD_1
-            // are not read.
+            // the first used); its second, the other of TEXCOORD_0 and TEXCOORD_1 used, if
+            // any. A third set is not read.
             let mut infos = texture_infos(&mat);
             let first = infos
                 .iter()
@@ -353,7 +353,7 @@ pub fn read_gltf(
                 .count();
             if beyond > 0 {
                 warnings.push(format!(
-                    "{}: {what}: {beyond} textures on texture coordinate sets past TEXCOORD_1 are not used",
+                    "{}: {what}: {beyond} textures not used: they read a third texture coordinate set (phong reads two)",
                     path.display()
                 ));
             }
