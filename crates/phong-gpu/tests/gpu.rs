@@ -473,6 +473,22 @@ fn sphere_and_floor(scene: &Scene, material: Material, maps: &Maps) -> Vec<Objec
         .collect()
 }
 
+/// The textured tests' scene (the tour at 200×150) and material (grey, shininess 30).
+fn textured_scene() -> (Scene, Material) {
+    let mut scene = load("tour.toml");
+    scene.image.width = 200;
+    scene.image.height = 150;
+    let material = Material::new(
+        Color::splat(0.3),
+        Color::splat(0.9),
+        Color::splat(0.6),
+        Color::BLACK,
+        30.0,
+    )
+    .unwrap();
+    (scene, material)
+}
+
 /// Textured objects on the GPU (the render pipeline, its textures, samplers and the CPU's
 /// mipmaps) against the CPU: a sphere and a floor with a diffuse and a specular map, each
 /// interpolation, magnified with bilinear filtering and minified with trilinear. Where the
@@ -485,17 +501,7 @@ fn sphere_and_floor(scene: &Scene, material: Material, maps: &Maps) -> Vec<Objec
 fn textured_objects_match_the_cpu() {
     let Some(gpu) = gpu() else { return };
     let mut r = Rng(11);
-    let mut scene = load("tour.toml");
-    scene.image.width = 200;
-    scene.image.height = 150;
-    let material = Material::new(
-        Color::splat(0.3),
-        Color::splat(0.9),
-        Color::splat(0.6),
-        Color::BLACK,
-        30.0,
-    )
-    .unwrap();
+    let (mut scene, material) = textured_scene();
     for (sampler, repeat, bound, largest) in [
         (Sampler::bilinear(Wrap::Repeat), 1.0, 0.002, 255),
         (Sampler::trilinear(Wrap::Repeat), 16.0, 0.06, 12),
@@ -536,17 +542,7 @@ fn textured_objects_match_the_cpu() {
 fn maps_on_the_second_set_match_the_cpu() {
     let Some(gpu) = gpu() else { return };
     let mut r = Rng(23);
-    let mut scene = load("tour.toml");
-    scene.image.width = 200;
-    scene.image.height = 150;
-    let material = Material::new(
-        Color::splat(0.3),
-        Color::splat(0.9),
-        Color::splat(0.6),
-        Color::BLACK,
-        30.0,
-    )
-    .unwrap();
+    let (mut scene, material) = textured_scene();
     let map = |t: std::sync::Arc<Texture>, set: u8| TextureMap {
         texture: t,
         sampler: Sampler::bilinear(Wrap::Repeat),

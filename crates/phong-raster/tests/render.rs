@@ -823,6 +823,32 @@ fn texture_4x4(alpha: impl Fn(usize, usize) -> u16) -> (Vec<[u16; 4]>, std::sync
     (texels, std::sync::Arc::new(t))
 }
 
+/// On every CPU path, each pixel of `s` (the `textured_quad` filling an `n`×`n` orthographic
+/// view, lit head-on, a white diffuse material) is the texel of `texture_4x4`'s `texels` that
+/// the quad's mapping `((x + 1)/2, (y + 1)/2)` puts there, found by hand.
+fn each_pixel_is_its_texel(s: &Scene, texels: &[[u16; 4]], what: &str) {
+    let n = s.image.width;
+    for path in common::paths() {
+        let img = path.render(s);
+        for y in 0..n {
+            for x in 0..n {
+                let (wx, wy) = ortho_world(x, y, n, 2.0);
+                let (u, v) = ((wx + 1.0) / 2.0, (wy + 1.0) / 2.0);
+                // Texel column floor(4u); row floor(4v) from the bottom, 3 − it from the top.
+                let (col, row) = ((u * 4.0) as usize, 3 - (v * 4.0) as usize);
+                let t = texels[row * 4 + col];
+                let want = Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
+                let got = px(&img, x, y);
+                assert!(
+                    (got - want).abs().max_element() < 1e-6,
+                    "{} {what} ({x}, {y}): {got} vs {want}",
+                    path.name
+                );
+            }
+        }
+    }
+}
+
 /// A diffuse map with nearest filtering on a quad lit head-on (N·L = 1, a white diffuse
 /// material, no ambient): each pixel is its texel, found by hand from the quad's coordinates,
 /// on every CPU path and interpolation.
@@ -837,31 +863,13 @@ fn a_diffuse_map_is_sampled_at_each_pixel() {
     o.maps.diffuse = Some(map);
     for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
         let s = scene(n, n, ortho_camera(2.0), vec![o.clone()], one_light(-Vec3::Z), interp);
-        for path in common::paths() {
-            let img = path.render(&s);
-            for y in 0..n {
-                for x in 0..n {
-                    let (wx, wy) = ortho_world(x, y, n, 2.0);
-                    let (u, v) = ((wx + 1.0) / 2.0, (wy + 1.0) / 2.0);
-                    // Texel column floor(4u); row floor(4v) from the bottom, 3 − it from the top.
-                    let (col, row) = ((u * 4.0) as usize, 3 - (v * 4.0) as usize);
-                    let t = texels[row * 4 + col];
-                    let want = Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
-                    let got = px(&img, x, y);
-                    assert!(
-                        (got - want).abs().max_element() < 1e-6,
-                        "{} {interp:?} ({x}, {y}): {got} vs {want}",
-                        path.name
-                    );
-                }
-            }
-        }
+        each_pixel_is_its_texel(&s, &texels, &format!("{interp:?}"));
     }
 }
 
 /// A map on the mesh's second set of texture coordinates (glTF's `TEXCOORD_1`) reads that
 /// set, not the first: the quad's first set is one point (a single texel), its second the
-/// quad's mapping; each pixel is its texel by hand as above, on every CPU path and
+/// quad's mapping; each pixel is its texel by hand (`each_pixel_is_its_texel`), each
 /// interpolation.
 #[test]
 fn a_map_on_the_second_set_reads_it() {
@@ -882,24 +890,7 @@ fn a_map_on_the_second_set_reads_it() {
     o.maps.diffuse = Some(map);
     for interp in [Interpolation::Phong, Interpolation::Gouraud, Interpolation::Flat] {
         let s = scene(n, n, ortho_camera(2.0), vec![o.clone()], one_light(-Vec3::Z), interp);
-        for path in common::paths() {
-            let img = path.render(&s);
-            for y in 0..n {
-                for x in 0..n {
-                    let (wx, wy) = ortho_world(x, y, n, 2.0);
-                    let (u, v) = ((wx + 1.0) / 2.0, (wy + 1.0) / 2.0);
-                    let (col, row) = ((u * 4.0) as usize, 3 - (v * 4.0) as usize);
-                    let t = texels[row * 4 + col];
-                    let want = Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 65535.0;
-                    let got = px(&img, x, y);
-                    assert!(
-                        (got - want).abs().max_element() < 1e-6,
-                        "{} {interp:?} ({x}, {y}): {got} vs {want}",
-                        path.name
-                    );
-                }
-            }
-        }
+        each_pixel_is_its_texel(&s, &texels, &format!("{interp:?}"));
     }
 }
 

@@ -153,33 +153,15 @@ pub(crate) trait Sampling: Vf32 {
     ) -> Result<[Self; 3], ([Self; 3], [Self; 3])>;
 }
 
-impl Sampling for Portable {
-    #[inline(never)]
-    fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3] {
-        bilinear_lanes(map, level, u, v)
-    }
-    #[inline(never)]
-    fn textured(
-        prep: &Prepared,
-        maps: &VectorMaps,
-        q: [Self; 6],
-        xy: (Self, Self),
-        k: &[Self; 24],
-    ) -> Result<[Self; 3], ([Self; 3], [Self; 3])> {
-        textured_lanes(prep, maps, q, xy, k)
-    }
-}
-
-/// The AVX2 builds: inlined.
-#[cfg(target_arch = "x86_64")]
-macro_rules! inlined_sampling {
-    ($($v:ty),*) => {$(
+/// `Sampling` for the build `$v`, its two steps with the attribute `$inline`.
+macro_rules! sampling {
+    ($v:ty, $inline:meta) => {
         impl Sampling for $v {
-            #[inline(always)]
+            #[$inline]
             fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3] {
                 bilinear_lanes(map, level, u, v)
             }
-            #[inline(always)]
+            #[$inline]
             fn textured(
                 prep: &Prepared,
                 maps: &VectorMaps,
@@ -190,10 +172,13 @@ macro_rules! inlined_sampling {
                 textured_lanes(prep, maps, q, xy, k)
             }
         }
-    )*};
+    };
 }
+sampling!(Portable, inline(never));
 #[cfg(target_arch = "x86_64")]
-inlined_sampling!(super::vector::Avx2, super::vector::Avx2x2);
+sampling!(super::vector::Avx2, inline(always));
+#[cfg(target_arch = "x86_64")]
+sampling!(super::vector::Avx2x2, inline(always));
 
 /// Whole numbers `i` modulo `p` into `0..p`, `inv` about `1/p` (the quotient's rounding can
 /// leave `r` one period out).
