@@ -209,11 +209,20 @@ impl RunArgs {
             let t = &loaded.textures;
             if t.images > 0 {
                 eprintln!(
-                    "phong: textures: {} images, {:.1} MiB with mipmaps; decode={:.1}ms mipmaps={:.1}ms",
+                    "phong: textures: {} images ({} from the texture cache), {:.1} MiB with mipmaps; decode={:.1}ms mipmaps={:.1}ms cache-write={:.1}ms",
                     t.images,
+                    t.from_store,
                     t.bytes as f64 / f64::from(1u32 << 20),
                     t.decode.as_secs_f64() * 1e3,
-                    t.mipmaps.as_secs_f64() * 1e3
+                    t.mipmaps.as_secs_f64() * 1e3,
+                    t.store_writes.as_secs_f64() * 1e3
+                );
+            }
+            if t.store_failures > 0 {
+                eprintln!(
+                    "phong: texture cache: {} writes failed: {}",
+                    t.store_failures,
+                    phong_scene::last_store_error().unwrap_or_default()
                 );
             }
         }

@@ -22,6 +22,28 @@ pub(crate) use materials::fmt3;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Where decoded textures of 16 MiB and more are kept with their mipmaps, so that the next
+    /// load reads them back instead of decoding (at most 2 GiB, the least recently used
+    /// removed); `off` keeps none. Default: $XDG_CACHE_HOME/phong/textures, else
+    /// ~/.cache/phong/textures.
+    #[arg(long, global = true, value_name = "DIR|off", env = "PHONG_TEXTURE_CACHE")]
+    texture_cache: Option<PathBuf>,
+}
+
+/// The texture store `--texture-cache` names (see [`Cli::texture_cache`]).
+fn texture_store(arg: Option<PathBuf>) -> Option<phong_scene::TextureStore> {
+    let dir = match arg {
+        Some(d) if d.as_os_str() == "off" => return None,
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => {
+            let base = std::env::var_os("XDG_CACHE_HOME")
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+                .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+            base.join("phong").join("textures")
+        }
+    };
+    Some(phong_scene::TextureStore::in_dir(dir))
 }
 
 #[derive(Subcommand)]
@@ -71,6 +93,7 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    phong_scene::set_texture_store(texture_store(cli.texture_cache));
     match cli.command {
         Command::Render(args) => render::render(args),
         Command::Bench(args) => bench::bench(args),

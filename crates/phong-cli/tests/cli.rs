@@ -553,3 +553,96 @@ fn ply_and_stl_models_render() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("cloud.xyz"), "{}", stderr(&o));
 }
+
+/// `-v`'s count of images read back from the texture cache.
+fn from_cache(o: &Output) -> usize {
+    let e = stderr(o);
+    let line = e
+        .lines()
+        .find(|l| l.contains("phong: textures:"))
+        .expect("a textures line");
+    let n = line.split(" images (").nth(1).and_then(|r| r.split(' ').next());
+    n.and_then(|n| n.parse().ok()).unwrap_or_else(|| panic!("{line}"))
+}
+
+#[test]
+fn a_large_texture_is_read_back_from_the_texture_cache() {
+    // A 2048² RGB image (21 MiB with its mipmaps: above the cache's 16 MiB) on a quad.
+    let out = tmp("scene.toml");
+    let dir = out.parent().unwrap();
+    let (w, h) = (2048u32, 2048u32);
+    let mut rgb = Vec::with_capacity((w * h * 3) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            rgb.extend_from_slice(&[((x * 7) ^ y) as u8, (y * 3) as u8, ((x + y) / 5) as u8]);
+        }
+    }
+    let mut enc = png::Encoder::new(std::fs::File::create(dir.join("big.png")).unwrap(), w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_compression(png::Compression::Fast);
+    enc.write_header().unwrap().write_image_data(&rgb).unwrap();
+    std::fs::write(
+        &*out,
+        "[image]\nwidth = 96\nheight = 64\n[camera]\nposition = [0, 0, 3]\n[[light]]\ntype = \"directional\"\ndirection = [0, 0, -1]\n\
+         [[object]]\nshape = \"plane\"\nrotation = [90, 0, 0]\nmaterial = { diffuse = [1, 1, 1], diffuse_map = \"big.png\", uv_scale = [3, 3] }\n",
+    )
+    .unwrap();
+    let cache = dir.join("cache");
+    let render = |png: &str, cache_arg: &str| {
+        let o = phong(&[
+            "render",
+            out.to_str().unwrap(),
+            "-o",
+            dir.join(png).to_str().unwrap(),
+            "-v",
+            "--texture-cache",
+            cache_arg,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        o
+    };
+    let ptx = || -> Vec<PathBuf> {
+        std::fs::read_dir(&cache).map_or(Vec::new(), |d| d.flatten().map(|e| e.path()).collect())
+    };
+    // Off: decoded, nothing kept.
+    let off = render("off.png", "off");
+    assert_eq!(from_cache(&off), 0);
+    assert!(ptx().is_empty());
+    // First load decodes and keeps one file; the second reads it back, the same image.
+    let first = render("first.png", cache.to_str().unwrap());
+    assert_eq!(from_cache(&first), 0);
+    let files = ptx();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let second = render("second.png", cache.to_str().unwrap());
+    assert_eq!(from_cache(&second), 1, "{}", stderr(&second));
+    let image = |p: &str| read_png(&dir.join(p)).3;
+    let lit = image("off.png");
+    let distinct: std::collections::HashSet<&[u8]> = lit.chunks(3).collect();
+    assert!(
+        distinct.len() > 100,
+        "the textured quad fills the view: {} colours",
+        distinct.len()
+    );
+    assert_eq!(image("first.png"), lit);
+    assert_eq!(image("second.png"), image("first.png"));
+    // A damaged file is not used: decoded again (and written anew), the same image.
+    let bytes = std::fs::read(&files[0]).unwrap();
+    std::fs::write(&files[0], &bytes[..bytes.len() / 2]).unwrap();
+    let third = render("third.png", cache.to_str().unwrap());
+    assert_eq!(from_cache(&third), 0);
+    assert_eq!(image("third.png"), image("first.png"));
+    assert_eq!(std::fs::read(&files[0]).unwrap(), bytes, "rewritten whole");
+    // The environment variable names it too.
+    let o = Command::new(env!("CARGO_BIN_EXE_phong"))
+        .args([
+            "render",
+            out.to_str().unwrap(),
+            "-o",
+            dir.join("env.png").to_str().unwrap(),
+            "-v",
+        ])
+        .env("PHONG_TEXTURE_CACHE", &cache)
+        .output()
+        .unwrap();
+    assert_eq!(from_cache(&o), 1, "{}", stderr(&o));
+}

@@ -18,6 +18,7 @@ mod png_out;
 mod polygon;
 mod read;
 mod texture_file;
+mod texture_store;
 mod toml_scene;
 
 pub use error::Error;
@@ -32,7 +33,8 @@ pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
 pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
-pub use texture_file::{ReadFile, TextureStats, decode as decode_texture};
+pub use texture_file::{ReadFile, TextureStats, decode as decode_texture, last_store_error};
+pub use texture_store::{TextureStore, set_texture_store, texture_store};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_with,
 };

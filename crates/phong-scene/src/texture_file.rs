@@ -5,6 +5,7 @@
 //! A map whose image is missing or cannot be decoded is a warning naming the material, the
 //! file and why; the material is drawn without it (as three.js does).
 
+use crate::texture_store;
 use phong_core::limits::{MAX_IMAGE_FILE_BYTES, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
 use phong_core::{Channel, Maps, MetalRough, NormalMap, Occlusion, Sampler, Texture, TextureMap, UvTransform, Wrap};
 use std::cell::Cell;
@@ -24,6 +25,19 @@ pub struct TextureStats {
     pub decode: Duration,
     /// Building the mipmap chains.
     pub mipmaps: Duration,
+    /// Images read back from the texture store (their time is in `decode`).
+    pub from_store: usize,
+    /// Writing decoded textures to the store.
+    pub store_writes: Duration,
+    /// Writes to the store that failed (see [`last_store_error`]).
+    pub store_failures: usize,
+}
+
+static STORE_ERROR: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Why the last write to the texture store failed, if one did.
+pub fn last_store_error() -> Option<String> {
+    STORE_ERROR.lock().unwrap_or_else(|e| e.into_inner()).clone()
 }
 
 thread_local! {
@@ -193,18 +207,47 @@ impl TextureCache {
     }
 }
 
-/// [`decode`], its time added to this thread's [`TextureStats`] (`start`: when reading began).
+/// [`decode`], or the texture store's copy where it has one (and the decoded texture kept
+/// there), the time added to this thread's [`TextureStats`] (`start`: when reading began).
 fn decode_timed(bytes: &[u8], srgb: bool, start: Instant) -> Result<Texture, String> {
+    let store = texture_store::texture_store().map(|s| (texture_store::Key::of(bytes, srgb), s));
+    let add = |f: &dyn Fn(&mut TextureStats)| {
+        STATS.with(|s| {
+            let mut v = s.get();
+            f(&mut v);
+            s.set(v);
+        })
+    };
+    if let Some(t) = store.as_ref().and_then(|(key, s)| texture_store::fetch(s, *key)) {
+        add(&|v| {
+            v.images += 1;
+            v.from_store += 1;
+            v.bytes += t.bytes();
+            v.decode += start.elapsed();
+        });
+        return Ok(t);
+    }
     let mut mipmaps = Duration::ZERO;
     let t = decode_with(bytes, srgb, &mut mipmaps)?;
-    STATS.with(|s| {
-        let mut v = s.get();
+    let decoded = start.elapsed();
+    add(&|v| {
         v.images += 1;
         v.bytes += t.bytes();
-        v.decode += start.elapsed().saturating_sub(mipmaps);
+        v.decode += decoded.saturating_sub(mipmaps);
         v.mipmaps += mipmaps;
-        s.set(v);
     });
+    if let Some((key, s)) = &store {
+        let begun = Instant::now();
+        let kept = texture_store::keep(s, *key, &t);
+        let took = begun.elapsed();
+        if let Err(why) = &kept {
+            *STORE_ERROR.lock().unwrap_or_else(|e| e.into_inner()) = Some(why.clone());
+        }
+        add(&|v| {
+            v.store_writes += took;
+            v.store_failures += usize::from(kept.is_err());
+        });
+    }
     Ok(t)
 }
 
