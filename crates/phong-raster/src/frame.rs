@@ -69,6 +69,8 @@ pub(crate) struct Frame<'a> {
     /// Per object: its maps as the vector sampler reads them, for a [`Mode::Textured`] object
     /// whose maps it covers (decided once per frame).
     pub vector_maps: Vec<Option<VectorMaps<'a>>>,
+    /// Per object: whether a map reads the mesh's second set of texture coordinates.
+    pub second_sets: Vec<bool>,
     /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
     pub gouraud_only: bool,
     /// Per object: its view vector rule.
@@ -102,11 +104,13 @@ impl<'a> Frame<'a> {
             .map(|o| scene.camera.view(o.shading.viewer))
             .collect();
         let pattern = pattern(scene.image.samples);
+        let second_sets: Vec<bool> = scene.objects.iter().map(|o| o.maps.uses_second_set()).collect();
         let modes: Vec<Mode> = scene
             .objects
             .iter()
             .zip(&views)
-            .map(|(o, &view)| {
+            .zip(&second_sets)
+            .map(|((o, &view), &second_set)| {
                 let Some(term) = lit_term(o.shading.output) else {
                     return Mode::Scalar;
                 };
@@ -119,7 +123,7 @@ impl<'a> Frame<'a> {
                         || m.metal_rough.is_some()
                         || m.occlusion.is_some()
                         // The fast path's planes carry one set of coordinates.
-                        || m.uses_second_set();
+                        || second_set;
                     let one_sample = scene.image.samples == phong_core::Samples::One;
                     if o.shading.interpolation == Interpolation::Phong
                         && term == Term::Color
@@ -158,6 +162,7 @@ impl<'a> Frame<'a> {
                 })
                 .collect(),
             modes,
+            second_sets,
             views,
             w,
             h,

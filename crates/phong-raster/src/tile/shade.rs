@@ -452,9 +452,10 @@ impl Frame<'_> {
     /// or triangle (Gouraud, flat: OpenGL's `GL_MODULATE` with a separate specular colour).
     fn shade_textured_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
         let (t, corners) = (self.tri(id), self.corners(id));
-        let obj = &self.scene.objects[self.object(id)];
+        let object = self.object(id);
+        let obj = &self.scene.objects[object];
         let first = Self::uv_at(t, corners, px, py, |v| v.uv);
-        let second = if obj.maps.uses_second_set() {
+        let second = if self.second_sets[object] {
             Self::uv_at(t, corners, px, py, |v| v.uv1)
         } else {
             first
