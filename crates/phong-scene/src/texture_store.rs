@@ -62,7 +62,7 @@ const HEADER: usize = 8 + 8 + 16 + 1 + 1 + 4;
 pub(crate) struct Key {
     hash: u128,
     len: u64,
-    srgb: bool,
+    pub srgb: bool,
 }
 
 impl Key {

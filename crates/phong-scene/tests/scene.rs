@@ -373,3 +373,46 @@ fn unusable_file_normals_fall_back_with_a_warning() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// One image named by a scene's material and by its OBJ's MTL (and the scene loaded again, as
+/// `phong serve` reloads it): decoded once, the texture shared while alive.
+#[test]
+fn an_image_named_twice_is_decoded_once() {
+    let dir = std::env::temp_dir().join(format!("phong-scene-shared-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 4×4 RGB image unlike any other test's (the sharing is process-wide).
+    let mut png = Vec::new();
+    let mut enc = png::Encoder::new(&mut png, 4, 4);
+    enc.set_color(png::ColorType::Rgb);
+    let pixels: Vec<u8> = (0..48u8).map(|i| i.wrapping_mul(37).wrapping_add(11)).collect();
+    enc.write_header().unwrap().write_image_data(&pixels).unwrap();
+    std::fs::write(dir.join("shared.png"), &png).unwrap();
+    std::fs::write(dir.join("m.mtl"), "newmtl a\nKd 1 1 1\nmap_Kd shared.png\n").unwrap();
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        "[[object]]\nshape = \"plane\"\nmaterial = { diffuse_map = \"shared.png\" }\n[[object]]\nmesh = \"m.obj\"\n",
+    )
+    .unwrap();
+    let first = phong_scene::load(&dir.join("s.toml")).unwrap();
+    assert_eq!(
+        (first.textures.images, first.textures.shared),
+        (1, 1),
+        "{:?}",
+        first.textures
+    );
+    let map = |l: &phong_scene::Loaded, i: usize| l.scene.objects[i].maps.diffuse.clone().unwrap().texture;
+    assert!(std::sync::Arc::ptr_eq(&map(&first, 0), &map(&first, 1)));
+    // Loaded again while the first is alive: shared; once it is dropped: decoded anew.
+    let again = phong_scene::load(&dir.join("s.toml")).unwrap();
+    assert_eq!((again.textures.images, again.textures.shared), (0, 2));
+    assert!(std::sync::Arc::ptr_eq(&map(&first, 0), &map(&again, 0)));
+    drop((first, again));
+    let fresh = phong_scene::load(&dir.join("s.toml")).unwrap();
+    assert_eq!((fresh.textures.images, fresh.textures.shared), (1, 1));
+    let _ = std::fs::remove_dir_all(dir);
+}
