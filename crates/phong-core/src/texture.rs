@@ -337,20 +337,23 @@ impl Texture {
     /// (bottom row first), such as a cache kept: checked, not rebuilt. Each level must be the
     /// one before halved (rounded down, at least 1) down to 1×1, with its texel count.
     pub fn from_levels8(levels: Vec<(u32, u32, Vec<[u8; 4]>)>) -> Result<Texture, Error> {
-        let levels = checked_levels(levels, 4)?;
-        let translucent = any_translucent(&levels[0].texels);
-        Ok(Texture {
-            chain: Chain::Eight(levels),
-            translucent,
-        })
+        Texture::from_levels(levels, 4, Chain::Eight)
     }
 
     /// [`Texture::from_levels8`] for 16-bit texels ([`Texture::level16`]).
     pub fn from_levels16(levels: Vec<(u32, u32, Vec<[u16; 4]>)>) -> Result<Texture, Error> {
-        let levels = checked_levels(levels, 8)?;
+        Texture::from_levels(levels, 8, Chain::Sixteen)
+    }
+
+    fn from_levels<T: Texel>(
+        levels: Vec<(u32, u32, Vec<T>)>,
+        bytes_per_texel: u64,
+        chain: fn(Vec<Level<T>>) -> Chain,
+    ) -> Result<Texture, Error> {
+        let levels = checked_levels(levels, bytes_per_texel)?;
         let translucent = any_translucent(&levels[0].texels);
         Ok(Texture {
-            chain: Chain::Sixteen(levels),
+            chain: chain(levels),
             translucent,
         })
     }

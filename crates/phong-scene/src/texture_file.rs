@@ -736,7 +736,11 @@ mod tests {
             let t = decode(&file, false).unwrap();
             let what = format!("{color:?} {depth:?} tRNS {trns}");
             assert_eq!((t.width(), t.height()), (w, h), "{what}");
-            assert_eq!(png8(&file).is_some(), bits <= 8, "{what}: row by row where 8 bits or fewer");
+            assert_eq!(
+                png8(&file).is_some(),
+                bits <= 8,
+                "{what}: row by row where 8 bits or fewer"
+            );
             for y in 0..h {
                 for x in 0..w {
                     let e = expected.get_pixel(x, h - 1 - y).0;
