@@ -184,8 +184,13 @@ pub struct MapRequest {
 /// Decoded textures by (name, sRGB), so that a file named by several materials is read once.
 #[derive(Default)]
 pub struct TextureCache {
-    done: HashMap<(String, bool), Result<Arc<Texture>, String>>,
+    done: HashMap<ImageKey, Result<Arc<Texture>, String>>,
+    /// Decoded ahead by [`TextureCache::prefetch`], not yet counted against the budget.
+    ready: HashMap<ImageKey, Result<Arc<Texture>, String>>,
 }
+
+/// An image as maps name it: its name, and whether it is decoded from sRGB.
+type ImageKey = (String, bool);
 
 /// Reads a file named by a map (the name as written; the reader resolves it).
 pub type ReadFile<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
@@ -196,17 +201,91 @@ impl TextureCache {
         if let Some(r) = self.done.get(&key) {
             return r.clone();
         }
-        let start = Instant::now();
-        let bytes = match source {
-            Source::File(f) => read(f),
-            Source::Bytes(b, _) => Ok(b.to_vec()),
+        let decoded = match self.ready.remove(&key) {
+            Some(r) => r,
+            None => {
+                let mut stats = TextureStats::default();
+                let r = read_source(source, read).and_then(|b| shared_or_decoded(&b, srgb, Instant::now(), &mut stats));
+                add_stats(&stats);
+                r
+            }
         };
-        let r = bytes
-            .and_then(|b| shared_or_decoded(&b, srgb, start))
-            .and_then(|t| spend(t.bytes()).map(|()| t));
+        // The budget is spent in the order the maps are used, wherever they were decoded.
+        let r = decoded.and_then(|t| spend(t.bytes()).map(|()| t));
         self.done.insert(key, r.clone());
         r
     }
+
+    /// Reads the images `requests` will load that are not loaded yet (on this thread, through
+    /// `read`), then decodes them on all cores: a material's maps, or a model's, decode side
+    /// by side instead of one after another.
+    fn prefetch<'r>(&mut self, requests: impl IntoIterator<Item = &'r MapRequest>, read: &ReadFile) {
+        let mut wanted: Vec<(ImageKey, Result<Vec<u8>, String>)> = Vec::new();
+        for r in requests {
+            let key = (r.source.name().to_string(), r.srgb && r.slot.is_colour());
+            if self.done.contains_key(&key) || self.ready.contains_key(&key) || wanted.iter().any(|(k, _)| *k == key) {
+                continue;
+            }
+            wanted.push((key, read_source(&r.source, read)));
+        }
+        if wanted.is_empty() {
+            return;
+        }
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(wanted.len());
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let results: Vec<(usize, Result<Arc<Texture>, String>, TextureStats)> = std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads)
+                .map(|_| {
+                    scope.spawn(|| {
+                        let mut mine = Vec::new();
+                        loop {
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(((_, srgb), bytes)) = wanted.get(i) else {
+                                break mine;
+                            };
+                            let mut stats = TextureStats::default();
+                            let r = match bytes {
+                                Ok(b) => shared_or_decoded(b, *srgb, Instant::now(), &mut stats),
+                                Err(e) => Err(e.clone()),
+                            };
+                            mine.push((i, r, stats));
+                        }
+                    })
+                })
+                .collect();
+            workers.into_iter().flat_map(|w| w.join().unwrap_or_default()).collect()
+        });
+        for (i, r, stats) in results {
+            add_stats(&stats);
+            self.ready.insert(wanted[i].0.clone(), r);
+        }
+    }
+}
+
+/// The bytes of a map's image.
+fn read_source(source: &Source, read: &ReadFile) -> Result<Vec<u8>, String> {
+    match source {
+        Source::File(f) => read(f),
+        Source::Bytes(b, _) => Ok(b.to_vec()),
+    }
+}
+
+/// Adds `stats` to this thread's.
+fn add_stats(stats: &TextureStats) {
+    STATS.with(|s| {
+        let mut v = s.get();
+        v.images += stats.images;
+        v.bytes += stats.bytes;
+        v.decode += stats.decode;
+        v.mipmaps += stats.mipmaps;
+        v.from_store += stats.from_store;
+        v.store_writes += stats.store_writes;
+        v.store_failures += stats.store_failures;
+        v.shared += stats.shared;
+        s.set(v);
+    });
 }
 
 /// Textures alive in this process by their image's [`Key`]: an image that another loader
@@ -214,20 +293,22 @@ impl TextureCache {
 /// shared, not decoded again.
 static LIVE: Mutex<Vec<(Key, Weak<Texture>)>> = Mutex::new(Vec::new());
 
-/// The texture of `bytes`: one alive in this process, else [`decode_timed`].
-fn shared_or_decoded(bytes: &[u8], srgb: bool, start: Instant) -> Result<Arc<Texture>, String> {
+/// The texture of `bytes`: one alive in this process, else [`decode_timed`]; what it cost
+/// added to `stats`.
+fn shared_or_decoded(
+    bytes: &[u8],
+    srgb: bool,
+    start: Instant,
+    stats: &mut TextureStats,
+) -> Result<Arc<Texture>, String> {
     let key = Key::of(bytes, srgb);
     let live = || LIVE.lock().unwrap_or_else(|e| e.into_inner());
     let found = live().iter().find(|(k, _)| *k == key).and_then(|(_, w)| w.upgrade());
     if let Some(t) = found {
-        STATS.with(|s| {
-            let mut v = s.get();
-            v.shared += 1;
-            s.set(v);
-        });
+        stats.shared += 1;
         return Ok(t);
     }
-    let t = Arc::new(decode_timed(bytes, key, start)?);
+    let t = Arc::new(decode_timed(bytes, key, start, stats)?);
     let mut l = live();
     l.retain(|(k, w)| w.strong_count() > 0 && *k != key);
     l.push((key, Arc::downgrade(&t)));
@@ -235,46 +316,30 @@ fn shared_or_decoded(bytes: &[u8], srgb: bool, start: Instant) -> Result<Arc<Tex
 }
 
 /// [`decode`], or the texture store's copy where it has one (and the decoded texture kept
-/// there), the time added to this thread's [`TextureStats`] (`start`: when reading began).
-fn decode_timed(bytes: &[u8], key: Key, start: Instant) -> Result<Texture, String> {
-    let srgb = key.srgb;
+/// there), the time added to `stats` (`start`: when decoding began).
+fn decode_timed(bytes: &[u8], key: Key, start: Instant, stats: &mut TextureStats) -> Result<Texture, String> {
     let store = texture_store::texture_store().map(|s| (key, s));
-    let add = |f: &dyn Fn(&mut TextureStats)| {
-        STATS.with(|s| {
-            let mut v = s.get();
-            f(&mut v);
-            s.set(v);
-        })
-    };
     if let Some(t) = store.as_ref().and_then(|(key, s)| texture_store::fetch(s, *key)) {
-        add(&|v| {
-            v.images += 1;
-            v.from_store += 1;
-            v.bytes += t.bytes();
-            v.decode += start.elapsed();
-        });
+        stats.images += 1;
+        stats.from_store += 1;
+        stats.bytes += t.bytes();
+        stats.decode += start.elapsed();
         return Ok(t);
     }
     let mut mipmaps = Duration::ZERO;
-    let t = decode_with(bytes, srgb, &mut mipmaps)?;
-    let decoded = start.elapsed();
-    add(&|v| {
-        v.images += 1;
-        v.bytes += t.bytes();
-        v.decode += decoded.saturating_sub(mipmaps);
-        v.mipmaps += mipmaps;
-    });
+    let t = decode_with(bytes, key.srgb, &mut mipmaps)?;
+    stats.images += 1;
+    stats.bytes += t.bytes();
+    stats.decode += start.elapsed().saturating_sub(mipmaps);
+    stats.mipmaps += mipmaps;
     if let Some((key, s)) = &store {
         let begun = Instant::now();
         let kept = texture_store::keep(s, *key, &t);
-        let took = begun.elapsed();
-        if let Err(why) = &kept {
-            *STORE_ERROR.lock().unwrap_or_else(|e| e.into_inner()) = Some(why.clone());
+        stats.store_writes += begun.elapsed();
+        if let Err(why) = kept {
+            *STORE_ERROR.lock().unwrap_or_else(|e| e.into_inner()) = Some(why);
+            stats.store_failures += 1;
         }
-        add(&|v| {
-            v.store_writes += took;
-            v.store_failures += usize::from(kept.is_err());
-        });
     }
     Ok(t)
 }
@@ -412,6 +477,21 @@ fn png8(bytes: &[u8]) -> Option<Result<Rgba8, String>> {
     Some(Ok((w, h, texels)))
 }
 
+/// The requests of one material that [`resolve`] loads: all but a bump map beside a normal
+/// map.
+fn used(requests: &[MapRequest]) -> impl Iterator<Item = &MapRequest> {
+    let has_normal_map = requests.iter().any(|r| r.slot == Slot::Normal);
+    requests
+        .iter()
+        .filter(move |r| !(r.slot == Slot::Bump && has_normal_map))
+}
+
+/// Decodes ahead, on all cores, the images that the materials' `requests` will load (see
+/// [`resolve`]): a model's maps side by side.
+pub fn prefetch(materials: &[Vec<MapRequest>], read: &ReadFile, cache: &mut TextureCache) {
+    cache.prefetch(materials.iter().flat_map(|m| used(m)), read);
+}
+
 /// A material's maps from its requests, images read by `read` through `cache`; every request
 /// that cannot be used is a warning (material `name`), and the material goes without it.
 ///
@@ -425,6 +505,7 @@ pub fn resolve(
     warnings: &mut Vec<String>,
 ) -> Maps {
     let mut maps = Maps::default();
+    cache.prefetch(used(requests), read);
     let has_normal_map = requests.iter().any(|r| r.slot == Slot::Normal);
     for r in requests {
         if r.slot == Slot::Bump && has_normal_map {

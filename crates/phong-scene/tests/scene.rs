@@ -416,3 +416,46 @@ fn an_image_named_twice_is_decoded_once() {
     assert_eq!((fresh.textures.images, fresh.textures.shared), (1, 1));
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A material's maps decoded side by side give each image's own decoding; a bump map beside a
+/// normal map is not decoded at all, and a missing image is a warning as before.
+#[test]
+fn a_materials_maps_decode_side_by_side_as_each_alone() {
+    let dir = std::env::temp_dir().join(format!("phong-scene-prefetch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let names = ["kd.png", "ks.png", "ke.png", "nm.png", "bump.png"];
+    let mut files = Vec::new();
+    for (k, name) in names.iter().enumerate() {
+        let mut png = Vec::new();
+        let mut enc = png::Encoder::new(&mut png, 6, 5);
+        enc.set_color(png::ColorType::Rgb);
+        let pixels: Vec<u8> = (0..90u8)
+            .map(|i| i.wrapping_mul(31 + 2 * k as u8).wrapping_add(k as u8))
+            .collect();
+        enc.write_header().unwrap().write_image_data(&pixels).unwrap();
+        std::fs::write(dir.join(name), &png).unwrap();
+        files.push(png);
+    }
+    std::fs::write(
+        dir.join("s.toml"),
+        "[[object]]\nshape = \"plane\"\nmaterial = { diffuse_map = \"kd.png\", specular_map = \"ks.png\", \
+         emission_map = \"ke.png\", normal_map = \"nm.png\", bump_map = \"bump.png\", ambient_map = \"none.png\" }\n",
+    )
+    .unwrap();
+    let l = phong_scene::load(&dir.join("s.toml")).unwrap();
+    assert_eq!(l.textures.images, 4, "{:?}", l.textures);
+    let maps = &l.scene.objects[0].maps;
+    let alone = |k: usize| phong_scene::decode_texture(&files[k], false).unwrap();
+    assert_eq!(*maps.diffuse.as_ref().unwrap().texture, alone(0));
+    assert_eq!(*maps.specular.as_ref().unwrap().texture, alone(1));
+    assert_eq!(*maps.emission.as_ref().unwrap().texture, alone(2));
+    assert_eq!(*maps.normal.as_ref().unwrap().map.texture, alone(3));
+    assert!(maps.ambient.is_none());
+    let warned = |what: &str| l.warnings.iter().any(|w| w.contains(what));
+    assert!(
+        warned("none.png") && warned("bump map bump.png is not used"),
+        "{:?}",
+        l.warnings
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -20,7 +20,7 @@ mod mtl;
 mod text;
 
 use crate::Error;
-use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, resolve};
+use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, prefetch, resolve};
 use glam::{DVec3, Vec2, Vec3};
 use mtl::{check_mtl, mtl_names, normalize_mtl, to_material};
 use phong_core::{Color, Maps, Material, Mesh};
@@ -295,16 +295,22 @@ pub fn load_obj_text(
     // Each material's maps, its images read once for the whole file.
     let requests = map_requests.into_inner();
     let mut cache = TextureCache::default();
-    let maps: Vec<Maps> = tobj_materials
+    let mine: Vec<Vec<MapRequest>> = tobj_materials
         .iter()
         .map(|m| {
-            let mine: Vec<MapRequest> = requests
+            requests
                 .iter()
                 .filter(|(name, _)| *name == m.name)
                 .map(|(_, r)| r.clone())
-                .collect();
-            resolve(&mine, &m.name, read_texture, &mut cache, warnings)
+                .collect()
         })
+        .collect();
+    // Every material's images decoded side by side, then resolved in order.
+    prefetch(&mine, read_texture, &mut cache);
+    let maps: Vec<Maps> = tobj_materials
+        .iter()
+        .zip(&mine)
+        .map(|(m, mine)| resolve(mine, &m.name, read_texture, &mut cache, warnings))
         .collect();
     let file = path
         .file_name()
