@@ -248,12 +248,21 @@ fn trim(store: &TextureStore, keep: &Path) {
     };
     let mut files: Vec<(SystemTime, u64, PathBuf)> = entries
         .flatten()
-        .filter(|e| e.path().extension().is_some_and(|x| x == "ptx"))
         .filter_map(|e| {
             let m = e.metadata().ok()?;
             Some((m.modified().ok()?, m.len(), e.path()))
         })
         .collect();
+    // A temporary file an hour old was left by a process that stopped while writing it.
+    let stale = SystemTime::now() - std::time::Duration::from_secs(3600);
+    files.retain(|(when, _, path)| match path.extension().and_then(|x| x.to_str()) {
+        Some("ptx") => true,
+        Some("tmp") if *when < stale => {
+            let _ = std::fs::remove_file(path);
+            false
+        }
+        _ => false,
+    });
     let mut total: u64 = files.iter().map(|f| f.1).sum();
     files.sort();
     for (_, len, path) in files {
@@ -351,6 +360,20 @@ mod tests {
         keep(&s, keys[2], &t).unwrap();
         let there = keys.map(|k| k.file(&s.dir).exists());
         assert_eq!(there, [true, false, true]);
+        // Temporary files left by a stopped writer: removed once an hour old, not before.
+        let (old, new) = (s.dir.join(".x.ptx.1.tmp"), s.dir.join(".y.ptx.2.tmp"));
+        for f in [&old, &new] {
+            std::fs::write(f, b"partial").unwrap();
+        }
+        let two_hours = SystemTime::now() - std::time::Duration::from_secs(7200);
+        File::options()
+            .write(true)
+            .open(&old)
+            .unwrap()
+            .set_modified(two_hours)
+            .unwrap();
+        keep(&s, keys[1], &t).unwrap();
+        assert!(!old.exists() && new.exists());
         std::fs::remove_dir_all(&s.dir).unwrap();
     }
 }
