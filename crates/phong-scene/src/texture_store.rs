@@ -21,8 +21,8 @@ use std::time::SystemTime;
 pub struct TextureStore {
     /// The folder (made where missing).
     pub dir: PathBuf,
-    /// Textures smaller than this (bytes, mipmaps included) are not kept: they decode about as
-    /// fast as they read back.
+    /// Textures smaller than this (bytes, mipmaps included) are not kept: disk is spent only
+    /// where decoding costs about a frame or more (BENCHMARKS.md, "The texture cache").
     pub min_bytes: u64,
     /// The folder's files are kept under this many bytes in all.
     pub max_total: u64,
