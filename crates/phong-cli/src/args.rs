@@ -209,11 +209,12 @@ impl RunArgs {
             let t = &loaded.textures;
             if t.images + t.shared > 0 {
                 eprintln!(
-                    "phong: textures: {} images ({} from the texture cache), {} shared, {:.1} MiB with mipmaps; decode={:.1}ms mipmaps={:.1}ms cache-write={:.1}ms",
+                    "phong: textures: {} images ({} from the texture cache), {} shared, {:.1} MiB with mipmaps; read={:.1}ms decode={:.1}ms mipmaps={:.1}ms cache-write={:.1}ms",
                     t.images,
                     t.from_store,
                     t.shared,
                     t.bytes as f64 / f64::from(1u32 << 20),
+                    t.read.as_secs_f64() * 1e3,
                     t.decode.as_secs_f64() * 1e3,
                     t.mipmaps.as_secs_f64() * 1e3,
                     t.store_writes.as_secs_f64() * 1e3

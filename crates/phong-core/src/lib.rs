@@ -57,7 +57,7 @@ pub use shading::{
     Lighting, Lit, LyonLambda, Normalization, Shading, ShadingOptions, SpecularModel, SurfacePoint, View, light, lyon,
     pow_positive, shade, shade_textured, specular_factor,
 };
-pub use texture::{Filter, MipFilter, Sampler, Texture, Wrap};
+pub use texture::{Filter, MipFilter, Sampler, SharedBytes, Texture, Wrap};
 
 /// The math types phong uses (re-exported from glam).
 pub use glam;

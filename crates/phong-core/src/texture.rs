@@ -9,6 +9,8 @@
 use crate::Error;
 use crate::limits::{MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE};
 use glam::{Vec2, Vec4};
+use std::ops::{Deref, Range};
+use std::sync::Arc;
 
 /// How a coordinate outside `[0, 1]` is brought back (`GL_REPEAT`, `GL_CLAMP_TO_EDGE`,
 /// `GL_MIRRORED_REPEAT`).
@@ -106,7 +108,7 @@ impl Sampler {
 }
 
 /// A texel's storage: 8 or 16 bits a channel.
-pub trait Texel: Copy + Send + Sync + std::fmt::Debug + PartialEq + 'static {
+pub trait Texel: bytemuck::Pod + Send + Sync + std::fmt::Debug + PartialEq + 'static {
     /// The largest channel value (255 or 65535).
     const MAX: f32;
     /// The channels as values in `[0, 1]` (`c / 255` or `c / 65535`, correctly rounded).
@@ -173,12 +175,48 @@ macro_rules! texel {
 texel!(u8, u16);
 texel!(u16, u32);
 
+/// Bytes that a texture's levels can be borrowed from instead of owned, such as a texture
+/// cache's file read into memory (huge pages, which a `Vec` cannot ask for). It must give the
+/// same bytes at every call.
+pub type SharedBytes = Arc<dyn AsRef<[u8]> + Send + Sync>;
+
+/// A level's texels: owned, or a checked range of shared bytes.
+#[derive(Clone)]
+enum Texels<T> {
+    Owned(Vec<T>),
+    Shared(SharedBytes, Range<usize>),
+}
+
+impl<T: Texel> Deref for Texels<T> {
+    type Target = [T];
+    #[inline(always)]
+    fn deref(&self) -> &[T] {
+        match self {
+            Texels::Owned(v) => v,
+            // The range's length and alignment were checked when it was made.
+            Texels::Shared(bytes, r) => bytemuck::cast_slice(&(**bytes).as_ref()[r.clone()]),
+        }
+    }
+}
+
+impl<T: Texel> PartialEq for Texels<T> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl<T: Texel> std::fmt::Debug for Texels<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} texels", self.len())
+    }
+}
+
 /// One mipmap level: `width × height` RGBA texels, bottom row first.
 #[derive(Clone, Debug, PartialEq)]
-struct Level<T> {
+struct Level<T: Texel> {
     width: u32,
     height: u32,
-    texels: Vec<T>,
+    texels: Texels<T>,
 }
 
 /// A mipmap chain of 8- or 16-bit texels.
@@ -233,7 +271,11 @@ fn chain<T: Texel>(width: u32, mut texels: Vec<T>) -> Vec<Level<T>> {
         let (top, bottom) = texels.split_at_mut((h - 1 - y) * w);
         top[y * w..(y + 1) * w].swap_with_slice(&mut bottom[..w]);
     }
-    let mut levels = vec![Level { width, height, texels }];
+    let mut levels = vec![Level {
+        width,
+        height,
+        texels: Texels::Owned(texels),
+    }];
     while let Some(next) = levels.last().and_then(Level::halved) {
         levels.push(next);
     }
@@ -250,7 +292,7 @@ fn any_translucent<T: Texel>(texels: &[T]) -> bool {
 
 /// A given mipmap chain as levels: level 0 within the limits, each next level its predecessor
 /// halved, the last 1×1, every texel count matching its size.
-fn checked_levels<T>(levels: Vec<(u32, u32, Vec<T>)>, bytes_per_texel: u64) -> Result<Vec<Level<T>>, Error> {
+fn checked_levels<T: Texel>(levels: Vec<(u32, u32, Texels<T>)>, bytes_per_texel: u64) -> Result<Vec<Level<T>>, Error> {
     let Some(&(w0, h0, ref t0)) = levels.first() else {
         return Err(Error::OutOfRange {
             what: "number of mipmap levels",
@@ -345,13 +387,70 @@ impl Texture {
         Texture::from_levels(levels, 8, Chain::Sixteen)
     }
 
+    /// A texture from a whole mipmap chain of 8-bit texels of sizes `sizes`, borrowed from
+    /// `bytes`, which holds the levels end to end from byte 0 (as [`Texture::from_levels8`]
+    /// takes them) and nothing after them. `has_alpha`: [`Texture::has_alpha`] where the caller
+    /// knows it, else found from the texels.
+    pub fn from_shared8(bytes: SharedBytes, sizes: &[(u32, u32)], has_alpha: Option<bool>) -> Result<Texture, Error> {
+        Texture::from_shared(bytes, sizes, has_alpha, 4, Chain::Eight)
+    }
+
+    /// [`Texture::from_shared8`] for 16-bit texels (2-byte aligned).
+    pub fn from_shared16(bytes: SharedBytes, sizes: &[(u32, u32)], has_alpha: Option<bool>) -> Result<Texture, Error> {
+        Texture::from_shared(bytes, sizes, has_alpha, 8, Chain::Sixteen)
+    }
+
+    fn from_shared<T: Texel>(
+        bytes: SharedBytes,
+        sizes: &[(u32, u32)],
+        has_alpha: Option<bool>,
+        bytes_per_texel: u64,
+        chain: fn(Vec<Level<T>>) -> Chain,
+    ) -> Result<Texture, Error> {
+        let all = (*bytes).as_ref();
+        let mut at = 0usize;
+        let mut levels = Vec::with_capacity(sizes.len());
+        for &(w, h) in sizes {
+            let len = (u64::from(w) * u64::from(h)).saturating_mul(bytes_per_texel);
+            let end = usize::try_from(len).ok().and_then(|len| at.checked_add(len));
+            let range = end.filter(|&end| end <= all.len()).map(|end| at..end);
+            let Some(range) = range.filter(|r| bytemuck::try_cast_slice::<u8, T>(&all[r.clone()]).is_ok()) else {
+                return Err(Error::OutOfRange {
+                    what: "shared texel bytes (their length or alignment)",
+                    range: "the levels' sizes, end to end",
+                    value: levels.len() as f32,
+                });
+            };
+            at = range.end;
+            levels.push((w, h, Texels::Shared(bytes.clone(), range)));
+        }
+        if at != all.len() {
+            return Err(Error::OutOfRange {
+                what: "shared texel bytes (their length)",
+                range: "the levels' sizes, end to end",
+                value: all.len() as f32,
+            });
+        }
+        Texture::checked(levels, has_alpha, bytes_per_texel, chain)
+    }
+
     fn from_levels<T: Texel>(
         levels: Vec<(u32, u32, Vec<T>)>,
         bytes_per_texel: u64,
         chain: fn(Vec<Level<T>>) -> Chain,
     ) -> Result<Texture, Error> {
+        let levels = levels.into_iter().map(|(w, h, t)| (w, h, Texels::Owned(t))).collect();
+        Texture::checked(levels, None, bytes_per_texel, chain)
+    }
+
+    fn checked<T: Texel>(
+        levels: Vec<(u32, u32, Texels<T>)>,
+        has_alpha: Option<bool>,
+        bytes_per_texel: u64,
+        chain: fn(Vec<Level<T>>) -> Chain,
+    ) -> Result<Texture, Error> {
         let levels = checked_levels(levels, bytes_per_texel)?;
-        let translucent = any_translucent(&levels[0].texels);
+        let translucent = has_alpha.unwrap_or_else(|| any_translucent(&levels[0].texels));
         Ok(Texture {
             chain: chain(levels),
             translucent,
@@ -521,7 +620,11 @@ impl<T: Texel> Level<T> {
                 texels.extend(a.iter().zip(b).map(|(&p, &q)| T::mean([p, p, q, q])));
             }
         }
-        Some(Level { width, height, texels })
+        Some(Level {
+            width,
+            height,
+            texels: Texels::Owned(texels),
+        })
     }
 }
 
@@ -633,6 +736,57 @@ mod tests {
         let back = Texture::from_levels16(l16).unwrap();
         assert!(back.has_alpha());
         assert_eq!(back, t16);
+    }
+
+    #[test]
+    fn levels_borrowed_from_shared_bytes_sample_as_owned_ones() {
+        let t = grey(&[0, 10, 99, 20, 31, 99], 3, 2);
+        let flat: Vec<u8> = (0..t.level_count())
+            .flat_map(|i| t.level8(i).unwrap().2.as_flattened().to_vec())
+            .collect();
+        let sizes = [(3, 2), (1, 1)];
+        let shared = Texture::from_shared8(Arc::new(flat.clone()), &sizes, None).unwrap();
+        assert_eq!(shared, t);
+        assert!(shared.has_alpha(), "grey's alpha is its value: found from the texels");
+        let s = Sampler::trilinear(Wrap::Repeat);
+        for (uv, lod) in [
+            (Vec2::new(0.3, 0.7), 0.0),
+            (Vec2::new(0.9, 0.2), 0.4),
+            (Vec2::new(-0.6, 1.3), 2.0),
+        ] {
+            assert_eq!(shared.sample(&s, uv, lod), t.sample(&s, uv, lod));
+        }
+        // A caller that knows the alpha is believed; one that does not has it found.
+        assert!(
+            !Texture::from_shared8(Arc::new(flat.clone()), &sizes, Some(false))
+                .unwrap()
+                .has_alpha()
+        );
+        // Too few bytes, one too many, a chain that is not halved: errors.
+        assert!(Texture::from_shared8(Arc::new(flat[..27].to_vec()), &sizes, None).is_err());
+        assert!(Texture::from_shared8(Arc::new([&flat[..], &[0]].concat()), &sizes, None).is_err());
+        assert!(Texture::from_shared8(Arc::new(flat.clone()), &[(3, 2), (2, 1)], None).is_err());
+        // 16 bits need 2-byte alignment: bytes that start at an odd address are refused.
+        let t16 = Texture::new(1, 2, &[[0, 0, 0, 65535], [9, 9, 9, 100]], 16).unwrap();
+        let mut b16: Vec<u8> = vec![0];
+        for i in 0..t16.level_count() {
+            b16.extend_from_slice(bytemuck::cast_slice(t16.level16(i).unwrap().2));
+        }
+        let odd = OddStart(b16);
+        let even = Arc::new(odd.as_ref()[..].to_vec());
+        let sizes16 = [(1, 2), (1, 1)];
+        let aligned = Texture::from_shared16(even, &sizes16, None);
+        let unaligned = Texture::from_shared16(Arc::new(odd), &sizes16, None);
+        assert_eq!(aligned.unwrap(), t16);
+        assert!(unaligned.is_err());
+    }
+
+    /// Bytes one past the start of a vector (whose buffer the allocator aligns): an odd address.
+    struct OddStart(Vec<u8>);
+    impl AsRef<[u8]> for OddStart {
+        fn as_ref(&self) -> &[u8] {
+            &self.0[1..]
+        }
     }
 
     #[test]

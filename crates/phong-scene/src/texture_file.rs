@@ -21,7 +21,9 @@ pub struct TextureStats {
     pub images: usize,
     /// Bytes of their textures, mipmaps included.
     pub bytes: u64,
-    /// Reading and decoding the files.
+    /// Reading the image files.
+    pub read: Duration,
+    /// Hashing and decoding the images, or reading them back from the texture store.
     pub decode: Duration,
     /// Building the mipmap chains.
     pub mipmaps: Duration,
@@ -205,7 +207,10 @@ impl TextureCache {
             Some(r) => r,
             None => {
                 let mut stats = TextureStats::default();
-                let r = read_source(source, read).and_then(|b| shared_or_decoded(&b, srgb, Instant::now(), &mut stats));
+                let begun = Instant::now();
+                let bytes = read_source(source, read);
+                stats.read = begun.elapsed();
+                let r = bytes.and_then(|b| shared_or_decoded(&b, srgb, Instant::now(), &mut stats));
                 add_stats(&stats);
                 r
             }
@@ -221,6 +226,7 @@ impl TextureCache {
     /// by side instead of one after another.
     fn prefetch<'r>(&mut self, requests: impl IntoIterator<Item = &'r MapRequest>, read: &ReadFile) {
         let mut wanted: Vec<(ImageKey, Result<Vec<u8>, String>)> = Vec::new();
+        let begun = Instant::now();
         for r in requests {
             let key = (r.source.name().to_string(), r.srgb && r.slot.is_colour());
             if self.done.contains_key(&key) || self.ready.contains_key(&key) || wanted.iter().any(|(k, _)| *k == key) {
@@ -228,6 +234,10 @@ impl TextureCache {
             }
             wanted.push((key, read_source(&r.source, read)));
         }
+        add_stats(&TextureStats {
+            read: begun.elapsed(),
+            ..TextureStats::default()
+        });
         if wanted.is_empty() {
             return;
         }
@@ -278,6 +288,7 @@ fn add_stats(stats: &TextureStats) {
         let mut v = s.get();
         v.images += stats.images;
         v.bytes += stats.bytes;
+        v.read += stats.read;
         v.decode += stats.decode;
         v.mipmaps += stats.mipmaps;
         v.from_store += stats.from_store;

@@ -9,11 +9,11 @@
 //! are written whole under a temporary name and renamed; the folder is kept under its size
 //! limit by removing the files least recently used.
 
-use phong_core::Texture;
+use phong_core::{SharedBytes, Texture};
 use std::fs::File;
 use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::RwLock;
+use std::sync::{Arc, RwLock};
 use std::time::SystemTime;
 
 /// Where and what to keep.
@@ -53,9 +53,10 @@ pub fn texture_store() -> Option<TextureStore> {
     STORE.read().unwrap_or_else(|e| e.into_inner()).clone()
 }
 
-const MAGIC: &[u8; 8] = b"phongtx\x01";
-/// Magic, source length, source hash, sRGB, bits, level count.
-const HEADER: usize = 8 + 8 + 16 + 1 + 1 + 4;
+const MAGIC: &[u8; 8] = b"phongtx\x02";
+/// Magic, source length, source hash, sRGB, bits, level count, whether any alpha is below 1
+/// (saves reading level 0 through once more).
+const HEADER: usize = 8 + 8 + 16 + 1 + 1 + 4 + 1;
 
 /// An image's key: its bytes' hash and length, and whether colour was decoded from sRGB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,7 +83,7 @@ impl Key {
         ))
     }
 
-    fn header(&self, bits: u8, levels: u32) -> [u8; HEADER] {
+    fn header(&self, bits: u8, levels: u32, translucent: bool) -> [u8; HEADER] {
         let mut h = [0u8; HEADER];
         h[..8].copy_from_slice(MAGIC);
         h[8..16].copy_from_slice(&self.len.to_le_bytes());
@@ -90,6 +91,7 @@ impl Key {
         h[32] = u8::from(self.srgb);
         h[33] = bits;
         h[34..38].copy_from_slice(&levels.to_le_bytes());
+        h[38] = u8::from(translucent);
         h
     }
 }
@@ -100,7 +102,7 @@ pub(crate) fn fetch(store: &TextureStore, key: Key) -> Option<Texture> {
     let mut h = [0u8; HEADER];
     f.read_exact(&mut h).ok()?;
     let count = u32::from_le_bytes(h[34..38].try_into().ok()?);
-    if h[..34] != key.header(h[33], count)[..34] || count == 0 || count > 32 {
+    if h[..34] != key.header(h[33], count, false)[..34] || count == 0 || count > 32 || h[38] > 1 {
         return None;
     }
     let mut sizes = vec![[0u8; 8]; count as usize];
@@ -142,33 +144,29 @@ pub(crate) fn fetch(store: &TextureStore, key: Key) -> Option<Texture> {
     if f.metadata().ok()?.len() != start + data {
         return None;
     }
+    let bytes = read_levels(&f, start, data)?;
     let t = match h[33] {
-        8 => Texture::from_levels8(read_levels(&f, start, &sizes)?),
-        _ => Texture::from_levels16(read_levels(&f, start, &sizes)?),
+        8 => Texture::from_shared8(bytes, &sizes, Some(h[38] == 1)),
+        _ => Texture::from_shared16(bytes, &sizes, Some(h[38] == 1)),
     }
     .ok()?;
     let _ = f.set_modified(SystemTime::now());
     Some(t)
 }
 
-/// The levels of sizes `sizes` from byte `start` of `f`, read straight into their texels, in
-/// pieces spread over the cores (the copy into fresh memory is most of a read's time).
-fn read_levels<T: bytemuck::Pod>(f: &File, start: u64, sizes: &[(u32, u32)]) -> Option<Vec<(u32, u32, Vec<T>)>> {
-    let mut levels: Vec<(u32, u32, Vec<T>)> = sizes
-        .iter()
-        .map(|&(w, h)| (w, h, vec![T::zeroed(); w as usize * h as usize]))
-        .collect();
+/// `len` bytes from byte `start` of `f`, read into memory of their own that asks for huge
+/// pages (most of a read's time was faulting in 4 KiB pages), in pieces spread over the cores.
+fn read_levels(f: &File, start: u64, len: u64) -> Option<SharedBytes> {
+    let mut map = memmap2::MmapMut::map_anon(usize::try_from(len).ok()?).ok()?;
+    // Only a hint: without transparent huge pages the read takes longer, no more.
+    #[cfg(target_os = "linux")]
+    let _ = map.advise(memmap2::Advice::HugePage);
     const PIECE: usize = 4 << 20;
-    let mut pieces: Vec<(u64, &mut [u8])> = Vec::new();
-    let mut at = start;
-    for (_, _, texels) in &mut levels {
-        let bytes: &mut [u8] = bytemuck::cast_slice_mut(texels);
-        let len = bytes.len() as u64;
-        for (i, piece) in bytes.chunks_mut(PIECE).enumerate() {
-            pieces.push((at + (i * PIECE) as u64, piece));
-        }
-        at += len;
-    }
+    let mut pieces: Vec<(u64, &mut [u8])> = map
+        .chunks_mut(PIECE)
+        .enumerate()
+        .map(|(i, piece)| (start + (i * PIECE) as u64, piece))
+        .collect();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
     let per = pieces.len().div_ceil(threads).max(1);
     let ok = std::thread::scope(|s| {
@@ -178,7 +176,8 @@ fn read_levels<T: bytemuck::Pod>(f: &File, start: u64, sizes: &[(u32, u32)]) -> 
             .collect();
         handles.into_iter().all(|h| h.join().unwrap_or(false))
     });
-    ok.then_some(levels)
+    let map = map.make_read_only().ok()?;
+    ok.then(|| Arc::new(map) as SharedBytes)
 }
 
 /// Fills `buf` from byte `at` of `f`.
@@ -220,7 +219,7 @@ pub(crate) fn keep(store: &TextureStore, key: Key, t: &Texture) -> Result<(), St
 fn write(tmp: &Path, key: Key, t: &Texture) -> std::io::Result<()> {
     let mut out = BufWriter::new(File::create(tmp)?);
     let count = t.level_count();
-    out.write_all(&key.header(t.bits(), count as u32))?;
+    out.write_all(&key.header(t.bits(), count as u32, t.has_alpha()))?;
     let size = |(w, h): (u32, u32)| [w.to_le_bytes(), h.to_le_bytes()].concat();
     for i in 0..count {
         let wh = match (t.level8(i), t.level16(i)) {
@@ -311,6 +310,20 @@ mod tests {
         let k16 = Key::of(b"sixteen", true);
         keep(&s, k16, &t16).unwrap();
         assert_eq!(fetch(&s, k16), Some(t16));
+        // Whether alpha is below 1 is kept, not found again: both ways.
+        assert!(fetch(&s, key).unwrap().has_alpha());
+        let opaque = Texture::from_rgba8(4, 4, &[[9, 8, 7, 255]; 16]).unwrap();
+        let ko = Key::of(b"opaque", false);
+        keep(&s, ko, &opaque).unwrap();
+        assert!(!fetch(&s, ko).unwrap().has_alpha());
+        // It comes from the header (byte 38), not from the texels.
+        let mut flipped = std::fs::read(ko.file(&s.dir)).unwrap();
+        flipped[38] = 1;
+        std::fs::write(ko.file(&s.dir), &flipped).unwrap();
+        assert!(fetch(&s, ko).unwrap().has_alpha());
+        flipped[38] = 2;
+        std::fs::write(ko.file(&s.dir), &flipped).unwrap();
+        assert_eq!(fetch(&s, ko), None, "a flag byte that is neither 0 nor 1");
         std::fs::remove_dir_all(&s.dir).unwrap();
     }
 
@@ -332,7 +345,7 @@ mod tests {
         std::fs::write(&path, &bad).unwrap();
         assert_eq!(fetch(&s, key), None);
         let mut bad = whole.clone();
-        bad[7] = 2;
+        bad[7] = 1;
         std::fs::write(&path, &bad).unwrap();
         assert_eq!(fetch(&s, key), None);
         std::fs::write(&path, &whole).unwrap();
