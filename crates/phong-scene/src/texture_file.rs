@@ -488,19 +488,17 @@ fn png8(bytes: &[u8]) -> Option<Result<Rgba8, String>> {
     Some(Ok((w, h, texels)))
 }
 
-/// The requests of one material that [`resolve`] loads: all but a bump map beside a normal
-/// map.
-fn used(requests: &[MapRequest]) -> impl Iterator<Item = &MapRequest> {
+/// The requests of one material that [`resolve`] loads, and those it does not: a bump map
+/// beside a normal map (the one owner of that rule).
+fn used(requests: &[MapRequest]) -> (Vec<&MapRequest>, Vec<&MapRequest>) {
     let has_normal_map = requests.iter().any(|r| r.slot == Slot::Normal);
-    requests
-        .iter()
-        .filter(move |r| !(r.slot == Slot::Bump && has_normal_map))
+    requests.iter().partition(|r| !(r.slot == Slot::Bump && has_normal_map))
 }
 
 /// Decodes ahead, on all cores, the images that the materials' `requests` will load (see
 /// [`resolve`]): a model's maps side by side.
 pub fn prefetch(materials: &[Vec<MapRequest>], read: &ReadFile, cache: &mut TextureCache) {
-    cache.prefetch(materials.iter().flat_map(|m| used(m)), read);
+    cache.prefetch(materials.iter().flat_map(|m| used(m).0), read);
 }
 
 /// A material's maps from its requests, images read by `read` through `cache`; every request
@@ -516,17 +514,16 @@ pub fn resolve(
     warnings: &mut Vec<String>,
 ) -> Maps {
     let mut maps = Maps::default();
-    cache.prefetch(used(requests), read);
-    let has_normal_map = requests.iter().any(|r| r.slot == Slot::Normal);
-    for r in requests {
-        if r.slot == Slot::Bump && has_normal_map {
-            warnings.push(format!(
-                "{}: material {name}: bump map {} is not used (the material has a normal map)",
-                r.at,
-                r.source.name()
-            ));
-            continue;
-        }
+    let (kept, left) = used(requests);
+    cache.prefetch(kept.iter().copied(), read);
+    for r in left {
+        warnings.push(format!(
+            "{}: material {name}: bump map {} is not used (the material has a normal map)",
+            r.at,
+            r.source.name()
+        ));
+    }
+    for r in kept {
         let texture = match cache.load(&r.source, r.srgb && r.slot.is_colour(), read) {
             Ok(t) => t,
             Err(why) => {
