@@ -116,8 +116,10 @@ impl<'a> Frame<'a> {
                 };
                 if o.textured() {
                     let m = &o.maps;
-                    let per_pixel_light = m.ambient.is_some()
-                        || m.emission.is_some()
+                    // Ambient and emission maps need the light's terms apart, which only the
+                    // vector sampler keeps (`Prepared::emission_apart`).
+                    let split = m.ambient.is_some() || m.emission.is_some();
+                    let per_pixel_light = (split && VectorMaps::new(m).is_none())
                         || m.shininess.is_some()
                         || m.normal.is_some()
                         || m.metal_rough.is_some()
@@ -130,7 +132,12 @@ impl<'a> Frame<'a> {
                         && one_sample
                         && !per_pixel_light
                     {
-                        return Mode::Textured(Prepared::new(&scene.lighting, &o.material, &o.shading.options, view));
+                        let prep = Prepared::new(&scene.lighting, &o.material, &o.shading.options, view);
+                        return Mode::Textured(if split {
+                            prep.emission_apart(&scene.lighting, &o.material)
+                        } else {
+                            prep
+                        });
                     }
                     return Mode::Scalar;
                 }
@@ -300,4 +307,37 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
         }
     }
     counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ambient and emission maps with linear filters are drawn by the vector sampler (the fast
+    /// path's textured mode), not per pixel; one it does not cover (nearest filtering) is.
+    #[test]
+    fn ambient_and_emission_maps_take_the_vector_sampler() {
+        let src = r#"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+material = { base = "brass", ambient_map = "assets/bricks.png", emission_map = "assets/checker.png" }
+[[object]]
+shape = "sphere"
+material = { base = "brass", emission_map = "assets/checker.png" }
+[[object]]
+shape = "sphere"
+material = { base = "brass", ambient_map = "assets/checker.png", filter = "nearest" }
+"#;
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/split.toml");
+        let scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+        for i in 0..2 {
+            assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
+            assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
+        }
+        assert!(matches!(frame.modes[2], Mode::Scalar));
+    }
 }

@@ -501,3 +501,96 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
             .is_none()
     );
 }
+
+/// Ambient and emission maps, which the vector sampler applies with the light's emission kept
+/// apart (`Prepared::emission_apart`): each alone, beside diffuse and specular maps, with and
+/// without clamping (the `opengl` model clamps), vertex colours or not, a second light with
+/// an ambient colour of its own, coordinates too large for the vector sampler's wrapping (the
+/// plane: its pixels are the reference's); the fast path within 1/255 of the reference.
+#[test]
+fn fast_path_matches_reference_with_ambient_and_emission_maps() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    // A quad with vertex colours, which tint the diffuse texel but not the ambient map's.
+    let dir = std::env::temp_dir().join(format!("phong-split-maps-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tinted = dir.join("tinted.obj");
+    std::fs::write(
+        &tinted,
+        "v -1 -1 0 1 0.2 0.2\nv 1 -1 0 0.2 1 0.2\nv 1 1 0 0.2 0.2 1\nv -1 1 0 1 1 1\n\
+         vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    for model in ["opengl", "blinn-phong"] {
+        let src = format!(
+            r#"
+[image]
+width = 200
+height = 120
+[camera]
+position = [0.0, 0.0, 6.0]
+[shading]
+model = "{model}"
+ambient = [0.3, 0.25, 0.2]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[light]]
+type = "directional"
+direction = [1.0, -0.5, -1.0]
+ambient = [0.2, 0.3, 0.1]
+color = [0.6, 0.6, 0.7]
+[[object]]
+shape = "sphere"
+position = [-2.2, 0.8, 0.0]
+material = {{ base = "brass", ambient = [1.5, 1.2, 1.0], ambient_map = "assets/bricks.png", uv_scale = [2.0, 1.0] }}
+[[object]]
+shape = "torus"
+position = [0.0, 0.8, 0.0]
+rotation = [60.0, 0.0, 0.0]
+material = {{ base = "jade", emission = [0.4, 0.3, 0.6], emission_map = "assets/checker.png" }}
+[[object]]
+shape = "cube"
+position = [2.2, 0.8, 0.0]
+rotation = [30.0, 40.0, 0.0]
+material = {{ base = "ruby", emission = [0.2, 0.5, 0.1], ambient_map = "assets/checker.png", emission_map = "assets/bricks_specular.png", diffuse_map = "assets/bricks.png", specular_map = "assets/bricks_specular.png", wrap = "mirror" }}
+[[object]]
+mesh = "assets/crate.obj"
+position = [-1.0, -1.3, 0.0]
+scale = 0.8
+rotation = [20.0, 30.0, 0.0]
+material = {{ base = "silver", emission = [0.3, 0.3, 0.3], emission_map = "assets/checker.png", ambient_map = "assets/bricks.png" }}
+[[object]]
+shape = "teapot"
+position = [1.4, -1.3, 0.0]
+scale = 0.6
+material = {{ base = "gold", ambient_map = "assets/bricks_specular.png", specular_map = "assets/checker.png", filter = "bilinear" }}
+[[object]]
+mesh = "{tinted}"
+position = [3.0, -1.3, 0.5]
+scale = 0.6
+rotation = [0.0, -30.0, 0.0]
+material = {{ base = "pearl", ambient_map = "assets/bricks.png", emission = [0.1, 0.0, 0.2], emission_map = "assets/checker.png" }}
+[[object]]
+shape = "plane"
+position = [0.0, -0.2, -2.0]
+scale = 6.0
+rotation = [80.0, 0.0, 0.0]
+material = {{ base = "pewter", ambient_map = "assets/checker.png", uv_scale = [3.0e5, 3.0e5] }}
+"#,
+            tinted = tinted.display()
+        );
+        let scene = phong_scene::parse_scene(&src, &root.join("split.toml")).unwrap().scene;
+        assert!(
+            scene
+                .objects
+                .iter()
+                .all(|o| o.maps.ambient.is_some() || o.maps.emission.is_some())
+        );
+        assert!(
+            !scene.objects[5].mesh.colors().is_empty(),
+            "the quad has vertex colours"
+        );
+        assert_fast_matches_reference(&scene, model);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

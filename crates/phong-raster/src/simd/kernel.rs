@@ -178,6 +178,8 @@ pub struct Prepared {
     kd: f32,
     ks: f32,
     base: Color,
+    /// The emission where it is kept apart from `base` ([`Prepared::emission_apart`]), else 0.
+    pub(super) emission: Color,
     lights: Vec<PreparedLight>,
 }
 
@@ -223,7 +225,18 @@ impl Prepared {
             kd,
             ks,
             base: material.emission() + material.ambient() * lighting.ambient(),
+            emission: Color::BLACK,
             lights,
+        }
+    }
+
+    /// This preparation with the material's emission kept apart from the ambient terms (for
+    /// ambient and emission maps, which modulate them apart: `phong_core::light`'s split).
+    pub fn emission_apart(self, lighting: &Lighting, material: &Material) -> Prepared {
+        Prepared {
+            base: material.ambient() * lighting.ambient(),
+            emission: material.emission(),
+            ..self
         }
     }
 }
@@ -283,6 +296,17 @@ fn acc<V: Vf32>(c: &mut [V; 3], k: Color, f: V, m: V::M) {
     for (ch, kc) in c.iter_mut().zip([k.r, k.g, k.b]) {
         *ch = V::splat(kc).mul_add(f, *ch);
     }
+}
+
+/// NaN → 0, overflow → ±f32::MAX, as `shade` (a function, not a closure: a closure is not
+/// always inlined into the AVX2 kernels, and its intrinsics then become calls).
+#[inline(always)]
+fn fin<V: Vf32>(x: V) -> V {
+    V::select(
+        x.nan(),
+        V::splat(0.0),
+        x.max(V::splat(f32::MIN)).min(V::splat(f32::MAX)),
+    )
 }
 
 /// Shades 8 points (positions and unnormalised normals by lane) of one object:
@@ -388,8 +412,6 @@ pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
         let on = V::and(spec_on, sf.gt(zero));
         acc(&mut spe, light.spe, fs, on);
     }
-    // NaN → 0, overflow → ±f32::MAX, as `shade`.
-    let fin = |x: V| V::select(x.nan(), zero, x.max(V::splat(f32::MIN)).min(V::splat(f32::MAX)));
     let mut t = Terms {
         ambient: amb,
         diffuse: dif,

@@ -155,9 +155,9 @@ impl Frame<'_> {
                     _ => 0,
                 };
                 let tinted = !self.scene.objects[object].mesh.colors().is_empty();
-                for (p, primary, specular) in unsampled.drain(..) {
+                for (p, light) in unsampled.drain(..) {
                     let (r, c) = at(p);
-                    let rgb = self.textured_color(object, (p, id), (x0, y0), tinted, (primary, specular));
+                    let rgb = self.textured_color(object, (p, id), (x0, y0), tinted, light);
                     out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
                 }
                 textured[object].extend(pixels[done..].iter().map(|&p| (p, id)));
@@ -236,11 +236,8 @@ impl Frame<'_> {
                 |i, rgb| out(items[i], rgb),
                 &mut unsampled,
             );
-            for (i, primary, specular) in unsampled {
-                out(
-                    items[i],
-                    self.textured_color(object, items[i], (x0, y0), tinted, (primary, specular)),
-                );
+            for (i, light) in unsampled {
+                out(items[i], self.textured_color(object, items[i], (x0, y0), tinted, light));
             }
             return;
         }
@@ -256,14 +253,15 @@ impl Frame<'_> {
             |i, primary, specular| {
                 out(
                     items[i],
-                    self.textured_color(object, items[i], (x0, y0), tinted, (primary, specular)),
+                    self.textured_color(object, items[i], (x0, y0), tinted, [primary, specular, [0.0; 3]]),
                 )
             },
         );
     }
 
     /// The colour of a textured pixel (`(row << 16 | column, triangle id)` in the tile at
-    /// `origin`) from its light (primary, specular): its maps sampled at the coordinates and
+    /// `origin`) from its light `[primary, specular, ambient]` (the ambient terms used where an
+    /// ambient map has them apart; see [`crate::simd::Unsampled`]): its maps sampled at the coordinates and
     /// exact derivatives of the triangle's planes and applied (`Lit::modulate`), the diffuse
     /// texel `tinted` by the vertex colours where the mesh has them.
     fn textured_color(
@@ -272,7 +270,7 @@ impl Frame<'_> {
         (p, id): (u32, u32),
         origin: (u32, u32),
         tinted: bool,
-        (primary, specular): ([f32; 3], [f32; 3]),
+        [primary, specular, ambient]: [[f32; 3]; 3],
     ) -> [f32; 3] {
         let obj = &self.scene.objects[object];
         let (x, y) = pixel_centre(origin, p);
@@ -281,10 +279,22 @@ impl Frame<'_> {
         if tinted {
             texels = texels.tinted(rgb);
         }
+        // As `phong_core::light` splits them: the emission and the ambient terms apart where
+        // maps of their own modulate them (the light was prepared so: `emission_apart`).
+        let maps = &obj.maps;
         let lit = Lit {
             primary: Color::new(primary[0], primary[1], primary[2]),
             specular: Color::new(specular[0], specular[1], specular[2]),
-            ..Lit::default()
+            emission: if maps.emission.is_some() {
+                obj.material.emission()
+            } else {
+                Color::BLACK
+            },
+            ambient: if maps.ambient.is_some() {
+                Color::new(ambient[0], ambient[1], ambient[2])
+            } else {
+                Color::BLACK
+            },
         };
         let c = lit.modulate(&texels, obj.shading.options.clamp);
         [c.r, c.g, c.b]
