@@ -116,14 +116,13 @@ impl<'a> Frame<'a> {
                 };
                 if o.textured() {
                     let m = &o.maps;
-                    // Ambient and emission maps need the light's terms apart, which only the
-                    // vector sampler keeps (`Prepared::emission_apart`).
-                    let split = m.ambient.is_some() || m.emission.is_some();
+                    // Ambient, emission and occlusion maps need the light's terms apart, which
+                    // only the vector sampler keeps (`Prepared::emission_apart`).
+                    let split = m.ambient.is_some() || m.emission.is_some() || m.occlusion.is_some();
                     let per_pixel_light = (split && VectorMaps::new(m).is_none())
                         || m.shininess.is_some()
                         || m.normal.is_some()
                         || m.metal_rough.is_some()
-                        || m.occlusion.is_some()
                         // The fast path's planes carry one set of coordinates.
                         || second_set;
                     let one_sample = scene.image.samples == phong_core::Samples::One;
@@ -313,10 +312,11 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 mod tests {
     use super::*;
 
-    /// Ambient and emission maps with linear filters are drawn by the vector sampler (the fast
-    /// path's textured mode), not per pixel; one it does not cover (nearest filtering) is.
+    /// Ambient, emission and occlusion maps with linear filters are drawn by the vector sampler
+    /// (the fast path's textured mode), not per pixel; one it does not cover (nearest
+    /// filtering) is.
     #[test]
-    fn ambient_and_emission_maps_take_the_vector_sampler() {
+    fn ambient_emission_and_occlusion_maps_take_the_vector_sampler() {
         let src = r#"
 [[light]]
 type = "point"
@@ -332,9 +332,15 @@ shape = "sphere"
 material = { base = "brass", ambient_map = "assets/checker.png", filter = "nearest" }
 "#;
         let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/split.toml");
-        let scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        // glTF's occlusion map, alone, on a copy of the second sphere.
+        let mut o = scene.objects[1].clone();
+        o.maps.emission = None;
+        let map = scene.objects[1].maps.emission.clone().unwrap();
+        o.maps.occlusion = Some(phong_core::Occlusion { map, strength: 1.0 });
+        scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
-        for i in 0..2 {
+        for i in [0, 1, 3] {
             assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
             assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
         }

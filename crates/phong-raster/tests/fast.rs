@@ -502,13 +502,13 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
     );
 }
 
-/// Ambient and emission maps, which the vector sampler applies with the light's emission kept
-/// apart (`Prepared::emission_apart`): each alone, beside diffuse and specular maps, with and
+/// Ambient, emission and occlusion maps, which the vector sampler applies with the light's
+/// emission kept apart (`Prepared::emission_apart`): each alone, beside diffuse and specular maps, with and
 /// without clamping (the `opengl` model clamps), vertex colours or not, a second light with
 /// an ambient colour of its own, coordinates too large for the vector sampler's wrapping (the
-/// plane: its pixels are the reference's); the fast path within 1/255 of the reference.
+/// planes: their pixels are the reference's); the fast path within 1/255 of the reference.
 #[test]
-fn fast_path_matches_reference_with_ambient_and_emission_maps() {
+fn fast_path_matches_reference_with_ambient_emission_and_occlusion_maps() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
     // A quad with vertex colours, which tint the diffuse texel but not the ambient map's.
     let dir = std::env::temp_dir().join(format!("phong-split-maps-{}", std::process::id()));
@@ -576,16 +576,38 @@ position = [0.0, -0.2, -2.0]
 scale = 6.0
 rotation = [80.0, 0.0, 0.0]
 material = {{ base = "pewter", ambient_map = "assets/checker.png", uv_scale = [3.0e5, 3.0e5] }}
+[[object]]
+shape = "plane"
+position = [-3.2, 1.5, 1.0]
+scale = 0.5
+rotation = [70.0, 0.0, 0.0]
+material = {{ base = "chrome", emission = [0.2, 0.1, 0.3], emission_map = "assets/checker.png", uv_scale = [3.0e5, 3.0e5] }}
 "#,
             tinted = tinted.display()
         );
-        let scene = phong_scene::parse_scene(&src, &root.join("split.toml")).unwrap().scene;
+        let mut scene = phong_scene::parse_scene(&src, &root.join("split.toml")).unwrap().scene;
         assert!(
             scene
                 .objects
                 .iter()
                 .all(|o| o.maps.ambient.is_some() || o.maps.emission.is_some())
         );
+        // glTF's occlusion map (no scene key gives one): beside an ambient map (the sphere),
+        // alone on the ambient terms (the torus: `T_Kd`, here 1, times the occlusion), tinted
+        // (the quad), with coordinates past the vector wrap (the planes; the second has no
+        // ambient map).
+        let mut r = Rng(7);
+        let texels: Vec<[u16; 4]> = (0..24 * 20)
+            .map(|_| [r.f(), r.f(), r.f()].map(|x| (x * 65535.0) as u16))
+            .map(|[a, b, c]| [a, b, c, 65535])
+            .collect();
+        let occlusion = std::sync::Arc::new(Texture::new(24, 20, &texels, 8).unwrap());
+        for (i, strength) in [(0, 1.0), (1, 0.6), (5, 0.8), (6, 1.0), (7, 0.9)] {
+            scene.objects[i].maps.occlusion = Some(Occlusion {
+                map: TextureMap::new(occlusion.clone()),
+                strength,
+            });
+        }
         assert!(
             !scene.objects[5].mesh.colors().is_empty(),
             "the quad has vertex colours"

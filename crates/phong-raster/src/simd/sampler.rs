@@ -84,14 +84,16 @@ pub struct VectorMaps<'a> {
     specular: Option<VectorMap<'a>>,
     ambient: Option<VectorMap<'a>>,
     emission: Option<VectorMap<'a>>,
+    /// glTF's occlusion map and its strength: the ambient terms times `1 + strength·(T.r − 1)`.
+    occlusion: Option<(VectorMap<'a>, f32)>,
     /// Vertex colours multiply the diffuse texel (`Texels::tinted`).
     tinted: bool,
 }
 
 impl<'a> VectorMaps<'a> {
-    /// `maps` if the sampler covers them: diffuse, specular, ambient and emission maps (at
-    /// least one) and no other (each as [`VectorMap`] covers it). With ambient or emission
-    /// maps the light must be prepared with [`Prepared::emission_apart`].
+    /// `maps` if the sampler covers them: diffuse, specular, ambient, emission and occlusion
+    /// maps (at least one) and no other (each as [`VectorMap`] covers it). With ambient,
+    /// emission or occlusion maps the light must be prepared with [`Prepared::emission_apart`].
     pub fn new(maps: &'a Maps) -> Option<VectorMaps<'a>> {
         // Every field named: a new map must be considered here.
         let Maps {
@@ -107,9 +109,9 @@ impl<'a> VectorMaps<'a> {
             alpha_cutoff: _,
             blend: _,
         } = maps;
-        let others =
-            shininess.is_some() || alpha.is_some() || normal.is_some() || metal_rough.is_some() || occlusion.is_some();
-        let none = diffuse.is_none() && specular.is_none() && ambient.is_none() && emission.is_none();
+        let others = shininess.is_some() || alpha.is_some() || normal.is_some() || metal_rough.is_some();
+        let none =
+            diffuse.is_none() && specular.is_none() && ambient.is_none() && emission.is_none() && occlusion.is_none();
         if others || none {
             return None;
         }
@@ -122,6 +124,10 @@ impl<'a> VectorMaps<'a> {
             specular: of(specular)?,
             ambient: of(ambient)?,
             emission: of(emission)?,
+            occlusion: match occlusion {
+                Some(o) => Some((VectorMap::of(&o.map)?, o.strength)),
+                None => None,
+            },
             tinted: false,
         })
     }
@@ -129,7 +135,12 @@ impl<'a> VectorMaps<'a> {
     /// Whether the ambient or emission terms have maps of their own (see
     /// [`Prepared::emission_apart`]).
     pub fn split(&self) -> bool {
-        self.ambient.is_some() || self.emission.is_some()
+        self.ambient_apart() || self.emission.is_some()
+    }
+
+    /// Whether the ambient terms have a factor of their own (an ambient or occlusion map).
+    fn ambient_apart(&self) -> bool {
+        self.ambient.is_some() || self.occlusion.is_some()
     }
 
     /// These maps, the diffuse texel tinted by the mesh's vertex colours where `tinted` (their
@@ -423,7 +434,7 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
             if maps.emission.is_none() {
                 p = p.add(V::splat(e[c]));
             }
-            if maps.ambient.is_none() {
+            if !maps.ambient_apart() {
                 p = p.add(lit.ambient[c]);
             }
             p
@@ -467,8 +478,17 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
         (true, None, Some(e)) => (None, Some(mapped(e, uv))),
         (true, None, None) => (None, None),
     };
+    // The occlusion's red channel (`None` inside: not wrapped).
+    #[allow(clippy::manual_map)]
+    let ao = match (SPLIT, &maps.occlusion) {
+        (true, Some((m, _))) => Some(match mapped(m, uv) {
+            Some(t) => Some(t[0]),
+            None => None,
+        }),
+        _ => None,
+    };
     let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
-    if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) {
+    if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
         return Err([primary, specular, if SPLIT { lit.ambient } else { [zero; 3] }]);
     }
     // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
@@ -480,19 +500,38 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
         }
     }
     let (td, ts, ta, te) = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten());
+    // The occlusion's factor `1 + strength·(T.r − 1)`.
+    let ao = match (ao.flatten(), &maps.occlusion) {
+        (Some(r), Some((_, strength))) => Some(r.sub(one).mul_add(V::splat(*strength), one)),
+        _ => None,
+    };
     let mut rgb = [zero; 3];
     for c in 0..3 {
-        let mut x = match td {
-            Some(t) => primary[c].mul(t[c].mul(tint[c])),
-            None if maps.tinted => primary[c].mul(tint[c]),
+        // T_Kd, tinted.
+        let kd = match td {
+            Some(t) => Some(t[c].mul(tint[c])),
+            None if maps.tinted => Some(tint[c]),
+            None => None,
+        };
+        let mut x = match kd {
+            Some(k) => primary[c].mul(k),
             None => primary[c],
         };
-        // `Lit::modulate`'s order: P⊗T_Kd + e⊗T_Ke + A⊗T_Ka + S⊗T_Ks.
+        // `Lit::modulate`'s order: P⊗T_Kd + e⊗T_Ke + A⊗T_Ka·T_AO + S⊗T_Ks (T_Ka is T_Kd
+        // without an ambient map).
         if let Some(ke) = te {
             x = x.add(V::splat(e[c]).mul(ke[c]));
         }
-        if let Some(ka) = ta {
-            x = x.add(lit.ambient[c].mul(ka[c]));
+        if SPLIT && maps.ambient_apart() {
+            let mut ka = match (ta, kd) {
+                (Some(t), _) => t[c],
+                (None, Some(k)) => k,
+                (None, None) => one,
+            };
+            if let Some(f) = ao {
+                ka = ka.mul(f);
+            }
+            x = x.add(lit.ambient[c].mul(ka));
         }
         let s = match ts {
             Some(t) => specular[c].mul(t[c]),

@@ -290,7 +290,7 @@ impl Frame<'_> {
             } else {
                 Color::BLACK
             },
-            ambient: if maps.ambient.is_some() {
+            ambient: if maps.ambient.is_some() || maps.occlusion.is_some() {
                 Color::new(ambient[0], ambient[1], ambient[2])
             } else {
                 Color::BLACK
