@@ -123,8 +123,8 @@ impl<'a> Frame<'a> {
                         || m.shininess.is_some()
                         || m.normal.is_some()
                         || m.metal_rough.is_some()
-                        // The fast path's planes carry one set of coordinates.
-                        || second_set;
+                        // The second set takes the vertex colours' planes.
+                        || (second_set && !o.mesh.colors().is_empty());
                     let one_sample = scene.image.samples == phong_core::Samples::One;
                     if o.shading.interpolation == Interpolation::Phong
                         && term == Term::Color
@@ -312,9 +312,9 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 mod tests {
     use super::*;
 
-    /// Ambient, emission and occlusion maps with linear filters are drawn by the vector sampler
-    /// (the fast path's textured mode), not per pixel; one it does not cover (nearest
-    /// filtering) is.
+    /// Ambient, emission and occlusion maps with linear filters, and maps on the second set of
+    /// coordinates, are drawn by the vector sampler (the fast path's textured mode), not per
+    /// pixel; one it does not cover (nearest filtering) is.
     #[test]
     fn ambient_emission_and_occlusion_maps_take_the_vector_sampler() {
         let src = r#"
@@ -339,8 +339,13 @@ material = { base = "brass", ambient_map = "assets/checker.png", filter = "neare
         let map = scene.objects[1].maps.emission.clone().unwrap();
         o.maps.occlusion = Some(phong_core::Occlusion { map, strength: 1.0 });
         scene.objects.push(o);
+        // A map on the second set of coordinates.
+        let mut o = scene.objects[0].clone();
+        o.mesh = o.mesh.clone().with_uvs1(o.mesh.uvs().to_vec()).unwrap();
+        o.maps.ambient.as_mut().unwrap().set = 1;
+        scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
-        for i in [0, 1, 3] {
+        for i in [0, 1, 3, 4] {
             assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
             assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
         }

@@ -616,3 +616,52 @@ material = {{ base = "chrome", emission = [0.2, 0.1, 0.3], emission_map = "asset
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Maps on the second set of texture coordinates (glTF's `TEXCOORD_1`), beside maps on the
+/// first: the vector sampler reads the set each map names (its planes in the vertex colours'
+/// place). Coordinates past the vector wrap on the second set (the plane) fall back per pixel.
+/// The fast path within 1/255 of the reference.
+#[test]
+fn fast_path_matches_reference_with_maps_on_the_second_set() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let src = r#"
+[image]
+width = 200
+height = 120
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[object]]
+shape = "sphere"
+position = [-2.0, 0.6, 0.0]
+material = { base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/checker.png" }
+[[object]]
+shape = "torus"
+position = [1.5, 0.6, 0.0]
+rotation = [60.0, 0.0, 0.0]
+material = { base = "jade", emission = [0.3, 0.2, 0.1], ambient_map = "assets/bricks.png", emission_map = "assets/checker.png", diffuse_map = "assets/bricks_specular.png" }
+[[object]]
+shape = "plane"
+position = [0.0, -1.5, 0.0]
+scale = 3.0
+rotation = [60.0, 0.0, 0.0]
+material = { base = "pewter", diffuse_map = "assets/checker.png" }
+"#;
+    let mut scene = phong_scene::parse_scene(src, &root.join("second.toml")).unwrap().scene;
+    // The second set: the first turned a quarter and scaled (the plane's far past the wrap).
+    for (i, scale) in [(0, 3.0), (1, 2.0), (2, 3.0e5)] {
+        let o = &mut scene.objects[i];
+        let uvs1: Vec<glam::Vec2> = o.mesh.uvs().iter().map(|t| glam::Vec2::new(t.y, t.x) * scale).collect();
+        o.mesh = o.mesh.clone().with_uvs1(uvs1).unwrap();
+    }
+    let maps = &mut scene.objects[0].maps;
+    maps.diffuse.as_mut().unwrap().set = 1;
+    let maps = &mut scene.objects[1].maps;
+    maps.ambient.as_mut().unwrap().set = 1;
+    maps.emission.as_mut().unwrap().set = 1;
+    scene.objects[2].maps.diffuse.as_mut().unwrap().set = 1;
+    assert!(scene.objects.iter().all(|o| o.maps.uses_second_set()));
+    assert_fast_matches_reference(&scene, "second set");
+}

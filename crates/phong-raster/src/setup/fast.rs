@@ -47,6 +47,19 @@ impl Frame<'_> {
         let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
         let colors = mesh.colors();
         let rgb_of = |i: u32| colors.get(i as usize).map_or(Vec3::ONE, |c| Vec3::from(c.to_array()));
+        let uvs1 = mesh.uvs1();
+        let uv1_of = |i: u32| uvs1.get(i as usize).copied().unwrap_or_default();
+        // The uv planes' colour rows carry a second set of coordinates where the maps read one
+        // (such objects have no vertex colours: `uv_planes`).
+        let second = self.second_sets[oi];
+        let extra_of = |i: u32| {
+            if second {
+                let uv = uv1_of(i);
+                Vec3::new(uv.x, uv.y, 0.0)
+            } else {
+                rgb_of(i)
+            }
+        };
         let lighting = gouraud.then(|| VertexLighting {
             isa: self.isa,
             prepared: Prepared::new(
@@ -105,7 +118,7 @@ impl Frame<'_> {
                             out.planes.push(phong_planes(&s, tri));
                             if textured {
                                 let idx = each3(|k| tri[s.order[k]]);
-                                out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(rgb_of)));
+                                out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of)));
                             }
                         }
                         out.tris.push(s.tri);
@@ -130,8 +143,7 @@ impl Frame<'_> {
                         color_back: lit3[1][k],
                         spec: [Vec3::ZERO; 2],
                         uv: uv_of(tri[k]),
-                        // Objects whose maps read a second set are the scalar path's.
-                        uv1: glam::Vec2::ZERO,
+                        uv1: uv1_of(tri[k]),
                         rgb: rgb_of(tri[k]),
                         tangent: Vec4::ZERO,
                     }

@@ -269,6 +269,8 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
 /// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
 /// The planes of texture coordinates `uv` and vertex colours `rgb` (per set-up vertex) of
 /// triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the colour over `w` in `attr[2..5]`.
+/// An object whose maps read a second set of coordinates passes them as `rgb` (`(u, v, 0)`):
+/// it has no vertex colours ([`crate::frame::Frame::second_sets`]).
 #[inline]
 pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], rgb: [Vec3; 3]) -> Planes {
     let attrs = [
@@ -349,7 +351,15 @@ impl Frame<'_> {
             return Some((s.tri, Planes::default(), Some(corners), None));
         }
         let mode = &self.modes[object as usize];
-        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv), v.map(|v| v.rgb)));
+        let second = self.second_sets[object as usize];
+        let extra = |v: &ClipVertex| {
+            if second {
+                Vec3::new(v.uv1.x, v.uv1.y, 0.0)
+            } else {
+                v.rgb
+            }
+        };
+        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra)));
         let planes = match mode {
             Mode::Scalar => Planes::default(),
             Mode::Phong(..) | Mode::Textured(_) => {

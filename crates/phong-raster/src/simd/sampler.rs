@@ -33,6 +33,8 @@ pub struct VectorMap<'a> {
     wrap: (Wrap, Wrap),
     mipmaps: bool,
     transform: UvTransform,
+    /// Reads the second set of texture coordinates ([`phong_core::TextureMap::set`]).
+    second: bool,
     /// 8-bit, repeated both ways, level 0 a power of two each way (and so every level):
     /// [`Vf32::gather_quad_rgb8`] wraps and fetches.
     quad8: bool,
@@ -67,6 +69,7 @@ impl<'a> VectorMap<'a> {
             wrap: (s.wrap_u, s.wrap_v),
             mipmaps: s.mip == MipFilter::Linear,
             transform: map.transform,
+            second: map.set >= 1,
             quad8: matches!(levels[0].2, Texels::Eight(_))
                 && s.wrap_u == Wrap::Repeat
                 && s.wrap_v == Wrap::Repeat
@@ -88,6 +91,8 @@ pub struct VectorMaps<'a> {
     occlusion: Option<(VectorMap<'a>, f32)>,
     /// Vertex colours multiply the diffuse texel (`Texels::tinted`).
     tinted: bool,
+    /// A map reads the second set of coordinates (never with `tinted`: they share planes).
+    second: bool,
 }
 
 impl<'a> VectorMaps<'a> {
@@ -119,17 +124,27 @@ impl<'a> VectorMaps<'a> {
             Some(m) => VectorMap::of(m).map(Some),
             None => Some(None),
         };
-        Some(VectorMaps {
-            diffuse: of(diffuse)?,
-            specular: of(specular)?,
-            ambient: of(ambient)?,
-            emission: of(emission)?,
-            occlusion: match occlusion {
-                Some(o) => Some((VectorMap::of(&o.map)?, o.strength)),
-                None => None,
-            },
-            tinted: false,
-        })
+        Some(
+            VectorMaps {
+                diffuse: of(diffuse)?,
+                specular: of(specular)?,
+                ambient: of(ambient)?,
+                emission: of(emission)?,
+                occlusion: match occlusion {
+                    Some(o) => Some((VectorMap::of(&o.map)?, o.strength)),
+                    None => None,
+                },
+                tinted: false,
+                second: false,
+            }
+            .with_second(),
+        )
+    }
+
+    /// Whether the sampler's general form is needed: a split light ([`VectorMaps::split`]) or
+    /// a map on the second set.
+    fn full(&self) -> bool {
+        self.split() || self.second
     }
 
     /// Whether the ambient or emission terms have maps of their own (see
@@ -138,9 +153,22 @@ impl<'a> VectorMaps<'a> {
         self.ambient_apart() || self.emission.is_some()
     }
 
+    /// The rows of the coordinates' planes read (8 floats each): the vertex colours' and a
+    /// second set's are in the third.
+    fn rows(&self) -> usize {
+        if self.tinted || self.second { 3 } else { 2 }
+    }
+
     /// Whether the ambient terms have a factor of their own (an ambient or occlusion map).
     fn ambient_apart(&self) -> bool {
         self.ambient.is_some() || self.occlusion.is_some()
+    }
+
+    fn with_second(self) -> VectorMaps<'a> {
+        let maps = [self.diffuse, self.specular, self.ambient, self.emission];
+        let occlusion = self.occlusion.map(|(m, _)| m);
+        let second = maps.iter().chain([&occlusion]).flatten().any(|m| m.second);
+        VectorMaps { second, ..self }
     }
 
     /// These maps, the diffuse texel tinted by the mesh's vertex colours where `tinted` (their
@@ -162,7 +190,7 @@ pub(crate) trait Sampling: Vf32 {
     fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3];
     /// [`textured_lanes`].
     #[allow(clippy::type_complexity)]
-    fn textured<const SPLIT: bool>(
+    fn textured<const FULL: bool>(
         prep: &Prepared,
         maps: &VectorMaps,
         q: [Self; 6],
@@ -180,14 +208,14 @@ macro_rules! sampling {
                 bilinear_lanes(map, level, u, v)
             }
             #[$inline]
-            fn textured<const SPLIT: bool>(
+            fn textured<const FULL: bool>(
                 prep: &Prepared,
                 maps: &VectorMaps,
                 q: [Self; 6],
                 xy: (Self, Self),
                 k: &[Self; 24],
             ) -> Result<[Self; 3], [[Self; 3]; 3]> {
-                textured_lanes::<Self, SPLIT>(prep, maps, q, xy, k)
+                textured_lanes::<Self, FULL>(prep, maps, q, xy, k)
             }
         }
     };
@@ -410,7 +438,7 @@ pub type Unsampled<I> = (I, [[f32; 3]; 3]);
 /// with the light where the sampler cannot wrap the coordinates exactly.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn textured_lanes<V: Sampling, const SPLIT: bool>(
+fn textured_lanes<V: Sampling, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     q: [V; 6],
@@ -420,9 +448,10 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (pos, nrm) = position_normal(q);
     let lit = shade(prep, pos, nrm);
-    // `SPLIT` is `maps.split()`, made a constant so that the common case does not keep the
-    // ambient terms alive through the sampling (measured: 5% of the textured sphere's frame).
-    let split = SPLIT;
+    // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
+    // maps on the first set) does not keep the ambient terms alive through the sampling, nor
+    // choose a set per map (measured: 3–5% of the textured sphere's frame).
+    let split = FULL && maps.split();
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
     let mut primary = [zero; 3];
     let mut specular = [zero; 3];
@@ -460,28 +489,43 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
     let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
     let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
     let uv = [u, v, ux, vx, uy, vy];
+    // The second set, where a map reads it, from the planes at 11 and 14 (in the vertex
+    // colours' place: such objects have none).
+    let uv1 = if FULL && maps.second {
+        let p1 = k[11].add(k[12].mul(dx)).add(k[13].mul(dy));
+        let p2 = k[14].add(k[15].mul(dx)).add(k[16].mul(dy));
+        let (u1, v1) = (p1.mul(rq), p2.mul(rq));
+        let (ux1, vx1) = (k[12].sub(u1.mul(k[3])).mul(rq), k[15].sub(v1.mul(k[3])).mul(rq));
+        let (uy1, vy1) = (k[13].sub(u1.mul(k[4])).mul(rq), k[16].sub(v1.mul(k[4])).mul(rq));
+        [u1, v1, ux1, vx1, uy1, vy1]
+    } else {
+        uv
+    };
     // (Matches, not closures: see `modulo`.)
     #[allow(clippy::manual_map)]
     let td = match &maps.diffuse {
-        Some(m) => Some(mapped(m, uv)),
+        Some(m) => Some(mapped(m, if FULL && m.second { uv1 } else { uv })),
         None => None,
     };
     #[allow(clippy::manual_map)]
     let ts = match &maps.specular {
-        Some(m) => Some(mapped(m, uv)),
+        Some(m) => Some(mapped(m, if FULL && m.second { uv1 } else { uv })),
         None => None,
     };
-    let (ta, te) = match (SPLIT, &maps.ambient, &maps.emission) {
+    let (ta, te) = match (FULL, &maps.ambient, &maps.emission) {
         (false, _, _) => (None, None),
-        (true, Some(a), Some(e)) => (Some(mapped(a, uv)), Some(mapped(e, uv))),
-        (true, Some(a), None) => (Some(mapped(a, uv)), None),
-        (true, None, Some(e)) => (None, Some(mapped(e, uv))),
+        (true, Some(a), Some(e)) => (
+            Some(mapped(a, if FULL && a.second { uv1 } else { uv })),
+            Some(mapped(e, if FULL && e.second { uv1 } else { uv })),
+        ),
+        (true, Some(a), None) => (Some(mapped(a, if FULL && a.second { uv1 } else { uv })), None),
+        (true, None, Some(e)) => (None, Some(mapped(e, if FULL && e.second { uv1 } else { uv }))),
         (true, None, None) => (None, None),
     };
     // The occlusion's red channel (`None` inside: not wrapped).
     #[allow(clippy::manual_map)]
-    let ao = match (SPLIT, &maps.occlusion) {
-        (true, Some((m, _))) => Some(match mapped(m, uv) {
+    let ao = match (FULL, &maps.occlusion) {
+        (true, Some((m, _))) => Some(match mapped(m, if FULL && m.second { uv1 } else { uv }) {
             Some(t) => Some(t[0]),
             None => None,
         }),
@@ -489,7 +533,7 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
     };
     let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
     if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
-        return Err([primary, specular, if SPLIT { lit.ambient } else { [zero; 3] }]);
+        return Err([primary, specular, if FULL { lit.ambient } else { [zero; 3] }]);
     }
     // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
     let mut tint = [one; 3];
@@ -522,7 +566,7 @@ fn textured_lanes<V: Sampling, const SPLIT: bool>(
         if let Some(ke) = te {
             x = x.add(V::splat(e[c]).mul(ke[c]));
         }
-        if SPLIT && maps.ambient_apart() {
+        if FULL && maps.ambient_apart() {
             let mut ka = match (ta, kd) {
                 (Some(t), _) => t[c],
                 (None, Some(k)) => k,
@@ -607,8 +651,8 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling>(
         }
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
         let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
-        let k = coefficients::<V>(&uv[..V::N], if maps.tinted { 3 } else { 2 });
-        let r = if maps.split() {
+        let k = coefficients::<V>(&uv[..V::N], maps.rows());
+        let r = if maps.full() {
             V::textured::<true>(prep, maps, q, (xs, ys), &k)
         } else {
             V::textured::<false>(prep, maps, q, (xs, ys), &k)
@@ -637,11 +681,11 @@ pub(crate) fn shade_group_textured<V: Sampling>(
         return 0;
     }
     let planes = Broadcast::<V>::new(planes, 6);
-    let k = coefficients::<V>(&[uv], if maps.tinted { 3 } else { 2 });
+    let k = coefficients::<V>(&[uv], maps.rows());
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
         let q = planes.at(x, y, 6);
-        let r = if maps.split() {
+        let r = if maps.full() {
             V::textured::<true>(prep, maps, q, (x, y), &k)
         } else {
             V::textured::<false>(prep, maps, q, (x, y), &k)

@@ -274,8 +274,12 @@ impl Frame<'_> {
     ) -> [f32; 3] {
         let obj = &self.scene.objects[object];
         let (x, y) = pixel_centre(origin, p);
-        let ([uv, d_dx, d_dy], rgb) = uv_from_planes(self.uv_planes(id), x, y);
-        let mut texels = obj.maps.sample(uv, d_dx, d_dy);
+        let ([first, second], rgb) = uv_from_planes(self.uv_planes(id), x, y);
+        let mut texels = if self.second_sets[object] {
+            obj.maps.sample_sets(&[first, second])
+        } else {
+            obj.maps.sample(first[0], first[1], first[2])
+        };
         if tinted {
             texels = texels.tinted(rgb);
         }
@@ -537,16 +541,20 @@ impl Frame<'_> {
 /// `1/w` (see `setup::uv_planes`), their screen derivatives, and the vertex colour: with
 /// `q = 1/w`, `u = q_u/q` and `∂u/∂x = (∂q_u/∂x − u·∂q/∂x)/q` (the planes' gradients are
 /// constant).
+/// The second set, where the object's maps read one, is in `attr[2]`, `attr[3]` instead of the
+/// colour (`setup::uv_planes`): `[first, second]` and the colour.
 #[inline]
-fn uv_from_planes(p: &Planes, x: f32, y: f32) -> ([Vec2; 3], Color) {
+fn uv_from_planes(p: &Planes, x: f32, y: f32) -> ([[Vec2; 3]; 2], Color) {
     let (dx, dy) = (x - p.origin[0], y - p.origin[1]);
     let eval = |k: [f32; 3]| k[0] + k[1] * dx + k[2] * dy;
     let q = eval(p.inv_w);
-    let (qu, qv) = (eval(p.attr[0]), eval(p.attr[1]));
-    let uv = Vec2::new(qu / q, qv / q);
-    let d = |g: usize| Vec2::new(p.attr[0][g] - uv.x * p.inv_w[g], p.attr[1][g] - uv.y * p.inv_w[g]) / q;
+    let set = |a: usize| {
+        let uv = Vec2::new(eval(p.attr[a]) / q, eval(p.attr[a + 1]) / q);
+        let d = |g: usize| Vec2::new(p.attr[a][g] - uv.x * p.inv_w[g], p.attr[a + 1][g] - uv.y * p.inv_w[g]) / q;
+        [uv, d(1), d(2)]
+    };
     let rgb = Color::new(eval(p.attr[2]) / q, eval(p.attr[3]) / q, eval(p.attr[4]) / q);
-    ([uv, d(1), d(2)], rgb)
+    ([set(0), set(2)], rgb)
 }
 
 #[cfg(test)]
