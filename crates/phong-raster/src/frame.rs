@@ -316,7 +316,7 @@ mod tests {
     /// coordinates, are drawn by the vector sampler (the fast path's textured mode), not per
     /// pixel; one it does not cover (nearest filtering) is.
     #[test]
-    fn ambient_emission_and_occlusion_maps_take_the_vector_sampler() {
+    fn ambient_emission_occlusion_and_second_set_maps_take_the_vector_sampler() {
         let src = r#"
 [[light]]
 type = "point"

@@ -266,7 +266,6 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
     })
 }
 
-/// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
 /// The planes of texture coordinates `uv` and vertex colours `rgb` (per set-up vertex) of
 /// triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the colour over `w` in `attr[2..5]`.
 /// An object whose maps read a second set of coordinates passes them as `rgb` (`(u, v, 0)`):
@@ -280,6 +279,7 @@ pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], rgb: [Vec3; 3]) -> Plane
     plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
 }
 
+/// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
 /// `attrs[j][i]` at vertex `i`, for set-up triangle `t` with vertex 0 snapped at `origin` (1/256
 /// pixel) and twice its area `area`: the barycentric `λ_i` is `E_i / area`, so
 /// `∂q/∂x = 256 Σ a_i q_i / area` per pixel (likewise `y` with `b`), and `q = q_0` at vertex 0.

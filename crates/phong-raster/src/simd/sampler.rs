@@ -5,7 +5,8 @@
 //! ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
 //!
 //! It covers the common cases, decided once per draw ([`VectorMaps::new`]): diffuse, specular,
-//! ambient and emission maps, 8 or 16 bits, linear filters, vertex colours or not. A
+//! ambient, emission and occlusion maps, 8 or 16 bits, linear filters, on either set of
+//! texture coordinates, vertex colours or not (not with a second set). A
 //! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
 //! caller's per-pixel sampler.
 
@@ -164,6 +165,7 @@ impl<'a> VectorMaps<'a> {
         self.ambient.is_some() || self.occlusion.is_some()
     }
 
+    /// These maps with `second` found from their maps' sets.
     fn with_second(self) -> VectorMaps<'a> {
         let maps = [self.diffuse, self.specular, self.ambient, self.emission];
         let occlusion = self.occlusion.map(|(m, _)| m);
@@ -429,7 +431,8 @@ fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
 
 /// A pixel the vector sampler leaves to the caller's per-pixel sampler, with its light
 /// `[primary, specular, ambient]` (`phong_core::Lit`'s: the first two clamped where the options
-/// clamp; the ambient terms, emission apart, count where an ambient map has them): its
+/// clamp; the ambient terms, emission apart, count where an ambient or occlusion map has
+/// them): its
 /// vector's coordinates could not be wrapped exactly (NaN, or beyond ±2^21 texels).
 pub type Unsampled<I> = (I, [[f32; 3]; 3]);
 
@@ -457,7 +460,7 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     let mut specular = [zero; 3];
     for c in 0..3 {
         // `phong_core::light`: P = D + e (no emission map) + A (no ambient map), where the
-        // light keeps `e` apart (split); else `t.ambient` holds both.
+        // light keeps `e` apart (split); else `lit.ambient` holds both.
         let mut p = if split {
             let mut p = lit.diffuse[c];
             if maps.emission.is_none() {
