@@ -7,10 +7,32 @@ use glam::{DVec3, Vec2, Vec3};
 use phong_scene::{Axis, ModelOptions, ViewName, load_model, load_model_full, load_with};
 use std::path::{Path, PathBuf};
 
-fn dir(tag: &str) -> PathBuf {
+/// A fresh folder for one test's files, removed when the test ends (passed or failed).
+struct Dir(PathBuf);
+
+impl std::ops::Deref for Dir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Dir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn dir(tag: &str) -> Dir {
     let d = std::env::temp_dir().join(format!("phong-models-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Dir(d)
 }
 
 fn write(d: &Path, name: &str, bytes: &[u8]) -> PathBuf {
