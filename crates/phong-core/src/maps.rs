@@ -366,9 +366,19 @@ impl Maps {
             .chain(self.occlusion.iter().map(|o| &o.map))
     }
 
-    /// Whether a map reads the mesh's second set of texture coordinates.
+    /// Whether a map reads the mesh's second set of texture coordinates (a set past 1 reads it,
+    /// as [`Maps::sample_sets`] does).
     pub fn uses_second_set(&self) -> bool {
-        self.each().any(|m| m.set == 1)
+        self.each().any(|m| m.set >= 1)
+    }
+
+    /// Which terms of the light these maps modulate apart ([`crate::light`]'s `split`): the
+    /// emission (an emission map) and the ambient terms (an ambient or occlusion map).
+    pub fn apart(&self) -> (bool, bool) {
+        (
+            self.emission.is_some(),
+            self.ambient.is_some() || self.occlusion.is_some(),
+        )
     }
 
     /// Samples every map at `uv` with screen derivatives `d_dx`, `d_dy` (one set of

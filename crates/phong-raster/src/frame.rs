@@ -118,7 +118,7 @@ impl<'a> Frame<'a> {
                     let m = &o.maps;
                     // Ambient, emission and occlusion maps need the light's terms apart, which
                     // only the vector sampler keeps (`Prepared::emission_apart`).
-                    let split = m.ambient.is_some() || m.emission.is_some() || m.occlusion.is_some();
+                    let split = m.apart() != (false, false);
                     let per_pixel_light = (split && VectorMaps::new(m).is_none())
                         || m.shininess.is_some()
                         || m.normal.is_some()

@@ -155,7 +155,8 @@ pub(crate) fn fetch(store: &TextureStore, key: Key) -> Option<Texture> {
 }
 
 /// `len` bytes from byte `start` of `f`, read into memory of their own that asks for huge
-/// pages (most of a read's time was faulting in 4 KiB pages), in pieces spread over the cores.
+/// pages (fewer page faults: BENCHMARKS.md, "The texture cache read into huge pages"), in
+/// pieces spread over the cores.
 fn read_levels(f: &File, start: u64, len: u64) -> Option<SharedBytes> {
     let mut map = memmap2::MmapMut::map_anon(usize::try_from(len).ok()?).ok()?;
     // Only a hint: without transparent huge pages the read takes longer, no more.

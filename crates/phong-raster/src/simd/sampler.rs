@@ -429,6 +429,13 @@ fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
     Some(t)
 }
 
+/// [`mapped`] at the coordinates of the set `map` reads: `uv1` where it reads the second and
+/// the sampler's general form (`FULL`) is compiled, else `uv`.
+#[inline(always)]
+fn mapped_set<V: Sampling, const FULL: bool>(map: &VectorMap, uv: [V; 6], uv1: [V; 6]) -> Option<[V; 3]> {
+    mapped(map, if FULL && map.second { uv1 } else { uv })
+}
+
 /// A pixel the vector sampler leaves to the caller's per-pixel sampler, with its light
 /// `[primary, specular, ambient]` (`phong_core::Lit`'s: the first two clamped where the options
 /// clamp; the ambient terms, emission apart, count where an ambient or occlusion map has
@@ -453,7 +460,7 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     let lit = shade(prep, pos, nrm);
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive through the sampling, nor
-    // choose a set per map (measured: 3–5% of the textured sphere's frame).
+    // choose a set per map (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
     let split = FULL && maps.split();
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
     let mut primary = [zero; 3];
@@ -507,28 +514,27 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     // (Matches, not closures: see `modulo`.)
     #[allow(clippy::manual_map)]
     let td = match &maps.diffuse {
-        Some(m) => Some(mapped(m, if FULL && m.second { uv1 } else { uv })),
+        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
         None => None,
     };
     #[allow(clippy::manual_map)]
     let ts = match &maps.specular {
-        Some(m) => Some(mapped(m, if FULL && m.second { uv1 } else { uv })),
+        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
         None => None,
     };
-    let (ta, te) = match (FULL, &maps.ambient, &maps.emission) {
-        (false, _, _) => (None, None),
-        (true, Some(a), Some(e)) => (
-            Some(mapped(a, if FULL && a.second { uv1 } else { uv })),
-            Some(mapped(e, if FULL && e.second { uv1 } else { uv })),
-        ),
-        (true, Some(a), None) => (Some(mapped(a, if FULL && a.second { uv1 } else { uv })), None),
-        (true, None, Some(e)) => (None, Some(mapped(e, if FULL && e.second { uv1 } else { uv }))),
-        (true, None, None) => (None, None),
+    // Only the general form has ambient, emission and occlusion maps.
+    let ta = match (FULL, &maps.ambient) {
+        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        _ => None,
+    };
+    let te = match (FULL, &maps.emission) {
+        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        _ => None,
     };
     // The occlusion's red channel (`None` inside: not wrapped).
     #[allow(clippy::manual_map)]
     let ao = match (FULL, &maps.occlusion) {
-        (true, Some((m, _))) => Some(match mapped(m, if FULL && m.second { uv1 } else { uv }) {
+        (true, Some((m, _))) => Some(match mapped_set::<V, FULL>(m, uv, uv1) {
             Some(t) => Some(t[0]),
             None => None,
         }),

@@ -285,16 +285,16 @@ impl Frame<'_> {
         }
         // As `phong_core::light` splits them: the emission and the ambient terms apart where
         // maps of their own modulate them (the light was prepared so: `emission_apart`).
-        let maps = &obj.maps;
+        let (emission_apart, ambient_apart) = obj.maps.apart();
         let lit = Lit {
             primary: Color::new(primary[0], primary[1], primary[2]),
             specular: Color::new(specular[0], specular[1], specular[2]),
-            emission: if maps.emission.is_some() {
+            emission: if emission_apart {
                 obj.material.emission()
             } else {
                 Color::BLACK
             },
-            ambient: if maps.ambient.is_some() || maps.occlusion.is_some() {
+            ambient: if ambient_apart {
                 Color::new(ambient[0], ambient[1], ambient[2])
             } else {
                 Color::BLACK
