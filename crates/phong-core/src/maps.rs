@@ -372,7 +372,7 @@ impl Maps {
         self.each().any(|m| m.set >= 1)
     }
 
-    /// Which terms of the light these maps modulate apart ([`crate::light`]'s `split`): the
+    /// Which terms of the light these maps modulate apart ([`light`](fn@crate::light)'s `split`): the
     /// emission (an emission map) and the ambient terms (an ambient or occlusion map).
     pub fn apart(&self) -> (bool, bool) {
         (
