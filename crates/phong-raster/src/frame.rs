@@ -3,7 +3,7 @@
 //! render itself (setup, then the tiles).
 
 use crate::fixed::pattern;
-use crate::setup::{Chunk, Corners, ID_INDEX_BITS, SampleSpan, Scratch, Tri};
+use crate::setup::{Chunk, Corners, Extra, ID_INDEX_BITS, SampleSpan, Scratch, Tri};
 use crate::simd::{Batch, Isa, Planes, Prepared, Term, VectorMaps};
 use crate::stats::{RenderStats, StageClock};
 use crate::target::{Pixel, resolve};
@@ -31,7 +31,8 @@ pub(crate) enum Mode {
     /// A textured object's colour with one sample a pixel, Phong-interpolated: light and maps
     /// by the vector sampler where it covers the maps ([`Frame::vector_maps`]), else the light
     /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
-    /// of its texture coordinates (maps that change the light are [`Mode::Scalar`]'s).
+    /// of its texture coordinates (maps that change the light, other than normal maps, are
+    /// [`Mode::Scalar`]'s; a normal map needs the vector sampler).
     Textured(Prepared),
     /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
     /// depth outputs).
@@ -71,6 +72,8 @@ pub(crate) struct Frame<'a> {
     pub vector_maps: Vec<Option<VectorMaps<'a>>>,
     /// Per object: whether a map reads the mesh's second set of texture coordinates.
     pub second_sets: Vec<bool>,
+    /// Per object: what its coordinates' planes carry beside the first set.
+    pub extras: Vec<Extra>,
     /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
     pub gouraud_only: bool,
     /// Per object: its view vector rule.
@@ -119,12 +122,14 @@ impl<'a> Frame<'a> {
                     // Ambient, emission and occlusion maps need the light's terms apart, which
                     // only the vector sampler keeps (`Prepared::emission_apart`).
                     let split = m.apart() != (false, false);
-                    let per_pixel_light = (split && VectorMaps::new(m).is_none())
+                    let colors = !o.mesh.colors().is_empty();
+                    // A normal map changes the light, which only the vector sampler tilts.
+                    let per_pixel_light = ((split || m.normal.is_some()) && VectorMaps::new(m).is_none())
                         || m.shininess.is_some()
-                        || m.normal.is_some()
                         || m.metal_rough.is_some()
-                        // The second set takes the vertex colours' planes.
-                        || (second_set && !o.mesh.colors().is_empty());
+                        // The second set takes the vertex colours' planes, the tangents both.
+                        || (second_set && colors)
+                        || (m.normal.is_some() && (second_set || colors));
                     let one_sample = scene.image.samples == phong_core::Samples::One;
                     if o.shading.interpolation == Interpolation::Phong
                         && term == Term::Color
@@ -165,6 +170,17 @@ impl<'a> Frame<'a> {
                 .map(|(o, m)| match m {
                     Mode::Textured(_) => VectorMaps::new(&o.maps).map(|v| v.tinted(!o.mesh.colors().is_empty())),
                     _ => None,
+                })
+                .collect(),
+            extras: scene
+                .objects
+                .iter()
+                .zip(&modes)
+                .zip(&second_sets)
+                .map(|((o, mode), &second)| match mode {
+                    Mode::Textured(_) if o.maps.normal.is_some() => Extra::Tangents,
+                    _ if second => Extra::SecondSet,
+                    _ => Extra::Colors,
                 })
                 .collect(),
             modes,
@@ -350,5 +366,47 @@ material = { base = "brass", ambient_map = "assets/checker.png", filter = "neare
             assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
         }
         assert!(matches!(frame.modes[2], Mode::Scalar));
+    }
+
+    /// An object with a normal (or bump) map is drawn by the vector sampler, its tangents in
+    /// its coordinates' planes; with a second set of coordinates, or nearest filtering, it is
+    /// shaded per pixel.
+    #[test]
+    fn normal_maps_take_the_vector_sampler_with_tangent_planes() {
+        let src = r#"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+material = { base = "brass", bump_map = "assets/bricks_height.png" }
+[[object]]
+shape = "torus"
+material = { base = "brass", diffuse_map = "assets/bricks.png", emission_map = "assets/checker.png", bump_map = "assets/bricks_height.png" }
+[[object]]
+shape = "sphere"
+material = { base = "brass", bump_map = "assets/checker.png", filter = "nearest" }
+[[object]]
+shape = "sphere"
+material = { base = "brass", diffuse_map = "assets/bricks.png" }
+"#;
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/normals.toml");
+        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        // A normal map beside a map on the second set.
+        let mut o = scene.objects[1].clone();
+        o.mesh = o.mesh.clone().with_uvs1(o.mesh.uvs().to_vec()).unwrap();
+        o.maps.emission.as_mut().unwrap().set = 1;
+        scene.objects.push(o);
+        let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+        for i in [0, 1] {
+            assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
+            assert!(frame.vector_maps[i].is_some(), "object {i}");
+            assert_eq!(frame.extras[i], Extra::Tangents, "object {i}");
+        }
+        assert!(matches!(frame.modes[2], Mode::Scalar));
+        assert!(matches!(frame.modes[3], Mode::Textured(_)));
+        assert_eq!(frame.extras[3], Extra::Colors);
+        assert!(matches!(frame.modes[4], Mode::Scalar));
+        assert_eq!(frame.extras[4], Extra::SecondSet);
     }
 }

@@ -49,17 +49,10 @@ impl Frame<'_> {
         let rgb_of = |i: u32| colors.get(i as usize).map_or(Vec3::ONE, |c| Vec3::from(c.to_array()));
         let uvs1 = mesh.uvs1();
         let uv1_of = |i: u32| uvs1.get(i as usize).copied().unwrap_or_default();
-        // The uv planes' colour rows carry a second set of coordinates where the maps read one
-        // (such objects have no vertex colours: `uv_planes`).
-        let second = self.second_sets[oi];
-        let extra_of = |i: u32| {
-            if second {
-                let uv = uv1_of(i);
-                Vec3::new(uv.x, uv.y, 0.0)
-            } else {
-                rgb_of(i)
-            }
-        };
+        let tangents = mesh.tangents();
+        let tangent_of = |i: u32| tangents.get(i as usize).copied().unwrap_or(Vec4::ZERO);
+        let extra = self.extras[oi];
+        let extra_of = |i: u32| extra.of(rgb_of(i), uv1_of(i), tangent_of(i));
         let lighting = gouraud.then(|| VertexLighting {
             isa: self.isa,
             prepared: Prepared::new(
@@ -145,7 +138,7 @@ impl Frame<'_> {
                         uv: uv_of(tri[k]),
                         uv1: uv1_of(tri[k]),
                         rgb: rgb_of(tri[k]),
-                        tangent: Vec4::ZERO,
+                        tangent: tangent_of(tri[k]),
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {

@@ -266,15 +266,38 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
     })
 }
 
-/// The planes of texture coordinates `uv` and vertex colours `rgb` (per set-up vertex) of
-/// triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the colour over `w` in `attr[2..5]`.
-/// An object whose maps read a second set of coordinates passes them as `rgb` (`(u, v, 0)`):
-/// it has no vertex colours ([`crate::frame::Frame::second_sets`]).
+/// What a textured object's coordinates' planes carry beside its first set ([`uv_planes`]'s
+/// `extra`), decided per object and frame ([`crate::frame::Frame::extras`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Extra {
+    /// The vertex colours (white where the mesh has none).
+    Colors,
+    /// The second set of texture coordinates (the object has no vertex colours).
+    SecondSet,
+    /// The tangents, for a normal map (no vertex colours, no second set).
+    Tangents,
+}
+
+impl Extra {
+    /// A vertex's extra attributes, from its colour, second set and tangent.
+    #[inline(always)]
+    pub(crate) fn of(self, rgb: Vec3, uv1: glam::Vec2, tangent: glam::Vec4) -> glam::Vec4 {
+        match self {
+            Extra::Colors => rgb.extend(0.0),
+            Extra::SecondSet => glam::Vec4::new(uv1.x, uv1.y, 0.0, 0.0),
+            Extra::Tangents => tangent,
+        }
+    }
+}
+
+/// The planes of texture coordinates `uv` and extra attributes `extra` (per set-up vertex; see
+/// [`Extra`]) of triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the extra attributes over
+/// `w` in `attr[2..6]`.
 #[inline]
-pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], rgb: [Vec3; 3]) -> Planes {
+pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], extra: [glam::Vec4; 3]) -> Planes {
     let attrs = [
-        crate::fixed::each3(|k| Vec3::new(uv[k].x, uv[k].y, rgb[k].x)),
-        crate::fixed::each3(|k| Vec3::new(rgb[k].y, rgb[k].z, 0.0)),
+        crate::fixed::each3(|k| Vec3::new(uv[k].x, uv[k].y, extra[k].x)),
+        crate::fixed::each3(|k| Vec3::new(extra[k].y, extra[k].z, extra[k].w)),
     ];
     plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
 }
@@ -351,14 +374,8 @@ impl Frame<'_> {
             return Some((s.tri, Planes::default(), Some(corners), None));
         }
         let mode = &self.modes[object as usize];
-        let second = self.second_sets[object as usize];
-        let extra = |v: &ClipVertex| {
-            if second {
-                Vec3::new(v.uv1.x, v.uv1.y, 0.0)
-            } else {
-                v.rgb
-            }
-        };
+        let extra = self.extras[object as usize];
+        let extra = |v: &ClipVertex| extra.of(v.rgb, v.uv1, v.tangent);
         let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra)));
         let planes = match mode {
             Mode::Scalar => Planes::default(),

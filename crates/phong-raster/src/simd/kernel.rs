@@ -78,6 +78,14 @@ impl<V: Vf32> V3<V> {
             z: V::select(m, a.z, b.z),
         }
     }
+    #[inline(always)]
+    fn cross(self, o: Self) -> Self {
+        V3 {
+            x: self.y.mul(o.z).sub(self.z.mul(o.y)),
+            y: self.z.mul(o.x).sub(self.x.mul(o.z)),
+            z: self.x.mul(o.y).sub(self.y.mul(o.x)),
+        }
+    }
     /// glam's `normalize_or_zero`: `v · (1/|v|)` when that reciprocal is finite and > 0.
     #[inline(always)]
     fn normalize_or_zero(self) -> (Self, V::M) {
@@ -97,6 +105,24 @@ impl<V: Vf32> V3<V> {
             ok,
         )
     }
+}
+
+/// `phong_core::perturb` for every lane: the normal `n` tilted by the tangent-space normal
+/// `ts` in the frame of the tangent `t` (`t[3]`: the bitangent's sign); `n` itself where the
+/// frame degenerates (a zero normal, or a tangent zero or along the normal).
+#[inline(always)]
+pub(super) fn perturb<V: Vf32>(n: V3<V>, t: [V; 4], ts: [V; 3]) -> V3<V> {
+    let (nn, n_ok) = n.normalize_or_zero();
+    let t3 = V3 {
+        x: t[0],
+        y: t[1],
+        z: t[2],
+    };
+    let (tt, t_ok) = t3.sub(nn.scale(nn.dot(t3))).normalize_or_zero();
+    let b = nn.cross(tt);
+    let sign = V::select(t[3].lt(V::splat(0.0)), V::splat(-1.0), V::splat(1.0));
+    let tilted = tt.scale(ts[0]).add(b.scale(sign.mul(ts[1]))).add(nn.scale(ts[2]));
+    V3::select(V::and(n_ok, t_ok), tilted, n)
 }
 
 /// `log2 x` for finite `x > 0` (not denormal): `x = m·2^e`, `m` in `[√½, √2)`,

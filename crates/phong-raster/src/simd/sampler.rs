@@ -5,16 +5,17 @@
 //! ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
 //!
 //! It covers the common cases, decided once per draw ([`VectorMaps::new`]): diffuse, specular,
-//! ambient, emission and occlusion maps, 8 or 16 bits, linear filters, on either set of
-//! texture coordinates, vertex colours or not (not with a second set). A
-//! vector whose coordinates are too large for exact `f32` wrapping (or NaN) is left to the
-//! caller's per-pixel sampler.
+//! ambient, emission, occlusion and normal maps (bump maps are normal maps by then), 8 or 16
+//! bits, linear filters, on either set of texture coordinates, vertex colours or not (not with
+//! a second set; a normal map with neither: its tangents take their planes). A vector whose
+//! coordinates are too large for exact `f32` wrapping (or NaN) is left to the caller's
+//! per-pixel sampler, lit (a normal map's texels for such a vector are sampled per lane here).
 
 use super::kernel::{
-    Broadcast, MAX_LANES, Planes, Prepared, centres, coefficients, interpolate, position_normal, shade,
+    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal, shade,
 };
 use super::vector::{Portable, Vf32};
-use phong_core::{Filter, Maps, MipFilter, TextureMap, UvTransform, Wrap};
+use phong_core::{Filter, Maps, MipFilter, NormalMap, TextureMap, UvTransform, Wrap};
 
 /// The most mipmap levels (a 16384 side has 15).
 const MAX_LEVELS: usize = 16;
@@ -90,6 +91,9 @@ pub struct VectorMaps<'a> {
     emission: Option<VectorMap<'a>>,
     /// glTF's occlusion map and its strength: the ambient terms times `1 + strength·(T.r − 1)`.
     occlusion: Option<(VectorMap<'a>, f32)>,
+    /// A tangent-space normal map: its levels, and the map for lanes the vector wrap cannot
+    /// take. The tangents' planes are the coordinates' planes' `attr[2..6]`.
+    normal: Option<(VectorMap<'a>, &'a NormalMap)>,
     /// Vertex colours multiply the diffuse texel (`Texels::tinted`).
     tinted: bool,
     /// A map reads the second set of coordinates (never with `tinted`: they share planes).
@@ -97,9 +101,10 @@ pub struct VectorMaps<'a> {
 }
 
 impl<'a> VectorMaps<'a> {
-    /// `maps` if the sampler covers them: diffuse, specular, ambient, emission and occlusion
-    /// maps (at least one) and no other (each as [`VectorMap`] covers it). With ambient,
-    /// emission or occlusion maps the light must be prepared with [`Prepared::emission_apart`].
+    /// `maps` if the sampler covers them: diffuse, specular, ambient, emission, occlusion and
+    /// normal maps (at least one) and no other (each as [`VectorMap`] covers it). With ambient,
+    /// emission or occlusion maps the light must be prepared with [`Prepared::emission_apart`];
+    /// with a normal map the coordinates' planes carry the tangents (`setup::uv_planes`).
     pub fn new(maps: &'a Maps) -> Option<VectorMaps<'a>> {
         // Every field named: a new map must be considered here.
         let Maps {
@@ -115,9 +120,13 @@ impl<'a> VectorMaps<'a> {
             alpha_cutoff: _,
             blend: _,
         } = maps;
-        let others = shininess.is_some() || alpha.is_some() || normal.is_some() || metal_rough.is_some();
-        let none =
-            diffuse.is_none() && specular.is_none() && ambient.is_none() && emission.is_none() && occlusion.is_none();
+        let others = shininess.is_some() || alpha.is_some() || metal_rough.is_some();
+        let none = diffuse.is_none()
+            && specular.is_none()
+            && ambient.is_none()
+            && emission.is_none()
+            && occlusion.is_none()
+            && normal.is_none();
         if others || none {
             return None;
         }
@@ -135,6 +144,10 @@ impl<'a> VectorMaps<'a> {
                     Some(o) => Some((VectorMap::of(&o.map)?, o.strength)),
                     None => None,
                 },
+                normal: match normal {
+                    Some(n) => Some((VectorMap::of(&n.map)?, n)),
+                    None => None,
+                },
                 tinted: false,
                 second: false,
             }
@@ -142,10 +155,10 @@ impl<'a> VectorMaps<'a> {
         )
     }
 
-    /// Whether the sampler's general form is needed: a split light ([`VectorMaps::split`]) or
-    /// a map on the second set.
+    /// Whether the sampler's general form is needed: a split light ([`VectorMaps::split`]), a
+    /// map on the second set or a normal map.
     fn full(&self) -> bool {
-        self.split() || self.second
+        self.split() || self.second || self.normal.is_some()
     }
 
     /// Whether the ambient or emission terms have maps of their own (see
@@ -154,10 +167,14 @@ impl<'a> VectorMaps<'a> {
         self.ambient_apart() || self.emission.is_some()
     }
 
-    /// The rows of the coordinates' planes read (8 floats each): the vertex colours' and a
-    /// second set's are in the third.
+    /// The rows of the coordinates' planes read (8 floats each): the vertex colours', a
+    /// second set's and the tangents' are in the third.
     fn rows(&self) -> usize {
-        if self.tinted || self.second { 3 } else { 2 }
+        if self.tinted || self.second || self.normal.is_some() {
+            3
+        } else {
+            2
+        }
     }
 
     /// Whether the ambient terms have a factor of their own (an ambient or occlusion map).
@@ -169,7 +186,8 @@ impl<'a> VectorMaps<'a> {
     fn with_second(self) -> VectorMaps<'a> {
         let maps = [self.diffuse, self.specular, self.ambient, self.emission];
         let occlusion = self.occlusion.map(|(m, _)| m);
-        let second = maps.iter().chain([&occlusion]).flatten().any(|m| m.second);
+        let normal = self.normal.map(|(m, _)| m);
+        let second = maps.iter().chain([&occlusion, &normal]).flatten().any(|m| m.second);
         VectorMaps { second, ..self }
     }
 
@@ -436,6 +454,97 @@ fn mapped_set<V: Sampling, const FULL: bool>(map: &VectorMap, uv: [V; 6], uv1: [
     mapped(map, if FULL && map.second { uv1 } else { uv })
 }
 
+/// The coordinates at centres `(x, y)` from their planes `k`: the first set
+/// `[u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`, the second (the first where no map reads it or
+/// `FULL` is off), and `(x − ox, y − oy, w)`.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn coordinates<V: Vf32, const FULL: bool>(maps: &VectorMaps, k: &[V; 24], x: V, y: V) -> ([V; 6], [V; 6], (V, V, V)) {
+    let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
+    // `c + gx·dx + gy·dy` of the planes at 2 (1/w), 5 (u/w) and 8 (v/w).
+    let mut p = [V::splat(0.0); 3];
+    for (j, i) in [2, 5, 8].into_iter().enumerate() {
+        p[j] = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy));
+    }
+    let rq = p[0].recip();
+    let (u, v) = (p[1].mul(rq), p[2].mul(rq));
+    let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
+    let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
+    let uv = [u, v, ux, vx, uy, vy];
+    // The second set, where a map reads it, from the planes at 11 and 14 (in the vertex
+    // colours' place: such objects have none).
+    let uv1 = if FULL && maps.second {
+        let p1 = k[11].add(k[12].mul(dx)).add(k[13].mul(dy));
+        let p2 = k[14].add(k[15].mul(dx)).add(k[16].mul(dy));
+        let (u1, v1) = (p1.mul(rq), p2.mul(rq));
+        let (ux1, vx1) = (k[12].sub(u1.mul(k[3])).mul(rq), k[15].sub(v1.mul(k[3])).mul(rq));
+        let (uy1, vy1) = (k[13].sub(u1.mul(k[4])).mul(rq), k[16].sub(v1.mul(k[4])).mul(rq));
+        [u1, v1, ux1, vx1, uy1, vy1]
+    } else {
+        uv
+    };
+    (uv, uv1, (dx, dy, rq))
+}
+
+/// The normal `nrm` tilted by the normal map of `maps` (if any) in the frame of the tangent
+/// interpolated from its planes at 11, 14, 17 and 20 (over `w` as the coordinates `c`).
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn tilted<V: Sampling, const FULL: bool>(
+    maps: &VectorMaps,
+    nrm: V3<V>,
+    k: &[V; 24],
+    (uv, uv1, (dx, dy, rq)): ([V; 6], [V; 6], (V, V, V)),
+) -> V3<V> {
+    let Some((map, source)) = &maps.normal else {
+        return nrm;
+    };
+    let mut t = [V::splat(0.0); 4];
+    for (c, t) in t.iter_mut().enumerate() {
+        let i = 11 + 3 * c;
+        *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
+    }
+    let texel = match mapped_set::<V, FULL>(map, uv, uv1) {
+        Some(texel) => texel,
+        None => normal_texels_per_lane(source, if map.second { uv1 } else { uv }),
+    };
+    perturb(nrm, t, tangent_space(source, texel))
+}
+
+/// A normal map's tangent-space normals from its texels (`[0, 1]`), as `phong_core::Maps`
+/// decodes them: `2·t − 1`, `x` and `y` times the scale, `y` negated for green down.
+#[inline(always)]
+fn tangent_space<V: Vf32>(map: &NormalMap, t: [V; 3]) -> [V; 3] {
+    let (one, two) = (V::splat(1.0), V::splat(2.0));
+    let y = if map.green_down { -map.scale } else { map.scale };
+    [
+        t[0].mul_add(two, V::splat(-1.0)).mul(V::splat(map.scale)),
+        t[1].mul_add(two, V::splat(-1.0)).mul(V::splat(y)),
+        t[2].mul(two).sub(one),
+    ]
+}
+
+/// A normal map's texels for lanes whose coordinates `uv` (the map's set) the vector wrap
+/// cannot take: each sampled by `phong_core::TextureMap::sample` (rare: NaN, or past ±2^21
+/// texels).
+#[inline(never)]
+fn normal_texels_per_lane<V: Vf32>(map: &NormalMap, uv: [V; 6]) -> [V; 3] {
+    let a = uv.map(V::to_array);
+    let mut out = [V::A::default(); 3];
+    for i in 0..V::N {
+        let at = |k: usize| a[k].as_ref()[i];
+        let t = map.map.sample(
+            glam::Vec2::new(at(0), at(1)),
+            glam::Vec2::new(at(2), at(3)),
+            glam::Vec2::new(at(4), at(5)),
+        );
+        for c in 0..3 {
+            out[c].as_mut()[i] = t[c];
+        }
+    }
+    out.map(V::from_array)
+}
+
 /// A pixel the vector sampler leaves to the caller's per-pixel sampler, with its light
 /// `[primary, specular, ambient]` (`phong_core::Lit`'s: the first two clamped where the options
 /// clamp; the ambient terms, emission apart, count where an ambient or occlusion map has
@@ -457,7 +566,15 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
 ) -> Result<[V; 3], [[V; 3]; 3]> {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (pos, nrm) = position_normal(q);
-    let lit = shade(prep, pos, nrm);
+    // The common case lights first, then finds the coordinates, as before normal maps were
+    // covered (BENCHMARKS.md, "Normal and bump maps on the fast path"); a normal map needs the
+    // coordinates first.
+    let (lit, (uv, uv1, (dx, dy, rq))) = if FULL && maps.normal.is_some() {
+        let c = coordinates::<V, FULL>(maps, k, x, y);
+        (shade(prep, pos, tilted::<V, FULL>(maps, nrm, k, c)), c)
+    } else {
+        (shade(prep, pos, nrm), coordinates::<V, FULL>(maps, k, x, y))
+    };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive through the sampling, nor
     // choose a set per map (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
@@ -488,29 +605,6 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
         primary[c] = p;
         specular[c] = s;
     }
-    let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
-    // `c + gx·dx + gy·dy` of the planes at 2 (1/w), 5 (u/w) and 8 (v/w).
-    let mut p = [zero; 3];
-    for (j, i) in [2, 5, 8].into_iter().enumerate() {
-        p[j] = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy));
-    }
-    let rq = p[0].recip();
-    let (u, v) = (p[1].mul(rq), p[2].mul(rq));
-    let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
-    let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
-    let uv = [u, v, ux, vx, uy, vy];
-    // The second set, where a map reads it, from the planes at 11 and 14 (in the vertex
-    // colours' place: such objects have none).
-    let uv1 = if FULL && maps.second {
-        let p1 = k[11].add(k[12].mul(dx)).add(k[13].mul(dy));
-        let p2 = k[14].add(k[15].mul(dx)).add(k[16].mul(dy));
-        let (u1, v1) = (p1.mul(rq), p2.mul(rq));
-        let (ux1, vx1) = (k[12].sub(u1.mul(k[3])).mul(rq), k[15].sub(v1.mul(k[3])).mul(rq));
-        let (uy1, vy1) = (k[13].sub(u1.mul(k[4])).mul(rq), k[16].sub(v1.mul(k[4])).mul(rq));
-        [u1, v1, ux1, vx1, uy1, vy1]
-    } else {
-        uv
-    };
     // (Matches, not closures: see `modulo`.)
     #[allow(clippy::manual_map)]
     let td = match &maps.diffuse {
