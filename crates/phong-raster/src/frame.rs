@@ -31,8 +31,8 @@ pub(crate) enum Mode {
     /// A textured object's colour with one sample a pixel, Phong-interpolated: light and maps
     /// by the vector sampler where it covers the maps ([`Frame::vector_maps`]), else the light
     /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
-    /// of its texture coordinates (maps that change the light, other than normal maps, are
-    /// [`Mode::Scalar`]'s; a normal map needs the vector sampler).
+    /// of its texture coordinates (maps that change the light, normal, shininess and
+    /// metallic-roughness maps, need the vector sampler: without it they are [`Mode::Scalar`]'s).
     Textured(Prepared),
     /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
     /// depth outputs).
@@ -123,10 +123,10 @@ impl<'a> Frame<'a> {
                     // only the vector sampler keeps (`Prepared::emission_apart`).
                     let split = m.apart() != (false, false);
                     let colors = !o.mesh.colors().is_empty();
-                    // A normal map changes the light, which only the vector sampler tilts.
-                    let per_pixel_light = ((split || m.normal.is_some()) && VectorMaps::new(m).is_none())
-                        || m.shininess.is_some()
-                        || m.metal_rough.is_some()
+                    // Normal, shininess and metallic-roughness maps change the light, which
+                    // only the vector sampler samples them for.
+                    let changes_light = m.normal.is_some() || m.shininess.is_some() || m.metal_rough.is_some();
+                    let per_pixel_light = ((split || changes_light) && VectorMaps::new(m).is_none())
                         // The second set takes the vertex colours' planes, the tangents both.
                         || (second_set && colors)
                         || (m.normal.is_some() && (second_set || colors));
@@ -370,9 +370,10 @@ material = { base = "brass", ambient_map = "assets/checker.png", filter = "neare
 
     /// An object with a normal (or bump) map is drawn by the vector sampler, its tangents in
     /// its coordinates' planes; with a second set of coordinates, or nearest filtering, it is
-    /// shaded per pixel.
+    /// shaded per pixel. So is one with a shininess map, unless the map reads its alpha (not
+    /// gathered).
     #[test]
-    fn normal_maps_take_the_vector_sampler_with_tangent_planes() {
+    fn normal_and_shininess_maps_take_the_vector_sampler() {
         let src = r#"
 [[light]]
 type = "point"
@@ -397,6 +398,13 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         o.mesh = o.mesh.clone().with_uvs1(o.mesh.uvs().to_vec()).unwrap();
         o.maps.emission.as_mut().unwrap().set = 1;
         scene.objects.push(o);
+        // A shininess map (the diffuse map's image), then the same on its alpha channel.
+        let mut o = scene.objects[3].clone();
+        let map = o.maps.diffuse.clone().unwrap();
+        o.maps.shininess = Some((map, phong_core::Channel::Luminance));
+        scene.objects.push(o.clone());
+        o.maps.shininess.as_mut().unwrap().1 = phong_core::Channel::A;
+        scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
         for i in [0, 1] {
             assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
@@ -408,5 +416,8 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         assert_eq!(frame.extras[3], Extra::Colors);
         assert!(matches!(frame.modes[4], Mode::Scalar));
         assert_eq!(frame.extras[4], Extra::SecondSet);
+        assert!(matches!(frame.modes[5], Mode::Textured(_)));
+        assert!(frame.vector_maps[5].is_some());
+        assert!(matches!(frame.modes[6], Mode::Scalar));
     }
 }

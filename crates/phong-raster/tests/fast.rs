@@ -762,3 +762,132 @@ material = {{ base = "pewter", bump_map = "assets/checker.png", uv_scale = [3.0e
         assert_fast_matches_reference(&scene, model);
     }
 }
+
+/// Shininess maps and glTF's metallic-roughness maps, which set the shininess per pixel: the
+/// vector sampler samples them before the light, whose `pow` and normalisation factor then take
+/// a shininess per lane. A shininess map on each channel (red, green, blue, luminance) under
+/// Phong, Blinn-Phong and Lyon specular terms and each normalisation, with the `opengl` model
+/// clamping; metallic-roughness maps of random texels (roughness down to 0: the largest
+/// shininess), beside a diffuse map or alone, with a normal map; coordinates past the vector
+/// wrap (the far plane: its maps then sampled per lane). The fast path within 1/255 of the
+/// reference.
+#[test]
+fn fast_path_matches_reference_with_shininess_and_metallic_roughness_maps() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let src = r#"
+[image]
+width = 220
+height = 130
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[light]]
+type = "directional"
+direction = [1.0, -0.5, -1.0]
+color = [0.5, 0.5, 0.6]
+[[object]]
+shape = "sphere"
+position = [-2.2, 0.8, 0.0]
+material = { base = "brass", shininess = 80.0, diffuse_map = "assets/bricks.png", shininess_map = "assets/bricks_specular.png", uv_scale = [2.0, 1.0] }
+[[object]]
+shape = "torus"
+position = [0.0, 0.8, 0.0]
+rotation = [60.0, 0.0, 0.0]
+material = { base = "jade", shininess = 40.0, shininess_map = "assets/bricks.png", wrap = "mirror" }
+[[object]]
+shape = "sphere"
+position = [2.2, 0.8, 0.0]
+material = { base = "chrome", shininess = 200.0, shininess_map = "assets/checker.png", specular_map = "assets/bricks.png", filter = "bilinear" }
+[[object]]
+shape = "sphere"
+position = [-2.2, -1.3, 0.0]
+material = { base = "gold", diffuse_map = "assets/bricks.png" }
+[[object]]
+shape = "cube"
+position = [0.0, -1.3, 0.0]
+rotation = [30.0, 40.0, 0.0]
+material = { base = "silver", bump_map = "assets/bricks_height.png" }
+[[object]]
+shape = "torus"
+position = [2.2, -1.3, 0.0]
+rotation = [70.0, 0.0, 0.0]
+material = { base = "ruby", shininess = 30.0, shininess_map = "assets/checker.png", emission = [0.1, 0.0, 0.1], emission_map = "assets/checker.png" }
+[[object]]
+shape = "plane"
+position = [0.0, -0.2, -3.0]
+scale = 6.0
+rotation = [80.0, 0.0, 0.0]
+material = { base = "pewter", shininess_map = "assets/checker.png", uv_scale = [3.0e5, 3.0e5] }
+"#;
+    let mut r = Rng(13);
+    let random = |r: &mut Rng, w: u32, h: u32| {
+        let texels: Vec<[u16; 4]> = (0..w * h)
+            .map(|_| [r.f(), r.f(), r.f()].map(|x| (x * 65535.0) as u16))
+            .map(|[a, b, c]| [a, b, c, 65535])
+            .collect();
+        std::sync::Arc::new(Texture::new(w, h, &texels, 16).unwrap())
+    };
+    let mr_texture = random(&mut r, 24, 20);
+    // Past the wrap every lane samples the last level: one texel for the whole plane, the same
+    // on both paths (such coordinates' low bits are noise to a filter).
+    let flat = |t: [f32; 3]| {
+        let t = t.map(|x| (x * 65535.0) as u16);
+        std::sync::Arc::new(Texture::new(64, 64, &vec![[t[0], t[1], t[2], 65535]; 64 * 64], 16).unwrap())
+    };
+    let models = [
+        SpecularModel::Phong,
+        SpecularModel::BlinnPhong,
+        SpecularModel::Lyon {
+            squarings: 3,
+            lambda: LyonLambda::Dot,
+        },
+    ];
+    let normalizations = [
+        Normalization::None,
+        Normalization::Phong,
+        Normalization::BlinnPhong,
+        Normalization::BlinnPhongExact,
+    ];
+    for (round, clamp) in [(0, true), (1, false)] {
+        let mut scene = phong_scene::parse_scene(src, &root.join("shininess.toml"))
+            .unwrap()
+            .scene;
+        for (i, o) in scene.objects.iter_mut().enumerate() {
+            o.shading.options.specular = models[(i + round) % 3];
+            o.shading.options.normalization = normalizations[(i + round) % 4];
+            o.shading.options.clamp = clamp;
+        }
+        for (i, channel) in [
+            (0, Channel::R),
+            (1, Channel::G),
+            (2, Channel::B),
+            (5, Channel::Luminance),
+        ] {
+            scene.objects[i].maps.shininess.as_mut().unwrap().1 = channel;
+        }
+        // Metallic-roughness: beside a diffuse map (the sphere), with a normal map (the cube),
+        // over a shininess map (the torus: the roughness's shininess wins), past the wrap (the
+        // plane, beside its shininess map).
+        for (i, metallic, roughness) in [(3, 1.0, 1.0), (4, 0.7, 0.8), (5, 1.0, 0.5), (6, 0.8, 0.9)] {
+            let o = &mut scene.objects[i];
+            let mut map = TextureMap::new(mr_texture.clone());
+            if i == 6 {
+                map.texture = flat([0.0, 0.35, 0.6]);
+                map.transform = o.maps.shininess.as_ref().unwrap().0.transform;
+            }
+            let mr = MetalRough {
+                map,
+                base_factor: Color::new(0.9, 0.7, 0.5),
+                metallic,
+                roughness,
+            };
+            o.material = mr.material(Color::BLACK, 1.0);
+            o.maps.metal_rough = Some(mr);
+        }
+        let far = scene.objects[6].maps.shininess.as_mut().unwrap();
+        far.0.texture = flat([0.2, 0.5, 0.9]);
+        assert_fast_matches_reference(&scene, &format!("clamp {clamp}"));
+    }
+}

@@ -166,6 +166,36 @@ fn pow_positive<V: Vf32>(x: V, s: f32) -> V {
     V::select(x.gt(V::splat(0.0)), r, V::splat(0.0))
 }
 
+/// [`pow_positive`] with the exponent `sv` per lane where given, else `s`.
+#[inline(always)]
+fn pow_lanes<V: Vf32>(x: V, s: f32, sv: Option<V>) -> V {
+    match sv {
+        None => pow_positive(x, s),
+        Some(sv) => {
+            let xc = x.max(V::splat(f32::MIN_POSITIVE)).min(V::splat(1.0));
+            let r = exp2(sv.mul(log2(xc)));
+            V::select(x.gt(V::splat(0.0)), r, V::splat(0.0))
+        }
+    }
+}
+
+/// The specular normalisation factor `Normalization::factors(s).1` for shininess `s` per lane
+/// (`s >= 0`).
+#[inline(always)]
+fn specular_factor<V: Vf32>(normalization: Normalization, s: V) -> V {
+    use core::f32::consts::PI;
+    match normalization {
+        Normalization::None => V::splat(1.0),
+        Normalization::Phong => s.add(V::splat(2.0)).mul(V::splat(1.0 / (2.0 * PI))),
+        Normalization::BlinnPhong => s.add(V::splat(8.0)).mul(V::splat(1.0 / (8.0 * PI))),
+        Normalization::BlinnPhongExact => {
+            let num = s.add(V::splat(2.0)).mul(s.add(V::splat(4.0)));
+            let den = exp2(s.mul(V::splat(-0.5))).add(s).mul(V::splat(8.0 * PI));
+            num.mul(den.recip())
+        }
+    }
+}
+
 /// `(x⁺)^s` for a per-light exponent (spot falloff), `0^0 = 1` as `powf`.
 #[inline(always)]
 fn pow_falloff<V: Vf32>(x: V, s: f32) -> V {
@@ -200,7 +230,8 @@ struct PreparedLight {
 pub struct Prepared {
     view: View,
     pub(super) options: ShadingOptions,
-    shininess: f32,
+    /// The material's shininess.
+    pub(super) shininess: f32,
     kd: f32,
     ks: f32,
     base: Color,
@@ -339,6 +370,13 @@ fn fin<V: Vf32>(x: V) -> V {
 /// `phong_core::shade` with `pow` approximated as documented above.
 #[inline(always)]
 pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
+    shade_shininess(p, pos, nrm, None)
+}
+
+/// [`shade`] with the shininess per lane where `sv` is given (a shininess or
+/// metallic-roughness map's, as `phong_core::light` takes it), else the material's.
+#[inline(always)]
+pub(super) fn shade_shininess<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>, sv: Option<V>) -> Terms<V> {
     let zero = V::splat(0.0);
     let (v, v_ok) = match p.view {
         View::Local { eye } => V3::splat(eye).sub(pos).normalize_or_zero(),
@@ -356,6 +394,10 @@ pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
     let o = &p.options;
     let s = p.shininess;
     let normalized = o.normalization != Normalization::None;
+    let ks = match sv {
+        Some(sv) => specular_factor(o.normalization, sv),
+        None => V::splat(p.ks),
+    };
     let mut amb = [V::splat(p.base.r), V::splat(p.base.g), V::splat(p.base.b)];
     let mut dif = [zero; 3];
     let mut spe = [zero; 3];
@@ -404,11 +446,11 @@ pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
             SpecularModel::None => zero,
             SpecularModel::Phong => {
                 let r = n.scale(ndotl.add(ndotl)).sub(l);
-                pow_positive(r.dot(v), s)
+                pow_lanes(r.dot(v), s, sv)
             }
             SpecularModel::BlinnPhong => {
                 let (h, h_ok) = l.add(v).normalize_or_zero();
-                V::select(h_ok, pow_positive(n.dot(h), s), zero)
+                V::select(h_ok, pow_lanes(n.dot(h), s, sv), zero)
             }
             SpecularModel::Lyon { squarings, lambda } => {
                 let r = n.scale(ndotl.add(ndotl)).sub(l);
@@ -422,10 +464,11 @@ pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
                 };
                 // Lyon's squarings per lane (a rarely used model: not worth a vector form).
                 let (rv, lam) = (rv.to_array(), lam.to_array());
+                let ss = sv.unwrap_or(V::splat(s)).to_array();
                 let mut out = V::A::default();
                 for (i, o) in out.as_mut().iter_mut().enumerate() {
                     if rv.as_ref()[i] > 0.0 {
-                        *o = phong_core::lyon(lam.as_ref()[i].max(0.0), s, squarings);
+                        *o = phong_core::lyon(lam.as_ref()[i].max(0.0), ss.as_ref()[i], squarings);
                     }
                 }
                 V::from_array(out)
@@ -434,7 +477,7 @@ pub(super) fn shade<V: Vf32>(p: &Prepared, pos: V3<V>, nrm: V3<V>) -> Terms<V> {
         if normalized {
             sf = sf.mul(ndotl.max(zero));
         }
-        let fs = factor.mul(V::splat(p.ks)).mul(sf);
+        let fs = factor.mul(ks).mul(sf);
         let on = V::and(spec_on, sf.gt(zero));
         acc(&mut spe, light.spe, fs, on);
     }

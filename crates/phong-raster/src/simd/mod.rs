@@ -111,7 +111,7 @@ pub fn shade_batch_lit<'p>(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn shade_batch_textured_avx2<'p>(
+fn shade_batch_textured_avx2<'p, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     n: usize,
@@ -119,7 +119,7 @@ fn shade_batch_textured_avx2<'p>(
     out: impl FnMut(usize, [f32; 3]),
     unsampled: &mut Vec<Unsampled<usize>>,
 ) {
-    sampler::shade_batch_textured::<vector::Avx2x2>(prep, maps, n, lane, out, unsampled)
+    sampler::shade_batch_textured::<vector::Avx2x2, FULL>(prep, maps, n, lane, out, unsampled)
 }
 
 /// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
@@ -139,16 +139,26 @@ pub fn shade_batch_textured<'p>(
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        unsafe { shade_batch_textured_avx2(prep, maps, n, lane, out, unsampled) };
+        unsafe {
+            if maps.full() {
+                shade_batch_textured_avx2::<true>(prep, maps, n, lane, out, unsampled)
+            } else {
+                shade_batch_textured_avx2::<false>(prep, maps, n, lane, out, unsampled)
+            }
+        };
         return;
     }
     let _ = isa;
-    sampler::shade_batch_textured::<vector::Portable>(prep, maps, n, lane, out, unsampled)
+    if maps.full() {
+        sampler::shade_batch_textured::<vector::Portable, true>(prep, maps, n, lane, out, unsampled)
+    } else {
+        sampler::shade_batch_textured::<vector::Portable, false>(prep, maps, n, lane, out, unsampled)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn shade_group_textured_avx2(
+fn shade_group_textured_avx2<const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     planes: (&Planes, &Planes),
@@ -157,7 +167,7 @@ fn shade_group_textured_avx2(
     out: impl FnMut(u32, [f32; 3]),
     unsampled: &mut Vec<Unsampled<u32>>,
 ) -> usize {
-    sampler::shade_group_textured::<vector::Avx2x2>(prep, maps, planes, origin, pixels, out, unsampled)
+    sampler::shade_group_textured::<vector::Avx2x2, FULL>(prep, maps, planes, origin, pixels, out, unsampled)
 }
 
 /// [`shade_batch_textured`] for the pixels of one triangle, its planes and its coordinates'
@@ -176,10 +186,20 @@ pub fn shade_group_textured(
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        return unsafe { shade_group_textured_avx2(prep, maps, planes, origin, pixels, out, unsampled) };
+        return unsafe {
+            if maps.full() {
+                shade_group_textured_avx2::<true>(prep, maps, planes, origin, pixels, out, unsampled)
+            } else {
+                shade_group_textured_avx2::<false>(prep, maps, planes, origin, pixels, out, unsampled)
+            }
+        };
     }
     let _ = isa;
-    sampler::shade_group_textured::<vector::Portable>(prep, maps, planes, origin, pixels, out, unsampled)
+    if maps.full() {
+        sampler::shade_group_textured::<vector::Portable, true>(prep, maps, planes, origin, pixels, out, unsampled)
+    } else {
+        sampler::shade_group_textured::<vector::Portable, false>(prep, maps, planes, origin, pixels, out, unsampled)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -1,21 +1,23 @@
-//! The vector texture sampler: a textured object's diffuse and specular maps sampled for a
-//! whole vector of pixels at once, as `phong_core::Texture::sample` samples one (bilinear in a
-//! level, the two levels of `GL_LINEAR_MIPMAP_LINEAR` blended, repeat/clamp/mirror wrap), the
-//! texels of every lane fetched by gathers, one per corner and level
-//! ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
+//! The vector texture sampler: a textured object's maps sampled for a whole vector of pixels
+//! at once, as `phong_core::Texture::sample` samples one (bilinear in a level, the two levels
+//! of `GL_LINEAR_MIPMAP_LINEAR` blended, repeat/clamp/mirror wrap), the texels of every lane
+//! fetched by gathers, one per corner and level ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]).
 //!
 //! It covers the common cases, decided once per draw ([`VectorMaps::new`]): diffuse, specular,
-//! ambient, emission, occlusion and normal maps (bump maps are normal maps by then), 8 or 16
-//! bits, linear filters, on either set of texture coordinates, vertex colours or not (not with
-//! a second set; a normal map with neither: its tangents take their planes). A vector whose
-//! coordinates are too large for exact `f32` wrapping (or NaN) is left to the caller's
-//! per-pixel sampler, lit (a normal map's texels for such a vector are sampled per lane here).
+//! ambient, emission, occlusion, normal, shininess (not from the alpha channel) and glTF
+//! metallic-roughness maps (bump maps are normal maps by then), 8 or 16 bits, linear filters,
+//! on either set of texture coordinates, vertex colours or not (not with a second set; a
+//! normal map with neither: its tangents take their planes). A vector whose coordinates are
+//! too large for exact `f32` wrapping (or NaN) is left to the caller's per-pixel sampler, lit
+//! (the texels that change the light itself, normal, shininess and metallic-roughness, are
+//! sampled per lane here for such a vector).
 
 use super::kernel::{
     Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal, shade,
+    shade_shininess,
 };
 use super::vector::{Portable, Vf32};
-use phong_core::{Filter, Maps, MipFilter, NormalMap, TextureMap, UvTransform, Wrap};
+use phong_core::{Channel, Filter, Maps, MetalRough, MipFilter, NormalMap, TextureMap, UvTransform, Wrap};
 
 /// The most mipmap levels (a 16384 side has 15).
 const MAX_LEVELS: usize = 16;
@@ -94,6 +96,11 @@ pub struct VectorMaps<'a> {
     /// A tangent-space normal map: its levels, and the map for lanes the vector wrap cannot
     /// take. The tangents' planes are the coordinates' planes' `attr[2..6]`.
     normal: Option<(VectorMap<'a>, &'a NormalMap)>,
+    /// A shininess map (its channel red, green, blue or luminance), and the map for lanes the
+    /// vector wrap cannot take.
+    shininess: Option<(VectorMap<'a>, Channel, &'a TextureMap)>,
+    /// glTF's metallic-roughness map (`phong_core::MetalRough`), and the same for such lanes.
+    metal_rough: Option<(VectorMap<'a>, &'a MetalRough)>,
     /// Vertex colours multiply the diffuse texel (`Texels::tinted`).
     tinted: bool,
     /// A map reads the second set of coordinates (never with `tinted`: they share planes).
@@ -120,13 +127,15 @@ impl<'a> VectorMaps<'a> {
             alpha_cutoff: _,
             blend: _,
         } = maps;
-        let others = shininess.is_some() || alpha.is_some() || metal_rough.is_some();
+        let others = alpha.is_some() || shininess.as_ref().is_some_and(|(_, c)| *c == Channel::A);
         let none = diffuse.is_none()
             && specular.is_none()
             && ambient.is_none()
             && emission.is_none()
             && occlusion.is_none()
-            && normal.is_none();
+            && normal.is_none()
+            && shininess.is_none()
+            && metal_rough.is_none();
         if others || none {
             return None;
         }
@@ -148,6 +157,14 @@ impl<'a> VectorMaps<'a> {
                     Some(n) => Some((VectorMap::of(&n.map)?, n)),
                     None => None,
                 },
+                shininess: match shininess {
+                    Some((m, c)) => Some((VectorMap::of(m)?, *c, m)),
+                    None => None,
+                },
+                metal_rough: match metal_rough {
+                    Some(mr) => Some((VectorMap::of(&mr.map)?, mr)),
+                    None => None,
+                },
                 tinted: false,
                 second: false,
             }
@@ -156,9 +173,15 @@ impl<'a> VectorMaps<'a> {
     }
 
     /// Whether the sampler's general form is needed: a split light ([`VectorMaps::split`]), a
-    /// map on the second set or a normal map.
-    fn full(&self) -> bool {
-        self.split() || self.second || self.normal.is_some()
+    /// map on the second set, or a map that changes the light (normal, shininess,
+    /// metallic-roughness).
+    pub(crate) fn full(&self) -> bool {
+        self.split() || self.second || self.changes_light()
+    }
+
+    /// Whether a map is sampled before the light: it tilts the normal or sets the shininess.
+    fn changes_light(&self) -> bool {
+        self.normal.is_some() || self.shininess.is_some() || self.metal_rough.is_some()
     }
 
     /// Whether the ambient or emission terms have maps of their own (see
@@ -187,7 +210,13 @@ impl<'a> VectorMaps<'a> {
         let maps = [self.diffuse, self.specular, self.ambient, self.emission];
         let occlusion = self.occlusion.map(|(m, _)| m);
         let normal = self.normal.map(|(m, _)| m);
-        let second = maps.iter().chain([&occlusion, &normal]).flatten().any(|m| m.second);
+        let shininess = self.shininess.map(|(m, ..)| m);
+        let metal_rough = self.metal_rough.map(|(m, _)| m);
+        let second = maps
+            .iter()
+            .chain([&occlusion, &normal, &shininess, &metal_rough])
+            .flatten()
+            .any(|m| m.second);
         VectorMaps { second, ..self }
     }
 
@@ -504,11 +533,65 @@ fn tilted<V: Sampling, const FULL: bool>(
         let i = 11 + 3 * c;
         *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
     }
-    let texel = match mapped_set::<V, FULL>(map, uv, uv1) {
-        Some(texel) => texel,
-        None => normal_texels_per_lane(source, if map.second { uv1 } else { uv }),
-    };
+    let texel = texels_or_per_lane::<V, FULL>(map, &source.map, uv, uv1);
     perturb(nrm, t, tangent_space(source, texel))
+}
+
+/// `map`'s RGB (`[0, 1]`) at its set's coordinates: by the vector sampler, or for a vector it
+/// cannot wrap, each lane by `phong_core::TextureMap::sample` (`source`, the same map), so that
+/// the light that such a vector is handed back with is right.
+#[inline(always)]
+fn texels_or_per_lane<V: Sampling, const FULL: bool>(
+    map: &VectorMap,
+    source: &TextureMap,
+    uv: [V; 6],
+    uv1: [V; 6],
+) -> [V; 3] {
+    match mapped_set::<V, FULL>(map, uv, uv1) {
+        Some(texel) => texel,
+        None => texels_per_lane(source, if map.second { uv1 } else { uv }),
+    }
+}
+
+/// The shininess per lane where a shininess or metallic-roughness map sets it, as
+/// `phong_core::Maps::sample_sets` and `phong_core::light` take it: the material's times the
+/// map's factor (at least 0), the metallic-roughness map's `MetalRough::shininess` of its
+/// roughness overriding a shininess map's. With the metallic-roughness map's texel, which
+/// also sets the diffuse and specular texels.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn shininess_lanes<V: Sampling, const FULL: bool>(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    (uv, uv1): ([V; 6], [V; 6]),
+) -> (Option<V>, Option<[V; 3]>) {
+    let zero = V::splat(0.0);
+    if let Some((map, source)) = &maps.metal_rough {
+        let t = texels_or_per_lane::<V, FULL>(map, &source.map, uv, uv1);
+        let r = V::splat(source.roughness).mul(t[1]).max(zero).min(V::splat(1.0));
+        let a = r.mul(r);
+        let a2 = a.mul(a);
+        let max = V::splat(MetalRough::MAX_SHININESS);
+        // 2/α² − 2; α² this small maps past the largest shininess (and 1/α² may not be finite).
+        let s = V::splat(2.0).mul(a2.recip()).sub(V::splat(2.0)).max(zero).min(max);
+        let s = V::select(a2.gt(V::splat(1e-12)), s, max);
+        return (Some(V::splat(prep.shininess).mul(s)), Some(t));
+    }
+    let Some((map, channel, source)) = &maps.shininess else {
+        return (None, None);
+    };
+    let t = texels_or_per_lane::<V, FULL>(map, source, uv, uv1);
+    let f = match channel {
+        // (The alpha channel is not gathered: `VectorMaps::new` leaves such maps per pixel.)
+        Channel::R | Channel::A => t[0],
+        Channel::G => t[1],
+        Channel::B => t[2],
+        Channel::Luminance => V::splat(0.2126)
+            .mul(t[0])
+            .add(V::splat(0.7152).mul(t[1]))
+            .add(V::splat(0.0722).mul(t[2])),
+    };
+    (Some(V::splat(prep.shininess).mul(f.max(zero))), None)
 }
 
 /// A normal map's tangent-space normals from its texels (`[0, 1]`), as `phong_core::Maps`
@@ -524,16 +607,15 @@ fn tangent_space<V: Vf32>(map: &NormalMap, t: [V; 3]) -> [V; 3] {
     ]
 }
 
-/// A normal map's texels for lanes whose coordinates `uv` (the map's set) the vector wrap
-/// cannot take: each sampled by `phong_core::TextureMap::sample` (rare: NaN, or past ±2^21
-/// texels).
+/// A map's RGB for lanes whose coordinates `uv` (the map's set) the vector wrap cannot take:
+/// each sampled by `phong_core::TextureMap::sample` (rare: NaN, or past ±2^21 texels).
 #[inline(never)]
-fn normal_texels_per_lane<V: Vf32>(map: &NormalMap, uv: [V; 6]) -> [V; 3] {
+fn texels_per_lane<V: Vf32>(map: &TextureMap, uv: [V; 6]) -> [V; 3] {
     let a = uv.map(V::to_array);
     let mut out = [V::A::default(); 3];
     for i in 0..V::N {
         let at = |k: usize| a[k].as_ref()[i];
-        let t = map.map.sample(
+        let t = map.sample(
             glam::Vec2::new(at(0), at(1)),
             glam::Vec2::new(at(2), at(3)),
             glam::Vec2::new(at(4), at(5)),
@@ -569,11 +651,13 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     // The common case lights first, then finds the coordinates, as before normal maps were
     // covered (BENCHMARKS.md, "Normal and bump maps on the fast path"); a normal map needs the
     // coordinates first.
-    let (lit, (uv, uv1, (dx, dy, rq))) = if FULL && maps.normal.is_some() {
+    let (lit, (uv, uv1, (dx, dy, rq)), mr) = if FULL && maps.changes_light() {
         let c = coordinates::<V, FULL>(maps, k, x, y);
-        (shade(prep, pos, tilted::<V, FULL>(maps, nrm, k, c)), c)
+        let nrm = tilted::<V, FULL>(maps, nrm, k, c);
+        let (sv, mr) = shininess_lanes::<V, FULL>(prep, maps, (c.0, c.1));
+        (shade_shininess(prep, pos, nrm, sv), c, mr)
     } else {
-        (shade(prep, pos, nrm), coordinates::<V, FULL>(maps, k, x, y))
+        (shade(prep, pos, nrm), coordinates::<V, FULL>(maps, k, x, y), None)
     };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive through the sampling, nor
@@ -647,6 +731,24 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
         }
     }
     let (td, ts, ta, te) = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten());
+    // A metallic-roughness texel's metalness `m` (its blue): `T_Kd·(1 − m)`, and the specular
+    // texel `0.04·(1 − m) + base⊗T_Kd·m` in the specular map's place (`Maps::sample_sets`).
+    let (td, ts) = match (FULL, mr, &maps.metal_rough) {
+        (true, Some(t), Some((_, source))) => {
+            let m = V::splat(source.metallic).mul(t[2]).max(zero).min(one);
+            let dielectric = one.sub(m);
+            let d = td.unwrap_or([one; 3]);
+            let base = source.base_factor;
+            let mut diffuse = [zero; 3];
+            let mut specular = [zero; 3];
+            for (c, b) in [base.r, base.g, base.b].into_iter().enumerate() {
+                diffuse[c] = d[c].mul(dielectric);
+                specular[c] = V::splat(b).mul(d[c]).mul(m).add(V::splat(0.04).mul(dielectric));
+            }
+            (Some(diffuse), Some(specular))
+        }
+        _ => (td, ts),
+    };
     // The occlusion's factor `1 + strength·(T.r − 1)`.
     let ao = match (ao.flatten(), &maps.occlusion) {
         (Some(r), Some((_, strength))) => Some(r.sub(one).mul_add(V::splat(*strength), one)),
@@ -727,7 +829,7 @@ fn emit<V: Vf32, I>(
 /// `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of its texture
 /// coordinates.
 #[inline(always)]
-pub(crate) fn shade_batch_textured<'p, V: Sampling>(
+pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     n: usize,
@@ -755,11 +857,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling>(
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
         let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
         let k = coefficients::<V>(&uv[..V::N], maps.rows());
-        let r = if maps.full() {
-            V::textured::<true>(prep, maps, q, (xs, ys), &k)
-        } else {
-            V::textured::<false>(prep, maps, q, (xs, ys), &k)
-        };
+        let r = V::textured::<FULL>(prep, maps, q, (xs, ys), &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
@@ -770,7 +868,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling>(
 /// column` from `origin`, `out(pixel, rgb)` takes each one's colour or `unsampled` its light.
 /// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline(always)]
-pub(crate) fn shade_group_textured<V: Sampling>(
+pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     (planes, uv): (&Planes, &Planes),
@@ -788,11 +886,7 @@ pub(crate) fn shade_group_textured<V: Sampling>(
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
         let q = planes.at(x, y, 6);
-        let r = if maps.full() {
-            V::textured::<true>(prep, maps, q, (x, y), &k)
-        } else {
-            V::textured::<false>(prep, maps, q, (x, y), &k)
-        };
+        let r = V::textured::<FULL>(prep, maps, q, (x, y), &k);
         emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
     }
     full
