@@ -33,7 +33,10 @@ pub(crate) enum Mode {
     /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
     /// of its texture coordinates (maps that change the light, normal, shininess and
     /// metallic-roughness maps, need the vector sampler: without it they are [`Mode::Scalar`]'s).
-    Textured(Prepared),
+    /// With `per_vertex` (Gouraud, always with the vector sampler), the vertices are lit into
+    /// primary and specular colours, which the triangle's planes carry instead of position and
+    /// normal.
+    Textured { prep: Prepared, per_vertex: bool },
     /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
     /// depth outputs).
     Scalar,
@@ -45,7 +48,7 @@ impl Mode {
         match self {
             Mode::Phong(prep, term) => Some(Batch::Phong(prep, *term)),
             Mode::Gouraud => Some(Batch::Gouraud),
-            Mode::Textured(_) | Mode::Scalar => None,
+            Mode::Textured { .. } | Mode::Scalar => None,
         }
     }
 }
@@ -131,19 +134,30 @@ impl<'a> Frame<'a> {
                         || (second_set && colors)
                         || (m.normal.is_some() && (second_set || colors));
                     let one_sample = scene.image.samples == phong_core::Samples::One;
-                    if o.shading.interpolation == Interpolation::Phong
-                        && term == Term::Color
-                        && one_sample
-                        && !per_pixel_light
-                    {
-                        let prep = Prepared::new(&scene.lighting, &o.material, &o.shading.options, view);
-                        return Mode::Textured(if split {
-                            prep.emission_apart(&scene.lighting, &o.material)
-                        } else {
-                            prep
-                        });
+                    if term != Term::Color || !one_sample {
+                        return Mode::Scalar;
                     }
-                    return Mode::Scalar;
+                    let prep = Prepared::new(&scene.lighting, &o.material, &o.shading.options, view);
+                    return match o.shading.interpolation {
+                        Interpolation::Phong if !per_pixel_light => Mode::Textured {
+                            prep: if split {
+                                prep.emission_apart(&scene.lighting, &o.material)
+                            } else {
+                                prep
+                            },
+                            per_vertex: false,
+                        },
+                        // Gouraud: only the diffuse and specular maps apply, by the sampler
+                        // (`VectorMaps::lit_per_vertex`); the second set takes the colours'
+                        // planes.
+                        Interpolation::Gouraud
+                            if !(second_set && colors)
+                                && VectorMaps::new(m).and_then(VectorMaps::lit_per_vertex).is_some() =>
+                        {
+                            Mode::Textured { prep, per_vertex: true }
+                        }
+                        _ => Mode::Scalar,
+                    };
                 }
                 match o.shading.interpolation {
                     Interpolation::Phong => Mode::Phong(
@@ -168,7 +182,9 @@ impl<'a> Frame<'a> {
                 .iter()
                 .zip(&modes)
                 .map(|(o, m)| match m {
-                    Mode::Textured(_) => VectorMaps::new(&o.maps).map(|v| v.tinted(!o.mesh.colors().is_empty())),
+                    Mode::Textured { per_vertex, .. } => VectorMaps::new(&o.maps)
+                        .and_then(|v| if *per_vertex { v.lit_per_vertex() } else { Some(v) })
+                        .map(|v| v.tinted(!o.mesh.colors().is_empty())),
                     _ => None,
                 })
                 .collect(),
@@ -178,7 +194,7 @@ impl<'a> Frame<'a> {
                 .zip(&modes)
                 .zip(&second_sets)
                 .map(|((o, mode), &second)| match mode {
-                    Mode::Textured(_) if o.maps.normal.is_some() => Extra::Tangents,
+                    Mode::Textured { per_vertex: false, .. } if o.maps.normal.is_some() => Extra::Tangents,
                     _ if second => Extra::SecondSet,
                     _ => Extra::Colors,
                 })
@@ -362,7 +378,7 @@ material = { base = "brass", ambient_map = "assets/checker.png", filter = "neare
         scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
         for i in [0, 1, 3, 4] {
-            assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
+            assert!(matches!(frame.modes[i], Mode::Textured { .. }), "object {i}");
             assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
         }
         assert!(matches!(frame.modes[2], Mode::Scalar));
@@ -407,17 +423,70 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
         for i in [0, 1] {
-            assert!(matches!(frame.modes[i], Mode::Textured(_)), "object {i}");
+            assert!(matches!(frame.modes[i], Mode::Textured { .. }), "object {i}");
             assert!(frame.vector_maps[i].is_some(), "object {i}");
             assert_eq!(frame.extras[i], Extra::Tangents, "object {i}");
         }
         assert!(matches!(frame.modes[2], Mode::Scalar));
-        assert!(matches!(frame.modes[3], Mode::Textured(_)));
+        assert!(matches!(frame.modes[3], Mode::Textured { .. }));
         assert_eq!(frame.extras[3], Extra::Colors);
         assert!(matches!(frame.modes[4], Mode::Scalar));
         assert_eq!(frame.extras[4], Extra::SecondSet);
-        assert!(matches!(frame.modes[5], Mode::Textured(_)));
+        assert!(matches!(frame.modes[5], Mode::Textured { .. }));
         assert!(frame.vector_maps[5].is_some());
         assert!(matches!(frame.modes[6], Mode::Scalar));
+    }
+
+    /// A Gouraud-shaded textured object is drawn by the vector sampler from its vertices'
+    /// primary and specular colours (only its diffuse and specular maps apply, so its other
+    /// maps do not matter, nor does their filter); with a metallic-roughness map, vertex colours
+    /// beside a second set, or flat shading, it is shaded per pixel.
+    #[test]
+    fn gouraud_textured_objects_take_the_vector_sampler() {
+        let src = r#"
+[shading]
+interpolation = "gouraud"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+material = { base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/checker.png" }
+[[object]]
+shape = "torus"
+material = { base = "brass", diffuse_map = "assets/bricks.png", emission_map = "assets/checker.png", bump_map = "assets/bricks_height.png" }
+[[object]]
+shape = "sphere"
+interpolation = "flat"
+material = { base = "brass", diffuse_map = "assets/bricks.png" }
+"#;
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/gouraud.toml");
+        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        // glTF's metallic-roughness map on a copy of the first sphere.
+        let mut o = scene.objects[0].clone();
+        let map = o.maps.diffuse.clone().unwrap();
+        o.maps.metal_rough = Some(phong_core::MetalRough {
+            map,
+            base_factor: phong_core::Color::WHITE,
+            metallic: 1.0,
+            roughness: 0.5,
+        });
+        scene.objects.push(o);
+        let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+        for i in [0, 1] {
+            assert!(
+                matches!(frame.modes[i], Mode::Textured { per_vertex: true, .. }),
+                "object {i}"
+            );
+            let maps = frame.vector_maps[i].expect("covered");
+            assert!(maps.per_vertex() && !maps.split() && !maps.full(), "object {i}");
+        }
+        assert_eq!(
+            frame.extras[1],
+            Extra::Colors,
+            "no tangents: the normal map does not apply"
+        );
+        assert!(matches!(frame.modes[2], Mode::Scalar));
+        assert!(matches!(frame.modes[3], Mode::Scalar));
     }
 }

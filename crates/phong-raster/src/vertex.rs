@@ -3,7 +3,7 @@
 
 use crate::clip::{NOT_FINITE, OUTSIDE_CLIP, outcode};
 use crate::fixed::{ONE, round_i64};
-use crate::simd::{Isa, Prepared, Term, light_vertices, project_vertices};
+use crate::simd::{Isa, Prepared, Term, light_vertices, light_vertices_lit, project_vertices};
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -78,39 +78,57 @@ pub(crate) fn fast_vertices(
 }
 
 /// Gouraud's vertex lighting of one object: the kernel's term at each vertex, seen from the
-/// front and (two-sided) from the back. A vertex lit alone or among others gives the same
-/// bits (the kernel's lanes are independent).
+/// front and (two-sided) from the back; for a textured object, its primary and specular
+/// colours (`phong_core::Lit`), which the texels modulate per pixel. A vertex lit alone or
+/// among others gives the same bits (the kernel's lanes are independent).
 pub(crate) struct VertexLighting {
     pub isa: Isa,
     pub prepared: Prepared,
     pub term: Term,
     pub two_sided: bool,
+    /// Textured: the primary and specular colours apart.
+    pub textured: bool,
 }
 
 impl VertexLighting {
     /// The colours of vertices `ps` with normals `ns`: `out[0]` from the front, `out[1]` from
-    /// the back (two-sided only).
-    pub fn light(&self, ps: &[Vec3], ns: &[Vec3], out: [&mut [Vec3]; 2]) {
+    /// the back (two-sided only); textured, those are the primary colours and `out[2]`,
+    /// `out[3]` the specular ones (else not written).
+    pub fn light(&self, ps: &[Vec3], ns: &[Vec3], out: [&mut [Vec3]; 4]) {
         let sides = if self.two_sided { 2 } else { 1 };
-        for (side, o) in out.into_iter().enumerate().take(sides) {
-            light_vertices(self.isa, &self.prepared, self.term, ps, ns, side == 1, o);
+        let [front, back, front_specular, back_specular] = out;
+        let sides_out = [[front, front_specular], [back, back_specular]];
+        for (side, [o, spec]) in sides_out.into_iter().enumerate().take(sides) {
+            if self.textured {
+                light_vertices_lit(self.isa, &self.prepared, ps, ns, side == 1, [o, spec]);
+            } else {
+                light_vertices(self.isa, &self.prepared, self.term, ps, ns, side == 1, o);
+            }
         }
     }
 
-    /// Lights, into `colors` (resized to the mesh; the other vertices keep what they held), the
-    /// vertices that `used` marks, by runs of 16-vertex groups with a used vertex, one kernel
-    /// call a run.
-    pub fn light_used(&self, positions: &[Vec3], normals: &[Vec3], used: &[AtomicBool], colors: &mut [Vec<Vec3>; 2]) {
-        let [front, back] = colors;
-        front.resize(positions.len(), Vec3::ZERO);
-        back.resize(if self.two_sided { positions.len() } else { 0 }, Vec3::ZERO);
-        let mut backs = back.chunks_mut(LIGHT_CHUNK);
+    /// Lights, into `colors` (as [`VertexLighting::light`]'s `out`, resized to the mesh; the
+    /// other vertices keep what they held), the vertices that `used` marks, by runs of
+    /// 16-vertex groups with a used vertex, one kernel call a run.
+    pub fn light_used(&self, positions: &[Vec3], normals: &[Vec3], used: &[AtomicBool], colors: &mut [Vec<Vec3>; 4]) {
+        let n = positions.len();
+        let lengths = [
+            n,
+            if self.two_sided { n } else { 0 },
+            if self.textured { n } else { 0 },
+            if self.textured && self.two_sided { n } else { 0 },
+        ];
+        for (c, len) in colors.iter_mut().zip(lengths) {
+            c.resize(len, Vec3::ZERO);
+        }
+        let [front, back, front_specular, back_specular] = colors;
+        let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
         let jobs: Vec<_> = front
             .chunks_mut(LIGHT_CHUNK)
-            .map(|f| (f, backs.next().unwrap_or_default()))
+            .map(|f| (f, others.each_mut().map(|o| o.next().unwrap_or_default())))
             .enumerate()
             .collect();
-        jobs.into_par_iter().for_each(|(j, (f, b))| {
+        jobs.into_par_iter().for_each(|(j, (f, mut o))| {
             let at = j * LIGHT_CHUNK;
             let range = at..at + f.len();
             let (ps, ns, us) = (&positions[range.clone()], &normals[range.clone()], &used[range]);
@@ -130,8 +148,10 @@ impl VertexLighting {
                     g += 1;
                 }
                 let run = start * LIGHT_GROUP..(g * LIGHT_GROUP).min(us.len());
-                let b = if b.is_empty() { &mut [][..] } else { &mut b[run.clone()] };
-                self.light(&ps[run.clone()], &ns[run.clone()], [&mut f[run], b]);
+                let [b, fs, bs] = o
+                    .each_mut()
+                    .map(|c| if c.is_empty() { &mut [][..] } else { &mut c[run.clone()] });
+                self.light(&ps[run.clone()], &ns[run.clone()], [&mut f[run], b, fs, bs]);
             }
         });
     }

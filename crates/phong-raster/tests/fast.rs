@@ -891,3 +891,129 @@ material = { base = "pewter", shininess_map = "assets/checker.png", uv_scale = [
         assert_fast_matches_reference(&scene, &format!("clamp {clamp}"));
     }
 }
+
+/// Gouraud-shaded textured objects, which the vector sampler draws from the vertices' primary
+/// and specular colours in the triangles' planes: diffuse and specular maps, clamped (the
+/// `opengl` model) and not; ambient, emission and normal maps, which apply with per-pixel
+/// light only (ignored here, by both paths); two-sided lighting, a plane seen from behind; vertex
+/// colours; a map on the second set; planes across the near plane (clipped), one seen from
+/// behind; coordinates past
+/// the vector wrap (their pixels finished per pixel). The fast path within 1/255 of the
+/// reference (`frame::tests` checks that such objects take the vector sampler).
+#[test]
+fn fast_path_matches_reference_with_gouraud_textured_objects() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let dir = std::env::temp_dir().join(format!("phong-gouraud-maps-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tinted = dir.join("tinted.obj");
+    std::fs::write(
+        &tinted,
+        "v -1 -1 0 1 0.2 0.2\nv 1 -1 0 0.2 1 0.2\nv 1 1 0 0.2 0.2 1\nv -1 1 0 1 1 1\n\
+         vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    for model in ["opengl", "blinn-phong"] {
+        let src = format!(
+            r#"
+[image]
+width = 220
+height = 130
+[camera]
+position = [0.0, 0.0, 6.0]
+near = 0.5
+[shading]
+model = "{model}"
+interpolation = "gouraud"
+two_sided = true
+ambient = [0.3, 0.25, 0.2]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+color = [1.6, 1.5, 1.4]
+[[light]]
+type = "directional"
+direction = [1.0, -0.5, -1.0]
+color = [0.5, 0.5, 0.6]
+[[light]]
+type = "point"
+position = [-0.6, -0.3, 5.8]
+color = [0.6, 0.6, 0.4]
+[[object]]
+shape = "sphere"
+segments = 24
+position = [-2.2, 0.8, 0.0]
+material = {{ base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/bricks_specular.png", uv_scale = [2.0, 1.0] }}
+[[object]]
+shape = "torus"
+position = [0.0, 0.8, 0.0]
+rotation = [60.0, 0.0, 0.0]
+material = {{ base = "jade", emission = [0.3, 0.2, 0.1], diffuse_map = "assets/checker.png", ambient_map = "assets/bricks.png", emission_map = "assets/bricks_specular.png", bump_map = "assets/bricks_height.png", wrap = "mirror" }}
+[[object]]
+shape = "plane"
+position = [2.2, 0.8, 0.0]
+scale = 0.9
+rotation = [-100.0, 20.0, 0.0]
+material = {{ base = "ruby", diffuse_map = "assets/bricks.png", filter = "bilinear" }}
+[[object]]
+mesh = "{tinted}"
+position = [-2.0, -1.2, 0.5]
+scale = 0.6
+rotation = [0.0, 30.0, 0.0]
+material = {{ base = "pearl", diffuse_map = "assets/bricks.png" }}
+[[object]]
+shape = "teapot"
+position = [0.3, -1.5, 0.0]
+scale = 0.6
+material = {{ base = "gold", specular_map = "assets/checker.png" }}
+[[object]]
+shape = "plane"
+position = [0.0, -2.2, 3.0]
+scale = 4.0
+rotation = [10.0, 0.0, 0.0]
+material = {{ base = "pewter", diffuse_map = "assets/checker.png", uv_scale = [6.0, 6.0] }}
+[[object]]
+shape = "plane"
+position = [0.0, 2.4, 3.0]
+scale = 4.0
+rotation = [-10.0, 0.0, 0.0]
+segments = 8
+material = {{ base = "emerald", shininess = 3.0, diffuse_map = "assets/bricks.png", specular_map = "assets/checker.png", uv_scale = [4.0, 4.0] }}
+[[object]]
+shape = "plane"
+segments = 4
+position = [0.25, -0.1, 5.2]
+scale = [0.15, 1.0, 1.6]
+rotation = [0.0, 0.0, -90.0]
+material = {{ base = "cyan plastic", shininess = 3.0, diffuse_map = "assets/checker.png", specular_map = "assets/bricks.png" }}
+[[object]]
+shape = "plane"
+position = [2.8, -1.0, 1.0]
+scale = 0.5
+rotation = [70.0, 0.0, 0.0]
+material = {{ base = "chrome", emission = [0.3, 0.2, 0.1], diffuse_map = "assets/checker.png", emission_map = "assets/bricks.png", uv_scale = [3.0e5, 3.0e5] }}
+"#,
+            tinted = tinted.display()
+        );
+        let mut scene = phong_scene::parse_scene(&src, &root.join("gouraud.toml"))
+            .unwrap()
+            .scene;
+        // A map on the second set: the torus's coordinates turned a quarter and doubled.
+        let o = &mut scene.objects[1];
+        let uvs1: Vec<glam::Vec2> = o.mesh.uvs().iter().map(|t| glam::Vec2::new(t.y, t.x) * 2.0).collect();
+        o.mesh = o.mesh.clone().with_uvs1(uvs1).unwrap();
+        o.maps.diffuse.as_mut().unwrap().set = 1;
+        assert!(
+            scene
+                .objects
+                .iter()
+                .all(|o| o.textured() && o.shading.interpolation == Interpolation::Gouraud)
+        );
+        assert!(scene.objects[1].maps.normal.is_some() && scene.objects[1].maps.emission.is_some());
+        assert!(
+            !scene.objects[3].mesh.colors().is_empty(),
+            "the quad has vertex colours"
+        );
+        assert_fast_matches_reference(&scene, model);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

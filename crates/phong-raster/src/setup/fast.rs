@@ -41,8 +41,9 @@ impl Frame<'_> {
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
             .for_each(|(out, ps)| fast_vertices(self.isa, clip_from_world, (self.w, self.h), ps, out));
-        let gouraud = matches!(self.modes[oi], Mode::Gouraud);
-        let textured = matches!(self.modes[oi], Mode::Textured(_));
+        // Lit per vertex (Gouraud, textured or not), and textured.
+        let gouraud = matches!(self.modes[oi], Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
+        let textured = matches!(self.modes[oi], Mode::Textured { .. });
         let uvs = mesh.uvs();
         let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
         let colors = mesh.colors();
@@ -63,6 +64,7 @@ impl Frame<'_> {
             ),
             term: lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
             two_sided,
+            textured,
         });
         let used = &mut scratch.used;
         if gouraud {
@@ -109,22 +111,21 @@ impl Frame<'_> {
                             });
                         } else {
                             out.planes.push(phong_planes(&s, tri));
-                            if textured {
-                                let idx = each3(|k| tri[s.order[k]]);
-                                out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of)));
-                            }
+                        }
+                        if textured {
+                            let idx = each3(|k| tri[s.order[k]]);
+                            out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of)));
                         }
                         out.tris.push(s.tri);
                     }
                     continue;
                 }
                 // Rare: clip, with the vertices in full (Gouraud: lit here).
-                let mut lit3 = [[Vec3::ZERO; 3]; 2];
+                let mut lit3 = [[Vec3::ZERO; 3]; 4];
                 if let Some(lighting) = &lighting {
                     let ps = tri.map(|i| positions[i as usize]);
                     let ns = tri.map(|i| normals[i as usize]);
-                    let [front, back] = &mut lit3;
-                    lighting.light(&ps, &ns, [front, back]);
+                    lighting.light(&ps, &ns, lit3.each_mut().map(|c| &mut c[..]));
                 }
                 let t = each3(|k| {
                     let i = tri[k] as usize;
@@ -134,7 +135,7 @@ impl Frame<'_> {
                         normal: normals[i],
                         color: lit3[0][k],
                         color_back: lit3[1][k],
-                        spec: [Vec3::ZERO; 2],
+                        spec: [lit3[2][k], lit3[3][k]],
                         uv: uv_of(tri[k]),
                         uv1: uv1_of(tri[k]),
                         rgb: rgb_of(tri[k]),
@@ -147,8 +148,8 @@ impl Frame<'_> {
                             out.clipped.push((out.tris.len() as u32, p));
                         } else {
                             out.planes.push(p);
-                            out.uv.extend(uv);
                         }
+                        out.uv.extend(uv);
                         out.tris.push(tri);
                     }
                 };
@@ -189,14 +190,21 @@ impl Frame<'_> {
                         // Twice the area: the cross product of edges 2 (vertex 0 to 1) and 1
                         // (vertex 2 to 0), as `setup_edges` computed it up to the sign.
                         let area = (t.a(1) * t.b(2) - t.a(2) * t.b(1)).unsigned_abs();
-                        let c = each3(|k| colors[usize::from(t.back)][p.idx[k] as usize]);
+                        let side = usize::from(t.back);
+                        let c = each3(|k| colors[side][p.idx[k] as usize]);
+                        // Textured: the specular colours too (`VertexLighting::light`).
+                        let s = if textured {
+                            each3(|k| colors[2 + side][p.idx[k] as usize])
+                        } else {
+                            [Vec3::ZERO; 3]
+                        };
                         plane_equations(
                             (i64::from(v[0].0), i64::from(v[0].1)),
                             t,
                             area,
                             [v[0].3, v[1].3, v[2].3],
-                            [c, [Vec3::ZERO; 3]],
-                            true,
+                            [c, s],
+                            !textured,
                         )
                     } else {
                         let c = clipped.next();

@@ -164,10 +164,11 @@ pub(crate) struct Pending {
 pub(crate) struct Scratch {
     /// The fast setup's per-vertex records (one object at a time).
     pub vertices: Vec<FastVertex>,
-    /// Gouraud: the lit colour of each vertex seen from the front, and (two-sided) the back;
-    /// kept between frames without clearing (only the vertices of drawn triangles are lit
-    /// and read).
-    pub colors: [Vec<Vec3>; 2],
+    /// Gouraud: the lit colour of each vertex seen from the front, and (two-sided) the back
+    /// (a textured object's primary colours, then its specular ones: see
+    /// `VertexLighting::light`); kept between frames without clearing (only the vertices of
+    /// drawn triangles are lit and read).
+    pub colors: [Vec<Vec3>; 4],
     /// Gouraud: whether a vertex is used by a drawn triangle (only those are lit).
     pub used: Vec<AtomicBool>,
     /// Chunks of set-up triangles, emptied, for the next frame's setup tasks.
@@ -376,10 +377,10 @@ impl Frame<'_> {
         let mode = &self.modes[object as usize];
         let extra = self.extras[object as usize];
         let extra = |v: &ClipVertex| extra.of(v.rgb, v.uv1, v.tangent);
-        let uv = matches!(mode, Mode::Textured(_)).then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra)));
+        let uv = matches!(mode, Mode::Textured { .. }).then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra)));
         let planes = match mode {
             Mode::Scalar => Planes::default(),
-            Mode::Phong(..) | Mode::Textured(_) => {
+            Mode::Phong(..) | Mode::Textured { per_vertex: false, .. } => {
                 let sign = if s.front { 1.0 } else { -1.0 };
                 let attrs = [v.map(|v| v.world), v.map(|v| v.normal * sign)];
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
@@ -387,6 +388,11 @@ impl Frame<'_> {
             Mode::Gouraud => {
                 let c = v.map(|v| if s.front { v.color } else { v.color_back });
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
+            }
+            Mode::Textured { per_vertex: true, .. } => {
+                let side = usize::from(!s.front);
+                let c = v.map(|v| if s.front { v.color } else { v.color_back });
+                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, v.map(|v| v.spec[side])], false)
             }
         };
         Some((s.tri, planes, None, uv))

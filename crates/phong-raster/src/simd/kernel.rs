@@ -563,6 +563,55 @@ pub(crate) fn light_vertices<V: Vf32>(
     }
 }
 
+/// Gouraud's vertex lighting of a textured object: `primary[i]` and `specular[i]`, the
+/// [`phong_core::Lit`] at `positions[i]` with `normals[i]` (negated with `flip`): emission,
+/// ambient and diffuse, and the specular term, each clamped where the options clamp.
+pub(crate) fn light_vertices_lit<V: Vf32>(
+    p: &Prepared,
+    positions: &[Vec3],
+    normals: &[Vec3],
+    flip: bool,
+    [primary, specular]: [&mut [Vec3]; 2],
+) {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    for (((ps, ns), po), so) in positions
+        .chunks(V::N)
+        .zip(normals.chunks(V::N))
+        .zip(primary.chunks_mut(V::N))
+        .zip(specular.chunks_mut(V::N))
+    {
+        let m = ps.len();
+        let mut c = [V::A::default(); 6];
+        for i in 0..V::N {
+            let (pp, mut nn) = (ps[i.min(m - 1)], ns[i.min(m - 1)]);
+            if flip {
+                nn = -nn;
+            }
+            for (k, v) in [pp.x, pp.y, pp.z, nn.x, nn.y, nn.z].into_iter().enumerate() {
+                c[k].as_mut()[i] = v;
+            }
+        }
+        let [px, py, pz, nx, ny, nz] = c.map(V::from_array);
+        let t = shade(p, V3 { x: px, y: py, z: pz }, V3 { x: nx, y: ny, z: nz });
+        let mut lit = [[zero; 3]; 2];
+        for ch in 0..3 {
+            lit[0][ch] = t.ambient[ch].add(t.diffuse[ch]);
+            lit[1][ch] = t.specular[ch];
+            if p.options.clamp {
+                for l in &mut lit {
+                    l[ch] = l[ch].max(zero).min(one);
+                }
+            }
+        }
+        for (o, l) in [po, so].into_iter().zip(lit) {
+            let l = l.map(V::to_array);
+            for (i, o) in o.iter_mut().enumerate() {
+                *o = Vec3::new(l[0].as_ref()[i], l[1].as_ref()[i], l[2].as_ref()[i]);
+            }
+        }
+    }
+}
+
 /// `shade8` in the portable build (the AVX2 build is [`super::shade8`]).
 pub fn shade8(p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> Shaded8 {
     shade_points::<super::vector::Portable>(p, position, normal)

@@ -111,7 +111,7 @@ pub fn shade_batch_lit<'p>(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn shade_batch_textured_avx2<'p, const FULL: bool>(
+fn shade_batch_textured_avx2<'p, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     n: usize,
@@ -119,7 +119,7 @@ fn shade_batch_textured_avx2<'p, const FULL: bool>(
     out: impl FnMut(usize, [f32; 3]),
     unsampled: &mut Vec<Unsampled<usize>>,
 ) {
-    sampler::shade_batch_textured::<vector::Avx2x2, FULL>(prep, maps, n, lane, out, unsampled)
+    sampler::shade_batch_textured::<vector::Avx2x2, FULL, PER_VERTEX>(prep, maps, n, lane, out, unsampled)
 }
 
 /// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
@@ -140,25 +140,28 @@ pub fn shade_batch_textured<'p>(
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         unsafe {
-            if maps.full() {
-                shade_batch_textured_avx2::<true>(prep, maps, n, lane, out, unsampled)
-            } else {
-                shade_batch_textured_avx2::<false>(prep, maps, n, lane, out, unsampled)
+            match (maps.full(), maps.per_vertex()) {
+                (true, true) => shade_batch_textured_avx2::<true, true>(prep, maps, n, lane, out, unsampled),
+                (true, false) => shade_batch_textured_avx2::<true, false>(prep, maps, n, lane, out, unsampled),
+                (false, true) => shade_batch_textured_avx2::<false, true>(prep, maps, n, lane, out, unsampled),
+                (false, false) => shade_batch_textured_avx2::<false, false>(prep, maps, n, lane, out, unsampled),
             }
         };
         return;
     }
     let _ = isa;
-    if maps.full() {
-        sampler::shade_batch_textured::<vector::Portable, true>(prep, maps, n, lane, out, unsampled)
-    } else {
-        sampler::shade_batch_textured::<vector::Portable, false>(prep, maps, n, lane, out, unsampled)
+    type P = vector::Portable;
+    match (maps.full(), maps.per_vertex()) {
+        (true, true) => sampler::shade_batch_textured::<P, true, true>(prep, maps, n, lane, out, unsampled),
+        (true, false) => sampler::shade_batch_textured::<P, true, false>(prep, maps, n, lane, out, unsampled),
+        (false, true) => sampler::shade_batch_textured::<P, false, true>(prep, maps, n, lane, out, unsampled),
+        (false, false) => sampler::shade_batch_textured::<P, false, false>(prep, maps, n, lane, out, unsampled),
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn shade_group_textured_avx2<const FULL: bool>(
+fn shade_group_textured_avx2<const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     planes: (&Planes, &Planes),
@@ -167,7 +170,9 @@ fn shade_group_textured_avx2<const FULL: bool>(
     out: impl FnMut(u32, [f32; 3]),
     unsampled: &mut Vec<Unsampled<u32>>,
 ) -> usize {
-    sampler::shade_group_textured::<vector::Avx2x2, FULL>(prep, maps, planes, origin, pixels, out, unsampled)
+    sampler::shade_group_textured::<vector::Avx2x2, FULL, PER_VERTEX>(
+        prep, maps, planes, origin, pixels, out, unsampled,
+    )
 }
 
 /// [`shade_batch_textured`] for the pixels of one triangle, its planes and its coordinates'
@@ -187,18 +192,37 @@ pub fn shade_group_textured(
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         return unsafe {
-            if maps.full() {
-                shade_group_textured_avx2::<true>(prep, maps, planes, origin, pixels, out, unsampled)
-            } else {
-                shade_group_textured_avx2::<false>(prep, maps, planes, origin, pixels, out, unsampled)
+            match (maps.full(), maps.per_vertex()) {
+                (true, true) => {
+                    shade_group_textured_avx2::<true, true>(prep, maps, planes, origin, pixels, out, unsampled)
+                }
+                (true, false) => {
+                    shade_group_textured_avx2::<true, false>(prep, maps, planes, origin, pixels, out, unsampled)
+                }
+                (false, true) => {
+                    shade_group_textured_avx2::<false, true>(prep, maps, planes, origin, pixels, out, unsampled)
+                }
+                (false, false) => {
+                    shade_group_textured_avx2::<false, false>(prep, maps, planes, origin, pixels, out, unsampled)
+                }
             }
         };
     }
     let _ = isa;
-    if maps.full() {
-        sampler::shade_group_textured::<vector::Portable, true>(prep, maps, planes, origin, pixels, out, unsampled)
-    } else {
-        sampler::shade_group_textured::<vector::Portable, false>(prep, maps, planes, origin, pixels, out, unsampled)
+    type P = vector::Portable;
+    match (maps.full(), maps.per_vertex()) {
+        (true, true) => {
+            sampler::shade_group_textured::<P, true, true>(prep, maps, planes, origin, pixels, out, unsampled)
+        }
+        (true, false) => {
+            sampler::shade_group_textured::<P, true, false>(prep, maps, planes, origin, pixels, out, unsampled)
+        }
+        (false, true) => {
+            sampler::shade_group_textured::<P, false, true>(prep, maps, planes, origin, pixels, out, unsampled)
+        }
+        (false, false) => {
+            sampler::shade_group_textured::<P, false, false>(prep, maps, planes, origin, pixels, out, unsampled)
+        }
     }
 }
 
@@ -258,6 +282,34 @@ pub fn light_vertices(
     }
     let _ = isa;
     kernel::light_vertices::<vector::Portable>(p, term, positions, normals, flip, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn light_vertices_lit_avx2(p: &Prepared, positions: &[Vec3], normals: &[Vec3], flip: bool, out: [&mut [Vec3]; 2]) {
+    kernel::light_vertices_lit::<vector::Avx2x2>(p, positions, normals, flip, out)
+}
+
+/// Gouraud's vertex lighting of a textured object: `out[0][i]` its primary colour (emission,
+/// ambient and diffuse) and `out[1][i]` its specular colour at `positions[i]` with
+/// `normals[i]` (negated with `flip`), each clamped where the options clamp, as
+/// `phong_core::light` makes them (`pow` approximated as in `kernel.rs`).
+pub fn light_vertices_lit(
+    isa: Isa,
+    p: &Prepared,
+    positions: &[Vec3],
+    normals: &[Vec3],
+    flip: bool,
+    out: [&mut [Vec3]; 2],
+) {
+    assert!(positions.len() == normals.len() && out.iter().all(|o| o.len() == positions.len()));
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        return unsafe { light_vertices_lit_avx2(p, positions, normals, flip, out) };
+    }
+    let _ = isa;
+    kernel::light_vertices_lit::<vector::Portable>(p, positions, normals, flip, out)
 }
 
 /// The lanes of [`shade_group`]'s vectors: it shades whole vectors only.

@@ -105,6 +105,9 @@ pub struct VectorMaps<'a> {
     tinted: bool,
     /// A map reads the second set of coordinates (never with `tinted`: they share planes).
     second: bool,
+    /// Gouraud: the light was made per vertex, its primary and specular colours are the
+    /// triangle's planes (see [`VectorMaps::lit_per_vertex`]).
+    per_vertex: bool,
 }
 
 impl<'a> VectorMaps<'a> {
@@ -167,6 +170,7 @@ impl<'a> VectorMaps<'a> {
                 },
                 tinted: false,
                 second: false,
+                per_vertex: false,
             }
             .with_second(),
         )
@@ -177,6 +181,34 @@ impl<'a> VectorMaps<'a> {
     /// metallic-roughness).
     pub(crate) fn full(&self) -> bool {
         self.split() || self.second || self.changes_light()
+    }
+
+    /// These maps for a Gouraud-shaded object, whose light is made per vertex into a primary
+    /// and a specular colour that its planes carry: only the diffuse and specular maps apply
+    /// (the reference's `Lit::modulate` with no ambient terms apart; the others need per-pixel
+    /// light). `None` with a metallic-roughness map, which changes those two texels (such an
+    /// object is shaded per pixel).
+    pub fn lit_per_vertex(self) -> Option<VectorMaps<'a>> {
+        if self.metal_rough.is_some() {
+            return None;
+        }
+        Some(
+            VectorMaps {
+                ambient: None,
+                emission: None,
+                occlusion: None,
+                normal: None,
+                shininess: None,
+                per_vertex: true,
+                ..self
+            }
+            .with_second(),
+        )
+    }
+
+    /// Whether the light was made per vertex (see [`VectorMaps::lit_per_vertex`]).
+    pub(crate) fn per_vertex(&self) -> bool {
+        self.per_vertex
     }
 
     /// Whether a map is sampled before the light: it tilts the normal or sets the shininess.
@@ -239,7 +271,7 @@ pub(crate) trait Sampling: Vf32 {
     fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3];
     /// [`textured_lanes`].
     #[allow(clippy::type_complexity)]
-    fn textured<const FULL: bool>(
+    fn textured<const FULL: bool, const PER_VERTEX: bool>(
         prep: &Prepared,
         maps: &VectorMaps,
         q: [Self; 6],
@@ -257,14 +289,14 @@ macro_rules! sampling {
                 bilinear_lanes(map, level, u, v)
             }
             #[$inline]
-            fn textured<const FULL: bool>(
+            fn textured<const FULL: bool, const PER_VERTEX: bool>(
                 prep: &Prepared,
                 maps: &VectorMaps,
                 q: [Self; 6],
                 xy: (Self, Self),
                 k: &[Self; 24],
             ) -> Result<[Self; 3], [[Self; 3]; 3]> {
-                textured_lanes::<Self, FULL>(prep, maps, q, xy, k)
+                textured_lanes::<Self, FULL, PER_VERTEX>(prep, maps, q, xy, k)
             }
         }
     };
@@ -634,12 +666,13 @@ fn texels_per_lane<V: Vf32>(map: &TextureMap, uv: [V; 6]) -> [V; 3] {
 /// vector's coordinates could not be wrapped exactly (NaN, or beyond ±2^21 texels).
 pub type Unsampled<I> = (I, [[f32; 3]; 3]);
 
-/// One vector of pixels at centres `(x, y)`, with interpolated position and normal `q` and the
-/// coordinates' planes `k` ([`coefficients`]): lit, textured and combined; `Err`
-/// with the light where the sampler cannot wrap the coordinates exactly.
+/// One vector of pixels at centres `(x, y)`, with interpolated position and normal `q` (with
+/// `PER_VERTEX`, Gouraud's primary and specular colours) and the coordinates' planes `k`
+/// ([`coefficients`]): lit, textured and combined; `Err` with the light where the sampler
+/// cannot wrap the coordinates exactly.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn textured_lanes<V: Sampling, const FULL: bool>(
+fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     q: [V; 6],
@@ -650,44 +683,53 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     let (pos, nrm) = position_normal(q);
     // The common case lights first, then finds the coordinates, as before normal maps were
     // covered (BENCHMARKS.md, "Normal and bump maps on the fast path"); a normal map needs the
-    // coordinates first.
-    let (lit, (uv, uv1, (dx, dy, rq)), mr) = if FULL && maps.changes_light() {
+    // coordinates first. Gouraud's light is the planes' (`PER_VERTEX` is `maps.per_vertex()`).
+    let (lit, (uv, uv1, (dx, dy, rq)), mr) = if PER_VERTEX {
+        (None, coordinates::<V, FULL>(maps, k, x, y), None)
+    } else if FULL && maps.changes_light() {
         let c = coordinates::<V, FULL>(maps, k, x, y);
         let nrm = tilted::<V, FULL>(maps, nrm, k, c);
         let (sv, mr) = shininess_lanes::<V, FULL>(prep, maps, (c.0, c.1));
-        (shade_shininess(prep, pos, nrm, sv), c, mr)
+        (Some(shade_shininess(prep, pos, nrm, sv)), c, mr)
     } else {
-        (shade(prep, pos, nrm), coordinates::<V, FULL>(maps, k, x, y), None)
+        (Some(shade(prep, pos, nrm)), coordinates::<V, FULL>(maps, k, x, y), None)
     };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive through the sampling, nor
     // choose a set per map (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
     let split = FULL && maps.split();
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
-    let mut primary = [zero; 3];
-    let mut specular = [zero; 3];
-    for c in 0..3 {
-        // `phong_core::light`: P = D + e (no emission map) + A (no ambient map), where the
-        // light keeps `e` apart (split); else `lit.ambient` holds both.
-        let mut p = if split {
-            let mut p = lit.diffuse[c];
-            if maps.emission.is_none() {
-                p = p.add(V::splat(e[c]));
+    // Gouraud: the vertices' colours interpolated, clamped per vertex where the options clamp
+    // (`phong_core::light`), as the reference interpolates them.
+    let (mut primary, mut specular) = (q3(q, 0), q3(q, 3));
+    let ambient = match &lit {
+        Some(lit) => lit.ambient,
+        None => [zero; 3],
+    };
+    if let Some(lit) = &lit {
+        for c in 0..3 {
+            // `phong_core::light`: P = D + e (no emission map) + A (no ambient map), where the
+            // light keeps `e` apart (split); else `lit.ambient` holds both.
+            let mut p = if split {
+                let mut p = lit.diffuse[c];
+                if maps.emission.is_none() {
+                    p = p.add(V::splat(e[c]));
+                }
+                if !maps.ambient_apart() {
+                    p = p.add(lit.ambient[c]);
+                }
+                p
+            } else {
+                lit.ambient[c].add(lit.diffuse[c])
+            };
+            let mut s = lit.specular[c];
+            if prep.options.clamp {
+                p = p.max(zero).min(one);
+                s = s.max(zero).min(one);
             }
-            if !maps.ambient_apart() {
-                p = p.add(lit.ambient[c]);
-            }
-            p
-        } else {
-            lit.ambient[c].add(lit.diffuse[c])
-        };
-        let mut s = lit.specular[c];
-        if prep.options.clamp {
-            p = p.max(zero).min(one);
-            s = s.max(zero).min(one);
+            primary[c] = p;
+            specular[c] = s;
         }
-        primary[c] = p;
-        specular[c] = s;
     }
     // (Matches, not closures: see `modulo`.)
     #[allow(clippy::manual_map)]
@@ -720,7 +762,7 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
     };
     let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
     if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
-        return Err([primary, specular, if FULL { lit.ambient } else { [zero; 3] }]);
+        return Err([primary, specular, if FULL { ambient } else { [zero; 3] }]);
     }
     // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
     let mut tint = [one; 3];
@@ -780,7 +822,7 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
             if let Some(f) = ao {
                 ka = ka.mul(f);
             }
-            x = x.add(lit.ambient[c].mul(ka));
+            x = x.add(ambient[c].mul(ka));
         }
         let s = match ts {
             Some(t) => specular[c].mul(t[c]),
@@ -794,6 +836,12 @@ fn textured_lanes<V: Sampling, const FULL: bool>(
         rgb[c] = x;
     }
     Ok(rgb)
+}
+
+/// Lanes `k..k + 3` of `q`.
+#[inline(always)]
+fn q3<V: Copy>(q: [V; 6], k: usize) -> [V; 3] {
+    [q[k], q[k + 1], q[k + 2]]
 }
 
 /// Hands the first `m` lanes of a [`Sampling::textured`] result to `out(lane, rgb)`, or their light to
@@ -829,7 +877,7 @@ fn emit<V: Vf32, I>(
 /// `lane(i)` gives pixel `i`'s centre, its triangle's planes and the planes of its texture
 /// coordinates.
 #[inline(always)]
-pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool>(
+pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     n: usize,
@@ -857,7 +905,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool>(
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
         let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
         let k = coefficients::<V>(&uv[..V::N], maps.rows());
-        let r = V::textured::<FULL>(prep, maps, q, (xs, ys), &k);
+        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, (xs, ys), &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
@@ -868,7 +916,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool>(
 /// column` from `origin`, `out(pixel, rgb)` takes each one's colour or `unsampled` its light.
 /// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline(always)]
-pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool>(
+pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     (planes, uv): (&Planes, &Planes),
@@ -886,7 +934,7 @@ pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool>(
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
         let q = planes.at(x, y, 6);
-        let r = V::textured::<FULL>(prep, maps, q, (x, y), &k);
+        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, (x, y), &k);
         emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
     }
     full

@@ -136,7 +136,7 @@ impl Frame<'_> {
                 continue;
             }
             let object = self.object(id);
-            if let Mode::Textured(prep) = &self.modes[object] {
+            if let Mode::Textured { prep, .. } = &self.modes[object] {
                 // Whole vectors of one triangle with its planes broadcast where the vector
                 // sampler covers the maps; the rest batched with the object's other pixels.
                 let done = match &self.vector_maps[object] {
@@ -196,7 +196,7 @@ impl Frame<'_> {
             },
         );
         for (object, items) in textured.iter().enumerate() {
-            let Mode::Textured(prep) = &self.modes[object] else {
+            let Mode::Textured { prep, .. } = &self.modes[object] else {
                 continue;
             };
             self.shade_textured_batch(object, prep, items, x0, y0, |(p, _), rgb| {
@@ -284,8 +284,10 @@ impl Frame<'_> {
             texels = texels.tinted(rgb);
         }
         // As `phong_core::light` splits them: the emission and the ambient terms apart where
-        // maps of their own modulate them (the light was prepared so: `emission_apart`).
-        let (emission_apart, ambient_apart) = obj.maps.apart();
+        // maps of their own modulate them (the light was prepared so: `emission_apart`); never
+        // for light made per vertex (Gouraud: only the diffuse and specular maps apply).
+        let per_vertex = matches!(self.modes[object], Mode::Textured { per_vertex: true, .. });
+        let (emission_apart, ambient_apart) = if per_vertex { (false, false) } else { obj.maps.apart() };
         let lit = Lit {
             primary: Color::new(primary[0], primary[1], primary[2]),
             specular: Color::new(specular[0], specular[1], specular[2]),
