@@ -9,6 +9,7 @@
 //! differ in rounding (fused multiply-adds, refined reciprocal estimates): both are tested
 //! against `phong_core::shade`, and the images of both against the reference path.
 
+mod filter;
 pub mod kernel;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
 mod project;
