@@ -406,6 +406,30 @@ fn assert_fast_matches_reference(scene: &Scene, what: &str) {
     }
 }
 
+/// A folder of the temporary directory, removed when dropped (when its test ends, failed too).
+struct Dir(std::path::PathBuf);
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A quad with vertex colours and coordinates over twice the image, as an OBJ file in a new
+/// folder `tag` of the temporary directory: the folder (removed when dropped) and the file.
+fn tinted_quad(tag: &str) -> (Dir, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tinted = dir.join("tinted.obj");
+    std::fs::write(
+        &tinted,
+        "v -1 -1 0 1 0.2 0.2\nv 1 -1 0 0.2 1 0.2\nv 1 1 0 0.2 0.2 1\nv -1 1 0 1 1 1\n\
+         vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    (Dir(dir), tinted)
+}
+
 /// A `Renderer` kept across frames of different scenes (sizes, meshes, sample counts, both
 /// paths) makes the same images as fresh renders: nothing of a previous frame leaks into the
 /// next through its reused memory.
@@ -511,15 +535,7 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
 fn fast_path_matches_reference_with_ambient_emission_and_occlusion_maps() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
     // A quad with vertex colours, which tint the diffuse texel but not the ambient map's.
-    let dir = std::env::temp_dir().join(format!("phong-split-maps-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let tinted = dir.join("tinted.obj");
-    std::fs::write(
-        &tinted,
-        "v -1 -1 0 1 0.2 0.2\nv 1 -1 0 0.2 1 0.2\nv 1 1 0 0.2 0.2 1\nv -1 1 0 1 1 1\n\
-         vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
-    )
-    .unwrap();
+    let (_dir, tinted) = tinted_quad("phong-split-maps");
     for model in ["opengl", "blinn-phong"] {
         let src = format!(
             r#"
@@ -614,7 +630,6 @@ material = {{ base = "chrome", emission = [0.2, 0.1, 0.3], emission_map = "asset
         );
         assert_fast_matches_reference(&scene, model);
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Maps on the second set of texture coordinates (glTF's `TEXCOORD_1`), beside maps on the
@@ -903,15 +918,7 @@ material = { base = "pewter", shininess_map = "assets/checker.png", uv_scale = [
 #[test]
 fn fast_path_matches_reference_with_gouraud_textured_objects() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let dir = std::env::temp_dir().join(format!("phong-gouraud-maps-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let tinted = dir.join("tinted.obj");
-    std::fs::write(
-        &tinted,
-        "v -1 -1 0 1 0.2 0.2\nv 1 -1 0 0.2 1 0.2\nv 1 1 0 0.2 0.2 1\nv -1 1 0 1 1 1\n\
-         vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
-    )
-    .unwrap();
+    let (_dir, tinted) = tinted_quad("phong-gouraud-maps");
     for model in ["opengl", "blinn-phong"] {
         let src = format!(
             r#"
@@ -1015,5 +1022,4 @@ material = {{ base = "chrome", emission = [0.3, 0.2, 0.1], diffuse_map = "assets
         );
         assert_fast_matches_reference(&scene, model);
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

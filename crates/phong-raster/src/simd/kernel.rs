@@ -542,30 +542,43 @@ pub(crate) fn light_vertices<V: Vf32>(
         .zip(normals.chunks(V::N))
         .zip(out.chunks_mut(V::N))
     {
-        let m = ps.len();
-        let mut c = [V::A::default(); 6];
-        for i in 0..V::N {
-            let (pp, mut nn) = (ps[i.min(m - 1)], ns[i.min(m - 1)]);
-            if flip {
-                nn = -nn;
-            }
-            for (k, v) in [pp.x, pp.y, pp.z, nn.x, nn.y, nn.z].into_iter().enumerate() {
-                c[k].as_mut()[i] = v;
-            }
+        let (pos, nrm) = vertex_lanes::<V>(ps, ns, flip);
+        store_lanes(shade(p, pos, nrm).get(term), os);
+    }
+}
+
+/// Vertices `ps` with normals `ns` (negated with `flip`) as lanes, the last repeated past
+/// `ps.len()`.
+#[inline(always)]
+fn vertex_lanes<V: Vf32>(ps: &[Vec3], ns: &[Vec3], flip: bool) -> (V3<V>, V3<V>) {
+    let m = ps.len();
+    let mut c = [V::A::default(); 6];
+    for i in 0..V::N {
+        let (pp, mut nn) = (ps[i.min(m - 1)], ns[i.min(m - 1)]);
+        if flip {
+            nn = -nn;
         }
-        let [px, py, pz, nx, ny, nz] = c.map(V::from_array);
-        let rgb = shade(p, V3 { x: px, y: py, z: pz }, V3 { x: nx, y: ny, z: nz })
-            .get(term)
-            .map(V::to_array);
-        for (i, o) in os.iter_mut().enumerate() {
-            *o = Vec3::new(rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]);
+        for (k, v) in [pp.x, pp.y, pp.z, nn.x, nn.y, nn.z].into_iter().enumerate() {
+            c[k].as_mut()[i] = v;
         }
+    }
+    let [px, py, pz, nx, ny, nz] = c.map(V::from_array);
+    (V3 { x: px, y: py, z: pz }, V3 { x: nx, y: ny, z: nz })
+}
+
+/// The first `out.len()` lanes of `rgb` into `out`.
+#[inline(always)]
+fn store_lanes<V: Vf32>(rgb: [V; 3], out: &mut [Vec3]) {
+    let rgb = rgb.map(V::to_array);
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = Vec3::new(rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]);
     }
 }
 
 /// Gouraud's vertex lighting of a textured object: `primary[i]` and `specular[i]`, the
 /// [`phong_core::Lit`] at `positions[i]` with `normals[i]` (negated with `flip`): emission,
 /// ambient and diffuse, and the specular term, each clamped where the options clamp.
+#[inline(always)]
 pub(crate) fn light_vertices_lit<V: Vf32>(
     p: &Prepared,
     positions: &[Vec3],
@@ -580,19 +593,8 @@ pub(crate) fn light_vertices_lit<V: Vf32>(
         .zip(primary.chunks_mut(V::N))
         .zip(specular.chunks_mut(V::N))
     {
-        let m = ps.len();
-        let mut c = [V::A::default(); 6];
-        for i in 0..V::N {
-            let (pp, mut nn) = (ps[i.min(m - 1)], ns[i.min(m - 1)]);
-            if flip {
-                nn = -nn;
-            }
-            for (k, v) in [pp.x, pp.y, pp.z, nn.x, nn.y, nn.z].into_iter().enumerate() {
-                c[k].as_mut()[i] = v;
-            }
-        }
-        let [px, py, pz, nx, ny, nz] = c.map(V::from_array);
-        let t = shade(p, V3 { x: px, y: py, z: pz }, V3 { x: nx, y: ny, z: nz });
+        let (pos, nrm) = vertex_lanes::<V>(ps, ns, flip);
+        let t = shade(p, pos, nrm);
         let mut lit = [[zero; 3]; 2];
         for ch in 0..3 {
             lit[0][ch] = t.ambient[ch].add(t.diffuse[ch]);
@@ -603,12 +605,8 @@ pub(crate) fn light_vertices_lit<V: Vf32>(
                 }
             }
         }
-        for (o, l) in [po, so].into_iter().zip(lit) {
-            let l = l.map(V::to_array);
-            for (i, o) in o.iter_mut().enumerate() {
-                *o = Vec3::new(l[0].as_ref()[i], l[1].as_ref()[i], l[2].as_ref()[i]);
-            }
-        }
+        store_lanes(lit[0], po);
+        store_lanes(lit[1], so);
     }
 }
 
