@@ -346,7 +346,8 @@ mod tests {
 
     /// Ambient, emission and occlusion maps with linear filters, and maps on the second set of
     /// coordinates, are drawn by the vector sampler (the fast path's textured mode), not per
-    /// pixel; one it does not cover (nearest filtering) is.
+    /// pixel; one it does not cover (a level filter of `GL_NEAREST`, as `GL_LINEAR_MIPMAP_NEAREST`)
+    /// is.
     #[test]
     fn ambient_emission_occlusion_and_second_set_maps_take_the_vector_sampler() {
         let src = r#"
@@ -361,10 +362,11 @@ shape = "sphere"
 material = { base = "brass", emission_map = "assets/checker.png" }
 [[object]]
 shape = "sphere"
-material = { base = "brass", ambient_map = "assets/checker.png", filter = "nearest" }
+material = { base = "brass", ambient_map = "assets/checker.png" }
 "#;
         let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/split.toml");
         let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        scene.objects[2].maps.ambient.as_mut().unwrap().sampler = linear_mipmap_nearest();
         // glTF's occlusion map, alone, on a copy of the second sphere.
         let mut o = scene.objects[1].clone();
         o.maps.emission = None;
@@ -385,7 +387,7 @@ material = { base = "brass", ambient_map = "assets/checker.png", filter = "neare
     }
 
     /// An object with a normal (or bump) map is drawn by the vector sampler, its tangents in
-    /// its coordinates' planes; with a second set of coordinates, or nearest filtering, it is
+    /// its coordinates' planes; with a second set of coordinates, or a filter it does not cover, it is
     /// shaded per pixel. So is one with a shininess map, unless the map reads its alpha (not
     /// gathered).
     #[test]
@@ -402,13 +404,14 @@ shape = "torus"
 material = { base = "brass", diffuse_map = "assets/bricks.png", emission_map = "assets/checker.png", bump_map = "assets/bricks_height.png" }
 [[object]]
 shape = "sphere"
-material = { base = "brass", bump_map = "assets/checker.png", filter = "nearest" }
+material = { base = "brass", bump_map = "assets/checker.png" }
 [[object]]
 shape = "sphere"
 material = { base = "brass", diffuse_map = "assets/bricks.png" }
 "#;
         let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/normals.toml");
         let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        scene.objects[2].maps.normal.as_mut().unwrap().map.sampler = linear_mipmap_nearest();
         // A normal map beside a map on the second set.
         let mut o = scene.objects[1].clone();
         o.mesh = o.mesh.clone().with_uvs1(o.mesh.uvs().to_vec()).unwrap();
@@ -435,6 +438,14 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         assert!(matches!(frame.modes[5], Mode::Textured { .. }));
         assert!(frame.vector_maps[5].is_some());
         assert!(matches!(frame.modes[6], Mode::Scalar));
+    }
+
+    /// `GL_LINEAR_MIPMAP_NEAREST` (glTF can ask for it), which the vector sampler does not cover.
+    fn linear_mipmap_nearest() -> phong_core::Sampler {
+        phong_core::Sampler {
+            mip: phong_core::MipFilter::Nearest,
+            ..phong_core::Sampler::trilinear(phong_core::Wrap::Repeat)
+        }
     }
 
     /// A Gouraud-shaded textured object is drawn by the vector sampler from its vertices'
@@ -488,5 +499,29 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         );
         assert!(matches!(frame.modes[2], Mode::Scalar));
         assert!(matches!(frame.modes[3], Mode::Scalar));
+    }
+
+    /// Nearest filtering (`GL_NEAREST`, no mipmaps) is one gather of level 0: such maps take
+    /// the vector sampler, Phong- or Gouraud-shaded, bump maps included.
+    #[test]
+    fn nearest_filtering_takes_the_vector_sampler() {
+        let src = r#"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+material = { base = "brass", diffuse_map = "assets/bricks.png", bump_map = "assets/bricks_height.png", filter = "nearest" }
+[[object]]
+shape = "sphere"
+interpolation = "gouraud"
+material = { base = "brass", specular_map = "assets/checker.png", filter = "nearest" }
+"#;
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/nearest.toml");
+        let scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+        assert!(matches!(frame.modes[0], Mode::Textured { per_vertex: false, .. }));
+        assert!(matches!(frame.modes[1], Mode::Textured { per_vertex: true, .. }));
+        assert!(frame.vector_maps.iter().all(Option::is_some));
     }
 }

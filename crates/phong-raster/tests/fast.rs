@@ -1023,3 +1023,85 @@ material = {{ base = "chrome", emission = [0.3, 0.2, 0.1], diffuse_map = "assets
         assert_fast_matches_reference(&scene, model);
     }
 }
+
+/// Nearest filtering (`filter = "nearest"`: `GL_NEAREST` both ways, no mipmaps), which the
+/// vector sampler reads as one gather of level 0: each wrap, magnified (the close plane) and
+/// minified (the far torus), 8- and 16-bit maps, diffuse, specular, emission and bump maps,
+/// Phong and Gouraud, vertex colours; coordinates past the vector wrap. The fast path within
+/// 1/255 of the reference.
+#[test]
+fn fast_path_matches_reference_with_nearest_filtering() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let (_dir, tinted) = tinted_quad("phong-nearest-maps");
+    let src = format!(
+        r#"
+[image]
+width = 220
+height = 130
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[object]]
+shape = "sphere"
+position = [-2.2, 0.8, 0.0]
+material = {{ base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/checker.png", filter = "nearest", uv_scale = [2.0, 1.0] }}
+[[object]]
+shape = "torus"
+position = [0.0, 0.8, -8.0]
+rotation = [60.0, 0.0, 0.0]
+material = {{ base = "jade", emission = [0.3, 0.2, 0.1], diffuse_map = "assets/checker.png", emission_map = "assets/bricks.png", filter = "nearest", wrap = "mirror", uv_scale = [7.0, 3.0] }}
+[[object]]
+shape = "plane"
+position = [2.2, 0.8, 3.5]
+scale = 0.6
+rotation = [80.0, 10.0, 0.0]
+material = {{ base = "ruby", diffuse_map = "assets/bricks.png", bump_map = "assets/bricks_height.png", filter = "nearest", wrap = "clamp", uv_scale = [1.3, 1.3], uv_offset = [-0.1, -0.1] }}
+[[object]]
+mesh = "{tinted}"
+position = [-2.0, -1.3, 0.5]
+scale = 0.6
+rotation = [0.0, 30.0, 0.0]
+interpolation = "gouraud"
+material = {{ base = "pearl", diffuse_map = "assets/bricks.png", filter = "nearest" }}
+[[object]]
+shape = "teapot"
+position = [0.3, -1.4, 0.0]
+scale = 0.6
+interpolation = "gouraud"
+material = {{ base = "gold", specular_map = "assets/checker.png", filter = "nearest" }}
+[[object]]
+shape = "plane"
+position = [2.6, -1.2, 1.0]
+scale = 0.5
+rotation = [70.0, 0.0, 0.0]
+material = {{ base = "chrome", diffuse_map = "assets/checker.png", filter = "nearest", uv_scale = [3.0e5, 3.0e5] }}
+"#,
+        tinted = tinted.display()
+    );
+    let mut scene = phong_scene::parse_scene(&src, &root.join("nearest.toml"))
+        .unwrap()
+        .scene;
+    // A 16-bit map of random texels in the sphere's diffuse map's place.
+    let mut r = Rng(11);
+    let texels: Vec<[u16; 4]> = (0..37 * 23)
+        .map(|_| [r.f(), r.f(), r.f()].map(|x| (x * 65535.0) as u16))
+        .map(|[a, b, c]| [a, b, c, 65535])
+        .collect();
+    let sixteen = std::sync::Arc::new(Texture::new(37, 23, &texels, 16).unwrap());
+    scene.objects[0].maps.diffuse.as_mut().unwrap().texture = sixteen;
+    // Past the vector wrap, nearest filtering is aliasing: the texel is decided by the last
+    // bits of the coordinates, which the reference computes in f64. A texture of one colour
+    // (8×8) keeps that plane's fallback testable.
+    let one = [[40u16 * 257, 160 * 257, 90 * 257, 65535]; 64];
+    scene.objects[5].maps.diffuse.as_mut().unwrap().texture = std::sync::Arc::new(Texture::new(8, 8, &one, 8).unwrap());
+    assert!(scene.objects.iter().all(|o| {
+        let m = &o.maps;
+        [&m.diffuse, &m.specular, &m.emission]
+            .into_iter()
+            .flatten()
+            .all(|t| t.sampler == Sampler::nearest(t.sampler.wrap_u))
+    }));
+    assert_fast_matches_reference(&scene, "nearest");
+}

@@ -34,14 +34,19 @@ pub struct VectorMap<'a> {
     quad8: bool,
     /// From storage units to `[0, 1]`: `1/255` or `1/65535`.
     unit: f32,
+    /// `GL_NEAREST` both ways without mipmaps: level 0's texel under the coordinates.
+    nearest: bool,
 }
 
 impl<'a> VectorMap<'a> {
     /// `map` if the sampler covers it: linear magnification and minification, mipmaps blended
-    /// (`GL_LINEAR_MIPMAP_LINEAR`) or none (`GL_LINEAR`).
+    /// (`GL_LINEAR_MIPMAP_LINEAR`) or none (`GL_LINEAR`); or nearest both ways without
+    /// mipmaps (`GL_NEAREST`).
     pub(super) fn of(map: &'a TextureMap) -> Option<VectorMap<'a>> {
         let s = map.sampler;
-        if s.mag != Filter::Linear || s.min != Filter::Linear || s.mip == MipFilter::Nearest {
+        let linear = s.mag == Filter::Linear && s.min == Filter::Linear && s.mip != MipFilter::Nearest;
+        let nearest = s.mag == Filter::Nearest && s.min == Filter::Nearest && s.mip == MipFilter::None;
+        if !linear && !nearest {
             return None;
         }
         let t = &map.texture;
@@ -70,6 +75,7 @@ impl<'a> VectorMap<'a> {
                 && levels[0].0.is_power_of_two()
                 && levels[0].1.is_power_of_two(),
             unit: if t.bits() == 8 { 1.0 / 255.0 } else { 1.0 / 65535.0 },
+            nearest,
         })
     }
 }
@@ -220,11 +226,28 @@ pub(super) fn bilinear_lanes<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> 
     out
 }
 
+/// `GL_NEAREST` without mipmaps: level 0's texel under `(u, v)` for every lane, RGB in texel
+/// units, as `phong_core`'s nearest filter (`floor(u·w)`, wrapped).
+#[inline(always)]
+fn nearest_lanes<V: Vf32>(map: &VectorMap, u: V, v: V) -> [V; 3] {
+    let (lw, lh, texels) = map.levels[0];
+    let (w, h) = (lw as f32, lh as f32);
+    let (x, _) = wrap_pair(map.wrap.0, u.mul(V::splat(w)).floor(), V::splat(w), V::splat(1.0 / w));
+    let (y, _) = wrap_pair(map.wrap.1, v.mul(V::splat(h)).floor(), V::splat(h), V::splat(1.0 / h));
+    match texels {
+        Texels::Eight(t) => V::gather_rgb8(t, lw, lh, x, y),
+        Texels::Sixteen(t) => V::gather_rgb16(t, lw, lh, x, y),
+    }
+}
+
 /// The map's RGB (0 to 255) at `(u, v)` (transformed) with screen derivatives
 /// `d = [∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`: `phong_core::Texture::sample` at
 /// `phong_core::Texture::lod`, for every lane.
 #[inline(always)]
 fn sample<V: Sampling>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
+    if map.nearest {
+        return nearest_lanes(map, u, v);
+    }
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let last = (map.count - 1) as f32;
@@ -306,7 +329,8 @@ mod tests {
     }
 
     /// The vector sampler against `phong_core::Texture::sample` at `Texture::lod`: random 8-
-    /// and 16-bit textures of odd and even sizes, every wrap, trilinear and bilinear, coordinates over
+    /// and 16-bit textures of odd and even sizes, every wrap (the same both ways and not),
+    /// trilinear, bilinear and nearest, coordinates over
     /// several copies of the image and derivatives from magnified to the last level, on both
     /// builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they differ in rounding only.
     #[test]
@@ -327,7 +351,19 @@ mod tests {
                 .collect();
             let texture = Arc::new(phong_core::Texture::new(w, h, &texels, bits).unwrap());
             for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
-                for sampler in [Sampler::trilinear(wrap), Sampler::bilinear(wrap)] {
+                // Each filter with one wrap both ways, and with another for v.
+                let other = match wrap {
+                    Wrap::Repeat => Wrap::Clamp,
+                    Wrap::Clamp => Wrap::Mirror,
+                    Wrap::Mirror => Wrap::Repeat,
+                };
+                let filters = [
+                    Sampler::trilinear(wrap),
+                    Sampler::bilinear(wrap),
+                    Sampler::nearest(wrap),
+                ];
+                let mixed = filters.map(|s| Sampler { wrap_v: other, ..s });
+                for sampler in filters.into_iter().chain(mixed) {
                     let maps = Maps {
                         diffuse: Some(TextureMap {
                             texture: texture.clone(),
