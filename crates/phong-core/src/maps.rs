@@ -65,6 +65,9 @@ pub enum Channel {
 }
 
 impl Channel {
+    /// The weights of red, green and blue in [`Channel::Luminance`] (Rec. 709's).
+    pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
     /// The channel of `rgba`.
     #[inline]
     pub fn of(self, rgba: [f32; 4]) -> f32 {
@@ -73,7 +76,10 @@ impl Channel {
             Channel::G => rgba[1],
             Channel::B => rgba[2],
             Channel::A => rgba[3],
-            Channel::Luminance => 0.2126 * rgba[0] + 0.7152 * rgba[1] + 0.0722 * rgba[2],
+            Channel::Luminance => {
+                let [r, g, b] = Channel::LUMINANCE;
+                r * rgba[0] + g * rgba[1] + b * rgba[2]
+            }
         }
     }
 }

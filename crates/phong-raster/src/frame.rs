@@ -364,8 +364,7 @@ material = { base = "brass", emission_map = "assets/checker.png" }
 shape = "sphere"
 material = { base = "brass", ambient_map = "assets/checker.png" }
 "#;
-        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/split.toml");
-        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let mut scene = parsed(src);
         scene.objects[2].maps.ambient.as_mut().unwrap().sampler = linear_mipmap_nearest();
         // glTF's occlusion map, alone, on a copy of the second sphere.
         let mut o = scene.objects[1].clone();
@@ -409,8 +408,7 @@ material = { base = "brass", bump_map = "assets/checker.png" }
 shape = "sphere"
 material = { base = "brass", diffuse_map = "assets/bricks.png" }
 "#;
-        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/normals.toml");
-        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let mut scene = parsed(src);
         scene.objects[2].maps.normal.as_mut().unwrap().map.sampler = linear_mipmap_nearest();
         // A normal map beside a map on the second set.
         let mut o = scene.objects[1].clone();
@@ -438,6 +436,12 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         assert!(matches!(frame.modes[5], Mode::Textured { .. }));
         assert!(frame.vector_maps[5].is_some());
         assert!(matches!(frame.modes[6], Mode::Scalar));
+    }
+
+    /// The scene of TOML `src`, its files relative to `examples/scenes` (its `assets`).
+    fn parsed(src: &str) -> Scene {
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/test.toml");
+        phong_scene::parse_scene(src, &at).unwrap().scene
     }
 
     /// `GL_LINEAR_MIPMAP_NEAREST` (glTF can ask for it), which the vector sampler does not cover.
@@ -471,8 +475,7 @@ shape = "sphere"
 interpolation = "flat"
 material = { base = "brass", diffuse_map = "assets/bricks.png" }
 "#;
-        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/gouraud.toml");
-        let mut scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let mut scene = parsed(src);
         // glTF's metallic-roughness map on a copy of the first sphere.
         let mut o = scene.objects[0].clone();
         let map = o.maps.diffuse.clone().unwrap();
@@ -517,8 +520,7 @@ shape = "sphere"
 interpolation = "gouraud"
 material = { base = "brass", specular_map = "assets/checker.png", filter = "nearest" }
 "#;
-        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/nearest.toml");
-        let scene = phong_scene::parse_scene(src, &at).unwrap().scene;
+        let scene = parsed(src);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
         assert!(matches!(frame.modes[0], Mode::Textured { per_vertex: false, .. }));
         assert!(matches!(frame.modes[1], Mode::Textured { per_vertex: true, .. }));

@@ -354,10 +354,13 @@ fn shininess_lanes<V: Sampling, const FULL: bool>(
         Channel::R | Channel::A => t[0],
         Channel::G => t[1],
         Channel::B => t[2],
-        Channel::Luminance => V::splat(0.2126)
-            .mul(t[0])
-            .add(V::splat(0.7152).mul(t[1]))
-            .add(V::splat(0.0722).mul(t[2])),
+        Channel::Luminance => {
+            let [r, g, b] = Channel::LUMINANCE;
+            V::splat(r)
+                .mul(t[0])
+                .add(V::splat(g).mul(t[1]))
+                .add(V::splat(b).mul(t[2]))
+        }
     };
     (Some(V::splat(prep.shininess).mul(f.max(zero))), None)
 }
