@@ -441,6 +441,18 @@ impl Maps {
         material.alpha() * t.diffuse[3] * t.alpha
     }
 
+    /// [`Maps::alpha`] of the texels at `sets` (as [`Maps::sample_sets`] takes them), sampling
+    /// only the diffuse and alpha maps: what the alpha test reads before a point is shaded.
+    pub fn alpha_sets(&self, material: &Material, sets: &[[Vec2; 3]; 2]) -> f32 {
+        let at = |m: &TextureMap| {
+            let [uv, d_dx, d_dy] = sets[usize::from(m.set.min(1))];
+            m.sample(uv, d_dx, d_dy)
+        };
+        let diffuse = self.diffuse.as_ref().map_or(1.0, |m| at(m)[3]);
+        let alpha = self.alpha.as_ref().map_or(1.0, |(m, c)| c.of(at(m)));
+        material.alpha() * diffuse * alpha
+    }
+
     /// Whether the alpha test discards a point of alpha `alpha`.
     #[inline]
     pub fn discards(&self, alpha: f32) -> bool {
@@ -457,6 +469,51 @@ mod tests {
     fn stored(n: &NormalMap, x: u32, y: u32) -> glam::Vec3 {
         let t = n.map.texture.texel(0, x, y);
         glam::Vec3::new(t[0], t[1], t[2]) * 2.0 - 1.0
+    }
+
+    /// The alpha test's own sampling gives the alpha of the full sampling, bit for bit (the
+    /// fast path's visibility and the reference's shading must discard the same points): a
+    /// diffuse map with alpha on the first set, an alpha map's green on the second.
+    #[test]
+    fn alpha_sets_is_the_alpha_of_the_sampled_texels() {
+        let texels: Vec<[u8; 4]> = (0..64u32)
+            .map(|i| {
+                [
+                    (i * 37 % 256) as u8,
+                    (i * 91 % 256) as u8,
+                    (i * 13 % 256) as u8,
+                    (i * 53 % 256) as u8,
+                ]
+            })
+            .collect();
+        let t = Arc::new(Texture::from_rgba8(8, 8, &texels).unwrap());
+        let mut alpha = TextureMap::new(t.clone());
+        alpha.set = 1;
+        let maps = Maps {
+            diffuse: Some(TextureMap::new(t)),
+            alpha: Some((alpha, Channel::G)),
+            ..Maps::default()
+        };
+        let material = Material::default().with_alpha(0.7).unwrap();
+        for i in 0..200 {
+            let f = i as f32;
+            let first = [
+                Vec2::new(f * 0.013, f * 0.029),
+                Vec2::new(0.01 * (f % 7.0), 0.0),
+                Vec2::new(0.0, 0.02 * (f % 5.0)),
+            ];
+            let second = [
+                Vec2::new(f * 0.031, 1.0 - f * 0.007),
+                Vec2::new(0.001, 0.0),
+                Vec2::new(0.0, 0.3),
+            ];
+            let sets = [first, second];
+            let full = Maps::alpha(&material, &maps.sample_sets(&sets));
+            assert_eq!(maps.alpha_sets(&material, &sets).to_bits(), full.to_bits(), "point {i}");
+        }
+        // Without maps: the material's alpha.
+        let none = Maps::default().alpha_sets(&material, &[[Vec2::ZERO; 3]; 2]);
+        assert_eq!(none, 0.7);
     }
 
     #[test]

@@ -324,8 +324,9 @@ impl Scene {
         order
     }
 
-    /// Whether an object is blended or alpha-tested: what the fast path and the GPU's compute
-    /// rasterizer leave to the reference path and the render pipeline.
+    /// Whether an object is blended or alpha-tested: what the GPU's compute rasterizer leaves to
+    /// the render pipeline, and the CPU's fast path with several samples a pixel to the
+    /// reference path.
     pub fn has_translucency(&self) -> bool {
         self.objects
             .iter()

@@ -22,6 +22,20 @@ pub(crate) enum Path {
     Fast,
 }
 
+impl Path {
+    /// The path that draws `scene`: the fast one unless `options` ask for the reference, or
+    /// the frame has several samples a pixel and an alpha-tested or blended object (the fast
+    /// path's visibility of several samples has no alpha test or blending).
+    pub fn of(scene: &Scene, options: &RenderOptions) -> Path {
+        let multi = scene.image.samples != phong_core::Samples::One;
+        if options.reference || (multi && scene.has_translucency()) {
+            Path::Reference
+        } else {
+            Path::Fast
+        }
+    }
+}
+
 /// How the fast path shades an object's pixels.
 pub(crate) enum Mode {
     /// Interpolated position and normal, the vector kernel; the term shown.
@@ -37,8 +51,8 @@ pub(crate) enum Mode {
     /// primary and specular colours, which the triangle's planes carry instead of position and
     /// normal.
     Textured { prep: Prepared, per_vertex: bool },
-    /// One pixel at a time, as the reference path (flat shading, textured objects, normal and
-    /// depth outputs).
+    /// One pixel at a time, as the reference path (flat shading, textured objects the vector
+    /// kernels do not cover, normal and depth outputs, blended objects).
     Scalar,
 }
 
@@ -51,6 +65,19 @@ impl Mode {
             Mode::Textured { .. } | Mode::Scalar => None,
         }
     }
+}
+
+/// How an object's points reach the image (the fast path decides visibility before shading).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Visibility {
+    /// Drawn where nearest.
+    Opaque,
+    /// Drawn where nearest and its alpha passes the alpha test, decided during visibility with
+    /// the reference's arithmetic ([`Frame::alpha_passes`]): the object keeps [`Corners`].
+    AlphaTested,
+    /// Blended over the opaque image after it is shaded, without writing depth
+    /// (`Object::blends`): shaded per pixel ([`Mode::Scalar`]).
+    Blended,
 }
 
 /// The kernel's term for a lit output; `None` for the normal and depth outputs.
@@ -73,6 +100,8 @@ pub(crate) struct Frame<'a> {
     /// Per object: its maps as the vector sampler reads them, for a [`Mode::Textured`] object
     /// whose maps it covers (decided once per frame).
     pub vector_maps: Vec<Option<VectorMaps<'a>>>,
+    /// Per object: how its points reach the image.
+    pub visibility: Vec<Visibility>,
     /// Per object: whether a map reads the mesh's second set of texture coordinates.
     pub second_sets: Vec<bool>,
     /// Per object: what its coordinates' planes carry beside the first set.
@@ -111,15 +140,33 @@ impl<'a> Frame<'a> {
             .collect();
         let pattern = pattern(scene.image.samples);
         let second_sets: Vec<bool> = scene.objects.iter().map(|o| o.maps.uses_second_set()).collect();
+        let visibility: Vec<Visibility> = scene
+            .objects
+            .iter()
+            .map(|o| {
+                if o.blends() {
+                    Visibility::Blended
+                } else if o.textured() && lit_term(o.shading.output).is_some() && o.maps.alpha_cutoff.is_some() {
+                    // (`Frame::shade_pixel` applies the alpha test to these points only.)
+                    Visibility::AlphaTested
+                } else {
+                    Visibility::Opaque
+                }
+            })
+            .collect();
         let modes: Vec<Mode> = scene
             .objects
             .iter()
             .zip(&views)
             .zip(&second_sets)
-            .map(|((o, &view), &second_set)| {
+            .zip(&visibility)
+            .map(|(((o, &view), &second_set), &visibility)| {
                 let Some(term) = lit_term(o.shading.output) else {
                     return Mode::Scalar;
                 };
+                if visibility == Visibility::Blended {
+                    return Mode::Scalar;
+                }
                 if o.textured() {
                     let m = &o.maps;
                     // Ambient, emission and occlusion maps need the light's terms apart, which
@@ -200,6 +247,7 @@ impl<'a> Frame<'a> {
                 })
                 .collect(),
             modes,
+            visibility,
             second_sets,
             views,
             w,
@@ -218,7 +266,11 @@ impl<'a> Frame<'a> {
         for oi in scene.draw_order() {
             let obj = &scene.objects[oi];
             let chunks = if path == Path::Reference || matches!(frame.modes[oi], Mode::Scalar) {
-                frame.setup_object_full(oi, obj, clip_from_world)
+                frame.setup_object_full(oi, obj, clip_from_world, false)
+            } else if frame.visibility[oi] == Visibility::AlphaTested {
+                // The alpha test reads the reference's coordinates (`Corners`); the shading,
+                // the planes.
+                frame.setup_object_full(oi, obj, clip_from_world, true)
             } else {
                 frame.setup_object_fast(oi, obj, clip_from_world, scratch, &spare)
             };
@@ -288,14 +340,7 @@ pub(crate) fn render<P: Pixel>(
     scratch: &mut Scratch,
 ) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
-    // Blending and the alpha test change what is visible, which the fast path decides before
-    // shading: such frames are the reference path's.
-    let path = if options.reference || scene.has_translucency() {
-        Path::Reference
-    } else {
-        Path::Fast
-    };
-    let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2), scratch);
+    let frame = Frame::build(scene, Path::of(scene, options), Isa::detect(!options.no_avx2), scratch);
     let setup = t0.elapsed();
     let t1 = Instant::now();
     let clock = StageClock::default();
@@ -525,5 +570,48 @@ material = { base = "brass", specular_map = "assets/checker.png", filter = "near
         assert!(matches!(frame.modes[0], Mode::Textured { per_vertex: false, .. }));
         assert!(matches!(frame.modes[1], Mode::Textured { per_vertex: true, .. }));
         assert!(frame.vector_maps.iter().all(Option::is_some));
+    }
+
+    /// Alpha-tested and blended objects are drawn by the fast path with one sample a pixel: an
+    /// alpha-tested textured object keeps its mode (the vector sampler, which does not read the
+    /// alpha map) and both its corners (for the alpha test) and its planes; a blended one is
+    /// shaded per pixel. With several samples such a frame is the reference path's.
+    #[test]
+    fn alpha_tested_and_blended_objects_take_the_fast_path() {
+        let src = r#"
+[[light]]
+type = "point"
+position = [1.0, 2.0, 3.0]
+[[object]]
+shape = "sphere"
+material = { base = "brass", diffuse_map = "assets/leaf.png", alpha_map = "assets/leaf.png" }
+[[object]]
+shape = "sphere"
+material = { base = "brass", alpha = 0.5, blend = true }
+[[object]]
+shape = "sphere"
+material = { base = "brass", diffuse_map = "assets/bricks.png" }
+"#;
+        let mut scene = parsed(src);
+        let options = RenderOptions::default();
+        assert_eq!(Path::of(&scene, &options), Path::Fast);
+        let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
+        assert_eq!(
+            frame.visibility,
+            [Visibility::AlphaTested, Visibility::Blended, Visibility::Opaque]
+        );
+        assert!(matches!(frame.modes[0], Mode::Textured { per_vertex: false, .. }));
+        assert!(frame.vector_maps[0].is_some());
+        assert!(matches!(frame.modes[1], Mode::Scalar));
+        let object = |o: u32| frame.tris.iter().filter(move |c| c.object == o);
+        assert!(object(0).all(|c| c.corners.len() == c.tris.len() && c.planes.len() == c.tris.len()));
+        assert!(object(0).all(|c| c.uv.len() == c.tris.len()));
+        assert!(object(0).any(|c| !c.tris.is_empty()));
+        assert!(object(2).all(|c| c.corners.is_empty()));
+        scene.image.samples = phong_core::Samples::Four;
+        assert_eq!(Path::of(&scene, &options), Path::Reference);
+        scene.objects.truncate(1);
+        scene.objects[0].maps.alpha_cutoff = None;
+        assert_eq!(Path::of(&scene, &options), Path::Fast);
     }
 }

@@ -1105,3 +1105,112 @@ material = {{ base = "chrome", diffuse_map = "assets/checker.png", filter = "nea
     }));
     assert_fast_matches_reference(&scene, "nearest");
 }
+
+/// Alpha-tested and blended objects on the fast path (visibility with the reference's alpha
+/// test, blended objects laid over the shaded image in drawing order) against the reference
+/// path, both builds: a map whose alpha crosses the cutoff smoothly (magnified and minified,
+/// trilinear), as the diffuse map's alpha and as an alpha map, Phong and Gouraud, vertex
+/// colours; blended objects textured and not, overlapping one another and alpha-tested ones,
+/// one of them alpha-tested too; and a transparent background, alpha compared.
+#[test]
+fn fast_path_matches_reference_with_alpha_test_and_blending() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let (_dir, tinted) = tinted_quad("phong-alpha-maps");
+    let src = format!(
+        r#"
+[image]
+width = 240
+height = 150
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[object]]
+shape = "torus"
+position = [0.0, 0.3, -2.0]
+material = {{ base = "jade", diffuse_map = "assets/bricks.png", uv_scale = [4.0, 2.0] }}
+[[object]]
+shape = "plane"
+position = [-1.6, 0.6, 1.0]
+rotation = [75.0, 20.0, 0.0]
+material = {{ base = "brass", diffuse_map = "assets/checker.png", alpha_cutoff = 0.5 }}
+[[object]]
+shape = "sphere"
+position = [1.8, 0.9, 0.5]
+interpolation = "gouraud"
+material = {{ base = "ruby", diffuse_map = "assets/bricks.png", alpha_map = "assets/leaf.png", uv_scale = [3.0, 2.0] }}
+[[object]]
+mesh = "{tinted}"
+position = [-2.0, -1.2, 1.5]
+scale = 0.7
+rotation = [0.0, 30.0, 0.0]
+material = {{ base = "pearl", alpha_map = "assets/leaf.png", specular_map = "assets/checker.png" }}
+[[object]]
+shape = "sphere"
+position = [0.0, -0.2, 1.0]
+scale = 0.8
+material = {{ base = "gold", alpha = 0.45, blend = true }}
+[[object]]
+shape = "plane"
+position = [0.6, -0.6, 2.0]
+rotation = [80.0, -15.0, 0.0]
+material = {{ base = "chrome", alpha = 0.8, blend = true, diffuse_map = "assets/checker.png", uv_scale = [2.0, 2.0] }}
+[[object]]
+shape = "teapot"
+position = [1.7, -1.2, 2.2]
+scale = 0.6
+interpolation = "gouraud"
+material = {{ base = "emerald", alpha = 0.3, blend = true }}
+[[object]]
+shape = "plane"
+position = [-0.4, 1.0, 2.5]
+rotation = [70.0, 0.0, 0.0]
+scale = 0.8
+material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/leaf.png", alpha_map = "assets/leaf.png", alpha_cutoff = 0.4 }}
+"#,
+        tinted = tinted.display()
+    );
+    let mut scene = phong_scene::parse_scene(&src, &root.join("alpha.toml")).unwrap().scene;
+    // The quad's diffuse map: random colours, an alpha that crosses 0.5 smoothly, 8-bit.
+    let mut r = Rng(5);
+    let (w, h) = (32u32, 16u32);
+    let texels: Vec<[u16; 4]> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            let a = 0.5 + 0.5 * (6.283 * x).sin() * (3.1416 * y).cos();
+            [r.f(), r.f(), r.f(), a].map(|c| (c * 255.0).round() as u16 * 257)
+        })
+        .collect();
+    let map = &mut scene.objects[1].maps.diffuse.as_mut().unwrap();
+    map.texture = std::sync::Arc::new(Texture::new(w, h, &texels, 8).unwrap());
+    map.transform = UvTransform::scale_offset(glam::Vec2::new(3.0, 3.0), glam::Vec2::ZERO);
+    assert!(scene.objects[1].maps.alpha_cutoff == Some(0.5) && !scene.objects[1].blends());
+    assert!(scene.objects[2].maps.alpha_cutoff == Some(0.5));
+    assert!((4..8).all(|i| scene.objects[i].blends()));
+    assert_fast_matches_reference(&scene, "alpha test and blending");
+    // A transparent background: where blended objects lie over it, the alpha too.
+    scene.image.background = [0.1, 0.2, 0.3, 0.0];
+    let reference = render(
+        &scene,
+        &RenderOptions {
+            reference: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let a = reference.to_bytes(scene.image.encoding, true);
+    for no_avx2 in [false, true] {
+        let fast = render(
+            &scene,
+            &RenderOptions {
+                no_avx2,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let b = fast.to_bytes(scene.image.encoding, true);
+        let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        assert!(worst <= 1, "transparent background (no_avx2 {no_avx2}): {worst}/255");
+    }
+}

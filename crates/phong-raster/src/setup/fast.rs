@@ -7,7 +7,7 @@
 //! (a sphere's back half is culled); the triangles wait as [`Pending`] until their colours
 //! exist.
 
-use super::{Chunk, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, uv_planes};
+use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, uv_planes};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
 use crate::frame::{Frame, Mode, lit_term};
@@ -143,7 +143,16 @@ impl Frame<'_> {
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {
-                    if let Some((tri, p, _, uv)) = self.setup(t, None, None, oi as u32, false) {
+                    if let Some((tri, p, _, uv)) = self.setup(
+                        t,
+                        None,
+                        None,
+                        oi as u32,
+                        Keep {
+                            corners: false,
+                            planes: true,
+                        },
+                    ) {
                         if gouraud {
                             out.clipped.push((out.tris.len() as u32, p));
                         } else {

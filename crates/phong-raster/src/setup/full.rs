@@ -3,7 +3,7 @@
 //! triangle (flat) by `Object::shade` (a textured object: its primary and specular colours,
 //! for the texels applied per pixel), [`Corners`] kept.
 
-use super::{Chunk, Corners, Flat, SETUP_CHUNK, Tri};
+use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::frame::Frame;
 use crate::simd::Planes;
@@ -14,9 +14,10 @@ use phong_core::{Color, Interpolation, Object};
 use rayon::prelude::*;
 
 impl Frame<'_> {
-    /// Sets up object `oi` with [`Corners`] for scalar shading, in chunks of [`SETUP_CHUNK`]
-    /// input triangles, each binned.
-    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4) -> Vec<Chunk> {
+    /// Sets up object `oi` with [`Corners`] for scalar shading (and with `planes`, its
+    /// fast-path planes too: an alpha-tested object), in chunks of [`SETUP_CHUNK`] input
+    /// triangles, each binned.
+    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4, planes: bool) -> Vec<Chunk> {
         let scene = self.scene;
         let interpolation = obj.shading.interpolation;
         let two_sided = obj.shading.options.two_sided;
@@ -79,9 +80,13 @@ impl Frame<'_> {
                 ..Chunk::default()
             };
             let mut push = |r: Option<(Tri, Planes, Option<Corners>, Option<Planes>)>| {
-                if let Some((t, _, c, _)) = r {
+                if let Some((t, p, c, uv)) = r {
                     out.tris.push(t);
                     out.corners.extend(c);
+                    if planes {
+                        out.planes.push(p);
+                        out.uv.extend(uv);
+                    }
                 }
             };
             for tri in chunk {
@@ -100,15 +105,21 @@ impl Frame<'_> {
                 });
                 if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
                     let proj = tri.map(|i| projected[i as usize]);
-                    push(self.setup(t, Some(proj), flat, oi as u32, true));
+                    push(self.setup(t, Some(proj), flat, oi as u32, Keep { corners: true, planes }));
                     continue;
                 }
                 match clip_triangle(&t) {
                     Clipped::Rejected => {}
-                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, true)),
+                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, Keep { corners: true, planes })),
                     Clipped::Polygon(p) => {
                         for i in 1..p.len() - 1 {
-                            push(self.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, true));
+                            push(self.setup(
+                                [p[0], p[i], p[i + 1]],
+                                None,
+                                flat,
+                                oi as u32,
+                                Keep { corners: true, planes },
+                            ));
                         }
                     }
                 }

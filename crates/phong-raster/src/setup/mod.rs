@@ -93,6 +93,15 @@ pub(crate) struct Setup {
 /// colour), specular colour (textured objects only), facet normal.
 pub(crate) type Flat = (Color, Color, Vec3);
 
+/// What [`Frame::setup`] keeps of a triangle besides its [`Tri`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Keep {
+    /// Its [`Corners`].
+    pub corners: bool,
+    /// Its fast-path [`Planes`] and coordinates' planes.
+    pub planes: bool,
+}
+
 /// What the scalar shading of a triangle needs besides [`Tri`]: kept only for the reference
 /// path and for objects the fast path shades one pixel at a time.
 pub(crate) struct Corners {
@@ -353,26 +362,26 @@ impl Frame<'_> {
     }
 
     /// Projects (unless `proj` is given), snaps, culls and sets up one triangle of clip-space
-    /// vertices; with `full`, its [`Corners`] for scalar shading, else its fast-path [`Planes`]
-    /// (and a textured object's [`uv_planes`]).
+    /// vertices, with what `keep` asks for: its [`Corners`] for scalar shading, its fast-path
+    /// [`Planes`] (and a textured object's [`uv_planes`]).
     pub(crate) fn setup(
         &self,
         v: [ClipVertex; 3],
         proj: Option<[Projected; 3]>,
         flat: Option<[Flat; 2]>,
         object: u32,
-        full: bool,
+        keep: Keep,
     ) -> Option<(Tri, Planes, Option<Corners>, Option<Planes>)> {
         let proj = proj.unwrap_or_else(|| v.map(|v| self.project(v.clip)));
         let s = self.setup_edges(proj, self.scene.objects[object as usize].shading.options.two_sided)?;
         let v = s.order.map(|k| v[k]);
-        if full {
-            let corners = Corners {
-                inv_w: s.inv_w,
-                v,
-                flat: flat.map(|f| f[usize::from(!s.front)]),
-            };
-            return Some((s.tri, Planes::default(), Some(corners), None));
+        let corners = keep.corners.then(|| Corners {
+            inv_w: s.inv_w,
+            v,
+            flat: flat.map(|f| f[usize::from(!s.front)]),
+        });
+        if !keep.planes {
+            return Some((s.tri, Planes::default(), corners, None));
         }
         let mode = &self.modes[object as usize];
         let extra = self.extras[object as usize];
@@ -395,7 +404,7 @@ impl Frame<'_> {
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, v.map(|v| v.spec[side])], false)
             }
         };
-        Some((s.tri, planes, None, uv))
+        Some((s.tri, planes, corners, uv))
     }
 }
 

@@ -60,14 +60,16 @@ impl<'a> VectorMaps<'a> {
             specular,
             emission,
             shininess,
-            alpha,
+            // The alpha decides what is drawn (the alpha test during visibility, blended objects
+            // per pixel), not the colour: the sampler does not read it.
+            alpha: _,
             normal,
             metal_rough,
             occlusion,
             alpha_cutoff: _,
             blend: _,
         } = maps;
-        let others = alpha.is_some() || shininess.as_ref().is_some_and(|(_, c)| *c == Channel::A);
+        let others = shininess.as_ref().is_some_and(|(_, c)| *c == Channel::A);
         let none = diffuse.is_none()
             && specular.is_none()
             && ambient.is_none()

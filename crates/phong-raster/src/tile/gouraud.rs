@@ -86,7 +86,7 @@ impl Frame<'_> {
                 planes: ColorPlanes::new(self.planes(ti)),
                 rows: &mut *rows,
             };
-            visible_single::<false, T>(scan, (x0, y0, tw, y1), depth, &mut [], Some(forward));
+            visible_single::<false, T>(scan, (x0, y0, tw, y1), depth, &mut [], Some(forward), |_, _| true);
         }
         tile.clock.add(marks);
         depth.iter().filter(|&&d| d != f32::INFINITY).count() as u64

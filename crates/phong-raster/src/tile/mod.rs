@@ -13,7 +13,7 @@ mod reference;
 mod shade;
 mod visible;
 
-use crate::frame::{Frame, Path};
+use crate::frame::{Frame, Path, Visibility};
 use crate::stats::StageClock;
 use crate::target::{Pixel, TileTarget};
 use phong_core::Encoding;
@@ -105,7 +105,10 @@ impl Frame<'_> {
             TilePlan::Reference
         } else if self.pattern.len() > 1 {
             TilePlan::Multi
-        } else if n == 1 && self.covers_rect(tile.bin[0], (tile.x0, tile.y0, tile.x1, tile.y1)) {
+        } else if n == 1
+            && self.visibility[self.object(tile.bin[0])] == Visibility::Opaque
+            && self.covers_rect(tile.bin[0], (tile.x0, tile.y0, tile.x1, tile.y1))
+        {
             TilePlan::Covered
         } else if self.gouraud_only {
             // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop:
@@ -129,7 +132,10 @@ impl Frame<'_> {
         let mut target = TileTarget {
             rows,
             encoding,
-            direct: plan == TilePlan::Reference || tile.bin.len() <= 1,
+            // (A blended triangle reads the pixels it is laid over: not from streamed memory.)
+            direct: plan == TilePlan::Reference
+                || tile.bin.is_empty()
+                || (tile.bin.len() == 1 && self.visibility[self.object(tile.bin[0])] != Visibility::Blended),
         };
         let TileBuffers { local, multi } = buffers;
         let Multi { depth, ids, .. } = multi;

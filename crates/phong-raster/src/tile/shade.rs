@@ -462,6 +462,21 @@ impl Frame<'_> {
         Some([c.r, c.g, c.b, obj.plain_alpha()])
     }
 
+    /// Whether triangle `id` (an alpha-tested object's) passes the alpha test at the centre of
+    /// pixel `(px, py)`: the alpha [`Frame::shade_pixel`] tests, from the same coordinates.
+    pub(crate) fn alpha_passes(&self, id: u32, px: u32, py: u32) -> bool {
+        let (t, corners) = (self.tri(id), self.corners(id));
+        let object = self.object(id);
+        let obj = &self.scene.objects[object];
+        let first = Self::uv_at(t, corners, px, py, |v| v.uv);
+        let second = if self.second_sets[object] {
+            Self::uv_at(t, corners, px, py, |v| v.uv1)
+        } else {
+            first
+        };
+        !obj.maps.discards(obj.maps.alpha_sets(&obj.material, &[first, second]))
+    }
+
     /// [`Frame::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
     /// pixel's texture coordinates with their exact derivatives, then applied to the light per
     /// pixel (Phong: `shade_textured`) or to the primary and specular colours made per vertex

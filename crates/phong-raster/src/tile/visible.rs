@@ -7,13 +7,14 @@
 //! ([`Frame::tile_multi`]) each sample is tested in turn.
 
 use super::gouraud::ColorPlanes;
+use super::reference::over;
 use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
-use crate::frame::{Frame, Mode};
+use crate::frame::{Frame, Mode, Visibility};
 use crate::setup::Tri;
 use crate::simd::{TilePixel, covered_span};
 use crate::stats::Marks;
-use crate::target::Store;
+use crate::target::{Store, resolve};
 use phong_core::limits::SUBPIXEL_BITS;
 
 /// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
@@ -101,20 +102,56 @@ impl Frame<'_> {
         ids.clear();
         ids.resize(tw * th, u32::MAX);
         let span = (tile.x0, tile.y0, tw, tile.y1);
+        // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque image.
+        let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
             let scan = Scan::new(self.tri(ti), k as u32, self.pattern[0], (tile.x0, tile.x1));
-            if matches!(self.modes[self.object(ti)], Mode::Gouraud) {
-                let forward = Forward {
-                    planes: ColorPlanes::new(self.planes(ti)),
-                    rows: &mut *rows,
-                };
-                visible_single::<true, _>(scan, span, depth, ids, Some(forward));
-            } else {
-                visible_single::<true, [f32; 4]>(scan, span, depth, ids, None);
+            match self.visibility[self.object(ti)] {
+                Visibility::Blended => {
+                    blended = k;
+                    break;
+                }
+                Visibility::AlphaTested => {
+                    let passes = |px, py| self.alpha_passes(ti, px, py);
+                    visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, passes);
+                }
+                Visibility::Opaque if matches!(self.modes[self.object(ti)], Mode::Gouraud) => {
+                    let forward = Forward {
+                        planes: ColorPlanes::new(self.planes(ti)),
+                        rows: &mut *rows,
+                    };
+                    visible_single::<true, _>(scan, span, depth, ids, Some(forward), |_, _| true);
+                }
+                Visibility::Opaque => visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, |_, _| true),
             }
         }
         marks.shading();
-        self.shade_single(tile, ids, rows, store, marks)
+        let shaded = self.shade_single(tile, ids, rows, store, marks);
+        shaded + self.blend_single(tile, &tile.bin[blended..], depth, rows)
+    }
+
+    /// Blends `bin`'s triangles (blended objects', in drawing order) over the shaded tile
+    /// `rows`, where nearer than `depth` (the opaque triangles'), as the reference path does:
+    /// each point shaded by [`Frame::shade_pixel`] and laid `over` the pixel, depth unchanged.
+    /// Returns the shadings done.
+    fn blend_single(&self, tile: &Tile, bin: &[u32], depth: &[f32], rows: &mut [&mut [[f32; 4]]]) -> u64 {
+        let mut shaded = 0;
+        let tw = tile.width();
+        for &ti in bin {
+            let t = self.tri(ti);
+            let scan = Scan::new(t, 0, self.pattern[0], (tile.x0, tile.x1));
+            covered_single(scan, (tile.x0, tile.y0, tw, tile.y1), |px, py, zz| {
+                let at = (py - tile.y0) as usize * tw + (px - tile.x0) as usize;
+                if zz < depth[at] {
+                    shaded += 1;
+                    if let Some(c) = self.shade_pixel(ti, px, py) {
+                        let o = &mut rows[(py - tile.y0) as usize][(px - tile.x0) as usize];
+                        *o = resolve(std::iter::once(over(c, *o)), 1, self.bg);
+                    }
+                }
+            });
+        }
+        shaded
     }
 
     /// [`TilePlan::Multi`](super::TilePlan::Multi): several samples a pixel. `ids` gets, per
@@ -177,7 +214,8 @@ impl Frame<'_> {
 /// pixels, where the three divisions cost more) test each pixel.
 ///
 /// With `forward`, each pixel that passes gets its colour at once and the id [`FORWARD`].
-/// Without `IDS` (all-Gouraud tiles) no id is written and `ids` is not read.
+/// Without `IDS` (all-Gouraud tiles) no id is written and `ids` is not read. A pixel that
+/// passes the depth test must then pass `passes(px, py)` (the alpha test) to be written.
 #[inline(always)]
 pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
     Scan {
@@ -190,6 +228,7 @@ pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
     depth: &mut [f32],
     ids: &mut [u32],
     mut forward: Option<Forward<T>>,
+    passes: impl Fn(u32, u32) -> bool,
 ) {
     let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
     let bb = t.bbox();
@@ -209,7 +248,7 @@ pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
                 let l = map3(e, |x| (x as f64 * t.inv_area) as f32);
                 let zz = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
                 let at = line + k as usize;
-                if zz < depth[at] {
+                if zz < depth[at] && passes(bx0 + k as u32, py) {
                     depth[at] = zz;
                     if forward.is_some() {
                         if IDS {
@@ -234,6 +273,36 @@ pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
                 let j = m.trailing_zeros();
                 row[j as usize] = T::from_linear(f.planes.at(bx0 + j, py));
                 m &= m - 1;
+            }
+        }
+    }
+}
+
+/// Each pixel centre of the tile `span` that triangle `scan.t` covers, with its depth, handed to
+/// `point(px, py, depth)`: [`visible_single`]'s coverage and depth arithmetic, without the test.
+pub(super) fn covered_single(
+    Scan {
+        t, o, cols: (bx0, bx1), ..
+    }: Scan,
+    (_, y0, _, y1): Span,
+    mut point: impl FnMut(u32, u32, f32),
+) {
+    let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
+    let bb = t.bbox();
+    let n = i64::from(bx1 - bx0);
+    for py in bb[1].max(y0)..bb[3].min(y1) {
+        let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
+        let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
+        let (lo, hi) = covered_span(row, step, n);
+        let mut eb = each3(|i| row[i] + step[i] * lo);
+        for k in lo..hi {
+            if (eb[0] | eb[1] | eb[2]) >= 0 {
+                let e = each3(|i| eb[i] + t.bias(i));
+                let l = map3(e, |x| (x as f64 * t.inv_area) as f32);
+                point(bx0 + k as u32, py, l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2]);
+            }
+            for i in 0..3 {
+                eb[i] += step[i];
             }
         }
     }
