@@ -323,13 +323,4 @@ impl Scene {
         order.extend(blended.into_iter().map(|(_, i)| i));
         order
     }
-
-    /// Whether an object is blended or alpha-tested: what the GPU's compute rasterizer leaves to
-    /// the render pipeline, and the CPU's fast path with several samples a pixel to the
-    /// reference path.
-    pub fn has_translucency(&self) -> bool {
-        self.objects
-            .iter()
-            .any(|o| o.blends() || (o.textured() && o.maps.alpha_cutoff.is_some()))
-    }
 }

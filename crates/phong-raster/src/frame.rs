@@ -22,27 +22,13 @@ pub(crate) enum Path {
     Fast,
 }
 
-impl Path {
-    /// The path that draws `scene`: the fast one unless `options` ask for the reference, or
-    /// the frame has several samples a pixel and an alpha-tested or blended object (the fast
-    /// path's visibility of several samples has no alpha test or blending).
-    pub fn of(scene: &Scene, options: &RenderOptions) -> Path {
-        let multi = scene.image.samples != phong_core::Samples::One;
-        if options.reference || (multi && scene.has_translucency()) {
-            Path::Reference
-        } else {
-            Path::Fast
-        }
-    }
-}
-
 /// How the fast path shades an object's pixels.
 pub(crate) enum Mode {
     /// Interpolated position and normal, the vector kernel; the term shown.
     Phong(Prepared, Term),
     /// Interpolated vertex colours.
     Gouraud,
-    /// A textured object's colour with one sample a pixel, Phong-interpolated: light and maps
+    /// A textured object's colour, Phong-interpolated: light and maps
     /// by the vector sampler where it covers the maps ([`Frame::vector_maps`]), else the light
     /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
     /// of its texture coordinates (maps that change the light, normal, shininess and
@@ -180,8 +166,7 @@ impl<'a> Frame<'a> {
                         // The second set takes the vertex colours' planes, the tangents both.
                         || (second_set && colors)
                         || (m.normal.is_some() && (second_set || colors));
-                    let one_sample = scene.image.samples == phong_core::Samples::One;
-                    if term != Term::Color || !one_sample {
+                    if term != Term::Color {
                         return Mode::Scalar;
                     }
                     let prep = Prepared::new(&scene.lighting, &o.material, &o.shading.options, view);
@@ -340,7 +325,8 @@ pub(crate) fn render<P: Pixel>(
     scratch: &mut Scratch,
 ) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
-    let frame = Frame::build(scene, Path::of(scene, options), Isa::detect(!options.no_avx2), scratch);
+    let path = if options.reference { Path::Reference } else { Path::Fast };
+    let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2), scratch);
     let setup = t0.elapsed();
     let t1 = Instant::now();
     let clock = StageClock::default();
@@ -572,10 +558,9 @@ material = { base = "brass", specular_map = "assets/checker.png", filter = "near
         assert!(frame.vector_maps.iter().all(Option::is_some));
     }
 
-    /// Alpha-tested and blended objects are drawn by the fast path with one sample a pixel: an
-    /// alpha-tested textured object keeps its mode (the vector sampler, which does not read the
-    /// alpha map) and both its corners (for the alpha test) and its planes; a blended one is
-    /// shaded per pixel. With several samples such a frame is the reference path's.
+    /// Alpha-tested and blended objects on the fast path: an alpha-tested textured object keeps
+    /// its mode (the vector sampler, which does not read the alpha map) and both its corners
+    /// (for the alpha test) and its planes; a blended one is shaded per pixel.
     #[test]
     fn alpha_tested_and_blended_objects_take_the_fast_path() {
         let src = r#"
@@ -592,9 +577,7 @@ material = { base = "brass", alpha = 0.5, blend = true }
 shape = "sphere"
 material = { base = "brass", diffuse_map = "assets/bricks.png" }
 "#;
-        let mut scene = parsed(src);
-        let options = RenderOptions::default();
-        assert_eq!(Path::of(&scene, &options), Path::Fast);
+        let scene = parsed(src);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
         assert_eq!(
             frame.visibility,
@@ -608,10 +591,5 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         assert!(object(0).all(|c| c.uv.len() == c.tris.len()));
         assert!(object(0).any(|c| !c.tris.is_empty()));
         assert!(object(2).all(|c| c.corners.is_empty()));
-        scene.image.samples = phong_core::Samples::Four;
-        assert_eq!(Path::of(&scene, &options), Path::Reference);
-        scene.objects.truncate(1);
-        scene.objects[0].maps.alpha_cutoff = None;
-        assert_eq!(Path::of(&scene, &options), Path::Fast);
     }
 }

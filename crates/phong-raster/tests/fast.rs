@@ -1111,7 +1111,8 @@ material = {{ base = "chrome", diffuse_map = "assets/checker.png", filter = "nea
 /// path, both builds: a map whose alpha crosses the cutoff smoothly (magnified and minified,
 /// trilinear), as the diffuse map's alpha and as an alpha map, Phong and Gouraud, vertex
 /// colours; blended objects textured and not, overlapping one another and alpha-tested ones,
-/// one of them alpha-tested too; and a transparent background, alpha compared.
+/// one of them alpha-tested too; one, 4 and 16 samples a pixel; and a transparent background
+/// (4 samples), alpha compared.
 #[test]
 fn fast_path_matches_reference_with_alpha_test_and_blending() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
@@ -1188,7 +1189,11 @@ material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/
     assert!(scene.objects[1].maps.alpha_cutoff == Some(0.5) && !scene.objects[1].blends());
     assert!(scene.objects[2].maps.alpha_cutoff == Some(0.5));
     assert!((4..8).all(|i| scene.objects[i].blends()));
-    assert_fast_matches_reference(&scene, "alpha test and blending");
+    for samples in [Samples::One, Samples::Four, Samples::Sixteen] {
+        scene.image.samples = samples;
+        assert_fast_matches_reference(&scene, &format!("alpha test and blending, {samples:?}"));
+    }
+    scene.image.samples = Samples::Four;
     // A transparent background: where blended objects lie over it, the alpha too.
     scene.image.background = [0.1, 0.2, 0.3, 0.0];
     let reference = render(
@@ -1212,5 +1217,69 @@ material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/
         let b = fast.to_bytes(scene.image.encoding, true);
         let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
         assert!(worst <= 1, "transparent background (no_avx2 {no_avx2}): {worst}/255");
+    }
+}
+
+/// Textured objects with several samples a pixel (one shading per visible pixel and triangle,
+/// at the pixel's centre, by the vector sampler) against the reference path, both builds, 4
+/// and 16 samples: diffuse and specular maps, ambient and emission maps, a bump map, a
+/// shininess map, Gouraud shading, vertex colours, flat shading (per pixel), edges between
+/// textured objects and the background.
+#[test]
+fn fast_path_matches_reference_with_textures_and_several_samples() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let (_dir, tinted) = tinted_quad("phong-multi-maps");
+    let src = format!(
+        r#"
+[image]
+width = 200
+height = 120
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[object]]
+shape = "sphere"
+position = [-2.0, 0.8, 0.0]
+material = {{ base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/bricks_specular.png", uv_scale = [2.0, 1.0] }}
+[[object]]
+shape = "torus"
+position = [0.0, 0.8, -1.0]
+rotation = [60.0, 0.0, 0.0]
+material = {{ base = "jade", emission = [0.2, 0.1, 0.0], ambient_map = "assets/checker.png", emission_map = "assets/bricks.png", uv_scale = [6.0, 2.0] }}
+[[object]]
+shape = "plane"
+position = [2.2, 0.8, 1.0]
+scale = 0.8
+rotation = [70.0, 10.0, 0.0]
+material = {{ base = "ruby", diffuse_map = "assets/bricks.png", bump_map = "assets/bricks_height.png", shininess_map = "assets/checker.png" }}
+[[object]]
+mesh = "{tinted}"
+position = [-2.0, -1.3, 0.5]
+scale = 0.6
+rotation = [0.0, 30.0, 0.0]
+interpolation = "gouraud"
+material = {{ base = "pearl", diffuse_map = "assets/bricks.png" }}
+[[object]]
+shape = "teapot"
+position = [0.3, -1.3, 0.0]
+scale = 0.6
+interpolation = "flat"
+material = {{ base = "gold", diffuse_map = "assets/checker.png" }}
+[[object]]
+shape = "cube"
+position = [2.3, -1.2, 0.0]
+scale = 0.5
+rotation = [30.0, 40.0, 0.0]
+interpolation = "gouraud"
+material = {{ base = "chrome", specular_map = "assets/checker.png", diffuse_map = "assets/bricks.png" }}
+"#,
+        tinted = tinted.display()
+    );
+    let mut scene = phong_scene::parse_scene(&src, &root.join("multi.toml")).unwrap().scene;
+    for samples in [Samples::Four, Samples::Sixteen] {
+        scene.image.samples = samples;
+        assert_fast_matches_reference(&scene, &format!("{samples:?}"));
     }
 }

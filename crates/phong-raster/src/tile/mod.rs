@@ -80,6 +80,8 @@ pub(crate) struct Multi {
     pub starts: Vec<usize>,
     /// Each job's colour.
     pub colors: Vec<[f32; 4]>,
+    /// Each sample's colour, where blended triangles are laid over them.
+    pub samples: Vec<[f32; 4]>,
 }
 
 impl Frame<'_> {

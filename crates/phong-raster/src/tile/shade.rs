@@ -6,7 +6,8 @@
 //! ([`shade_group`]), the rest gathered lane by lane ([`Frame::shade_gathered`]); with
 //! several, one job per visible (pixel, triangle), gathered, then the reference's resolve.
 
-use super::visible::FORWARD;
+use super::reference::over;
+use super::visible::{Bits, FORWARD};
 use super::{Multi, Tile};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
@@ -43,6 +44,10 @@ pub(super) fn run_length(ids: &[u32], k: u32) -> usize {
     }
     n + chunks.remainder().iter().take_while(|&&id| id == k).count()
 }
+
+/// A textured object's jobs of a multi-sample tile: `(pixel, triangle)`, and each one's index
+/// in the tile's jobs.
+type TexturedJobs = (Vec<(u32, u32)>, Vec<u32>);
 
 impl Frame<'_> {
     /// Shades, by object, pixels whose triangles differ lane to lane (each lane gathers its
@@ -199,8 +204,8 @@ impl Frame<'_> {
             let Mode::Textured { prep, .. } = &self.modes[object] else {
                 continue;
             };
-            self.shade_textured_batch(object, prep, items, x0, y0, |(p, _), rgb| {
-                let (r, c) = at(p);
+            self.shade_textured_batch(object, prep, items, x0, y0, |i, rgb| {
+                let (r, c) = at(items[i].0);
                 out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
             });
         }
@@ -211,6 +216,7 @@ impl Frame<'_> {
     /// Shades a textured object's pixels `items` (`(row << 16 | column, triangle id)` in the
     /// tile at `(x0, y0)`): by the vector sampler where it covers the maps, else their light by
     /// the vector kernel and their maps sampled per pixel ([`Frame::textured_color`]).
+    /// `out(i, rgb)` takes item `i`'s colour.
     fn shade_textured_batch(
         &self,
         object: usize,
@@ -218,7 +224,7 @@ impl Frame<'_> {
         items: &[(u32, u32)],
         x0: u32,
         y0: u32,
-        mut out: impl FnMut((u32, u32), [f32; 3]),
+        mut out: impl FnMut(usize, [f32; 3]),
     ) {
         let tinted = !self.scene.objects[object].mesh.colors().is_empty();
         if let Some(maps) = &self.vector_maps[object] {
@@ -233,11 +239,11 @@ impl Frame<'_> {
                     let (x, y) = pixel_centre((x0, y0), p);
                     (x, y, self.planes(id), self.uv_planes(id))
                 },
-                |i, rgb| out(items[i], rgb),
+                &mut out,
                 &mut unsampled,
             );
             for (i, light) in unsampled {
-                out(items[i], self.textured_color(object, items[i], (x0, y0), tinted, light));
+                out(i, self.textured_color(object, items[i], (x0, y0), tinted, light));
             }
             return;
         }
@@ -252,7 +258,7 @@ impl Frame<'_> {
             },
             |i, primary, specular| {
                 out(
-                    items[i],
+                    i,
                     self.textured_color(object, items[i], (x0, y0), tinted, [primary, specular, [0.0; 3]]),
                 )
             },
@@ -308,20 +314,23 @@ impl Frame<'_> {
 
     /// The shading of a tile of several samples a pixel after visibility (`ids`: per sample,
     /// the packed id of its visible triangle or `u32::MAX`): one job per visible (pixel,
-    /// triangle), then the reference's resolve, sample by sample.
+    /// triangle), then `blended` (blended objects' triangles, in drawing order) laid over the
+    /// samples, then the reference's resolve, sample by sample.
     pub(super) fn shade_multi(
         &self,
         tile: &Tile,
         work: &mut Multi,
         rows: &mut [&mut [[f32; 4]]],
+        blended: &[u32],
         mut marks: Marks,
     ) -> u64 {
         let Multi {
+            depth,
             ids,
             jobs,
             starts,
             colors,
-            ..
+            samples,
         } = work;
         let (x0, y0) = (tile.x0, tile.y0);
         let (tw, th) = (tile.width(), tile.height());
@@ -348,12 +357,20 @@ impl Frame<'_> {
         colors.clear();
         colors.resize(jobs.len(), [0.0; 4]);
         let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
+        // Per textured object, its jobs `(pixel, triangle)` and where each is in `jobs`.
+        let mut textured: Vec<TexturedJobs> = vec![Default::default(); self.scene.objects.len()];
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
-            if matches!(self.modes[self.object(ti)], Mode::Scalar) {
-                let (px, py) = at(pixel);
-                colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.bg);
-            } else {
-                batches[self.object(ti)].push(k as u32);
+            match self.modes[self.object(ti)] {
+                Mode::Scalar => {
+                    let (px, py) = at(pixel);
+                    colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.bg);
+                }
+                Mode::Textured { .. } => {
+                    let (items, at) = &mut textured[self.object(ti)];
+                    items.push((pixel, ti));
+                    at.push(k as u32);
+                }
+                _ => batches[self.object(ti)].push(k as u32),
             }
         }
         self.shade_gathered(
@@ -365,21 +382,63 @@ impl Frame<'_> {
             },
             |k, rgb| colors[k as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
         );
-        marks.resolving();
+        for (object, (items, at)) in textured.iter().enumerate() {
+            if let Mode::Textured { prep, .. } = &self.modes[object] {
+                self.shade_textured_batch(object, prep, items, x0, y0, |i, rgb| {
+                    colors[at[i] as usize] = [rgb[0], rgb[1], rgb[2], 1.0];
+                });
+            }
+        }
+        // Sample `s` of `pixel`: its visible triangle's colour, or the background.
+        let sample = |pixel: usize, s: usize| {
+            let id = ids[pixel * ns + s];
+            if id == u32::MAX {
+                self.bg
+            } else {
+                let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+                colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+            }
+        };
         let out = rows.iter_mut().flat_map(|r| r.iter_mut());
-        for (pixel, o) in out.enumerate() {
-            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
-            let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
-                if id == u32::MAX {
-                    self.bg
-                } else {
-                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+        if blended.is_empty() {
+            marks.resolving();
+            for (pixel, o) in out.enumerate() {
+                *o = resolve((0..ns).map(|s| sample(pixel, s)), ns, self.bg);
+            }
+            tile.clock.add(marks);
+            return jobs.len() as u64;
+        }
+        // Blended triangles over the samples, as the reference path lays them.
+        samples.clear();
+        samples.extend(
+            (0..tw * th)
+                .flat_map(|pixel| (0..ns).map(move |s| (pixel, s)))
+                .map(|(p, s)| sample(p, s)),
+        );
+        let mut shaded = jobs.len() as u64;
+        for &ti in blended {
+            self.covered_multi(self.tri(ti), tile, |px, py, base, zs, covered| {
+                let mut mask = 0u32;
+                for s in Bits(covered) {
+                    mask |= u32::from(zs[s] < depth[base + s]) << s;
+                }
+                if mask == 0 {
+                    return;
+                }
+                shaded += 1;
+                if let Some(c) = self.shade_pixel(ti, px, py) {
+                    for s in Bits(mask) {
+                        samples[base + s] = over(c, samples[base + s]);
+                    }
                 }
             });
-            *o = resolve(samples, ns, self.bg);
+        }
+        marks.resolving();
+        for (px, o) in samples.chunks_exact(ns).zip(out) {
+            *o = resolve(px.iter().copied(), ns, self.bg);
         }
         tile.clock.add(marks);
-        jobs.len() as u64
+        shaded
     }
 
     /// Perspective-correct weights of triangle `t`'s vertices at the centre of pixel

@@ -168,8 +168,34 @@ impl Frame<'_> {
         ids.clear();
         ids.resize(tw * tile.height() * ns, u32::MAX);
         let mut offsets = [[0i64; 3]; 16];
-        for &ti in tile.bin {
+        // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque samples.
+        let mut blended = tile.bin.len();
+        for (k, &ti) in tile.bin.iter().enumerate() {
             let t = self.tri(ti);
+            match self.visibility[self.object(ti)] {
+                Visibility::Blended => {
+                    blended = k;
+                    break;
+                }
+                Visibility::AlphaTested => {
+                    // As the reference: the samples nearer than what they hold, then the alpha
+                    // test once at the pixel's centre.
+                    self.covered_multi(t, tile, |px, py, base, zs, covered| {
+                        let mut mask = 0u32;
+                        for s in Bits(covered) {
+                            mask |= u32::from(zs[s] < depth[base + s]) << s;
+                        }
+                        if mask != 0 && self.alpha_passes(ti, px, py) {
+                            for s in Bits(mask) {
+                                depth[base + s] = zs[s];
+                                ids[base + s] = ti;
+                            }
+                        }
+                    });
+                    continue;
+                }
+                Visibility::Opaque => {}
+            }
             // Per sample an offset from the pixel corner, per pixel a step of `a·256`: exact
             // integer adds, the reference's values.
             for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
@@ -204,7 +230,53 @@ impl Frame<'_> {
             }
         }
         marks.shading();
-        self.shade_multi(tile, work, rows, marks)
+        self.shade_multi(tile, work, rows, &tile.bin[blended..], marks)
+    }
+
+    /// Each pixel of `tile` with a sample that triangle `t` covers, handed to
+    /// `pixel(px, py, base, depths, covered)`: `base` indexes its first sample in the tile's
+    /// buffers, `covered` has bit `s` set for each covered sample and `depths[s]` its depth
+    /// ([`Frame::tile_multi`]'s arithmetic, without the depth test).
+    pub(super) fn covered_multi(&self, t: &Tri, tile: &Tile, mut pixel: impl FnMut(u32, u32, usize, &[f32; 16], u32)) {
+        let Tile { x0, y0, x1, y1, .. } = *tile;
+        let (tw, ns) = (tile.width(), self.pattern.len());
+        let mut offsets = [[0i64; 3]; 16];
+        for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
+            *o = each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
+        }
+        let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
+        let bb = t.bbox();
+        let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
+        let mut zs = [0f32; 16];
+        for py in bb[1].max(y0)..bb[3].min(y1) {
+            let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
+            let mut row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i]);
+            for px in bx0..bx1 {
+                let mut covered = 0u32;
+                for (s, o) in offsets[..ns].iter().enumerate() {
+                    let eb = [row[0] + o[0], row[1] + o[1], row[2] + o[2]];
+                    if (eb[0] | eb[1] | eb[2]) < 0 {
+                        continue;
+                    }
+                    let e = each3(|i| eb[i] + t.bias(i));
+                    let l = map3(e, |x| (x as f64 * t.inv_area) as f32);
+                    zs[s] = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];
+                    covered |= 1 << s;
+                }
+                if covered != 0 {
+                    pixel(
+                        px,
+                        py,
+                        ((py - y0) as usize * tw + (px - x0) as usize) * ns,
+                        &zs,
+                        covered,
+                    );
+                }
+                for i in 0..3 {
+                    row[i] += step[i];
+                }
+            }
+        }
     }
 }
 
@@ -305,5 +377,20 @@ pub(super) fn covered_single(
                 eb[i] += step[i];
             }
         }
+    }
+}
+
+/// The set bits of a mask, lowest first.
+pub(super) struct Bits(pub u32);
+
+impl Iterator for Bits {
+    type Item = usize;
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        (self.0 != 0).then(|| {
+            let s = self.0.trailing_zeros() as usize;
+            self.0 &= self.0 - 1;
+            s
+        })
     }
 }
