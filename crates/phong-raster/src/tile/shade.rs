@@ -325,12 +325,11 @@ impl Frame<'_> {
         mut marks: Marks,
     ) -> u64 {
         let Multi {
-            depth,
             ids,
             jobs,
             starts,
             colors,
-            samples,
+            ..
         } = work;
         let (x0, y0) = (tile.x0, tile.y0);
         let (tw, th) = (tile.width(), tile.height());
@@ -389,32 +388,59 @@ impl Frame<'_> {
                 });
             }
         }
-        // Sample `s` of `pixel`: its visible triangle's colour, or the background.
-        let sample = |pixel: usize, s: usize| {
-            let id = ids[pixel * ns + s];
-            if id == u32::MAX {
-                self.bg
-            } else {
-                let mine = &jobs[starts[pixel]..starts[pixel + 1]];
-                colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
-            }
-        };
-        let out = rows.iter_mut().flat_map(|r| r.iter_mut());
-        if blended.is_empty() {
-            marks.resolving();
-            for (pixel, o) in out.enumerate() {
-                *o = resolve((0..ns).map(|s| sample(pixel, s)), ns, self.bg);
-            }
-            tile.clock.add(marks);
-            return jobs.len() as u64;
+        if !blended.is_empty() {
+            return self.blend_multi(tile, work, rows, blended, marks);
         }
-        // Blended triangles over the samples, as the reference path lays them.
+        marks.resolving();
+        let out = rows.iter_mut().flat_map(|r| r.iter_mut());
+        for (pixel, o) in out.enumerate() {
+            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+            let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
+                if id == u32::MAX {
+                    self.bg
+                } else {
+                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+                }
+            });
+            *o = resolve(samples, ns, self.bg);
+        }
+        tile.clock.add(marks);
+        jobs.len() as u64
+    }
+
+    /// [`Frame::shade_multi`]'s end where the tile has `blended` triangles (blended objects', in
+    /// drawing order): each sample's colour, the blended triangles laid over the samples they
+    /// cover nearer than the opaque depth (as the reference path lays them), then the resolve.
+    /// Returns the shadings done. (Apart, so that the opaque tiles' code stays as it was.)
+    #[inline(never)]
+    fn blend_multi(
+        &self,
+        tile: &Tile,
+        work: &mut Multi,
+        rows: &mut [&mut [[f32; 4]]],
+        blended: &[u32],
+        mut marks: Marks,
+    ) -> u64 {
+        let Multi {
+            depth,
+            ids,
+            jobs,
+            starts,
+            colors,
+            samples,
+        } = work;
+        let ns = self.pattern.len();
         samples.clear();
-        samples.extend(
-            (0..tw * th)
-                .flat_map(|pixel| (0..ns).map(move |s| (pixel, s)))
-                .map(|(p, s)| sample(p, s)),
-        );
+        for (pixel, ids) in ids.chunks_exact(ns).enumerate() {
+            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+            samples.extend(ids.iter().map(|&id| {
+                if id == u32::MAX {
+                    self.bg
+                } else {
+                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+                }
+            }));
+        }
         let mut shaded = jobs.len() as u64;
         for &ti in blended {
             self.covered_multi(self.tri(ti), tile, |px, py, base, zs, covered| {
@@ -434,6 +460,7 @@ impl Frame<'_> {
             });
         }
         marks.resolving();
+        let out = rows.iter_mut().flat_map(|r| r.iter_mut());
         for (px, o) in samples.chunks_exact(ns).zip(out) {
             *o = resolve(px.iter().copied(), ns, self.bg);
         }

@@ -237,6 +237,7 @@ impl Frame<'_> {
     /// `pixel(px, py, base, depths, covered)`: `base` indexes its first sample in the tile's
     /// buffers, `covered` has bit `s` set for each covered sample and `depths[s]` its depth
     /// ([`Frame::tile_multi`]'s arithmetic, without the depth test).
+    #[inline(never)]
     pub(super) fn covered_multi(&self, t: &Tri, tile: &Tile, mut pixel: impl FnMut(u32, u32, usize, &[f32; 16], u32)) {
         let Tile { x0, y0, x1, y1, .. } = *tile;
         let (tw, ns) = (tile.width(), self.pattern.len());
