@@ -3,7 +3,7 @@
 //! render itself (setup, then the tiles).
 
 use crate::fixed::pattern;
-use crate::setup::{Chunk, Corners, Extra, ID_INDEX_BITS, SampleSpan, Scratch, Tri};
+use crate::setup::{Chunk, Corners, Extra, ID_INDEX_BITS, Keep, SampleSpan, Scratch, Tri};
 use crate::simd::{Batch, Isa, Planes, Prepared, Term, VectorMaps};
 use crate::stats::{RenderStats, StageClock};
 use crate::target::{Pixel, resolve};
@@ -179,10 +179,10 @@ impl<'a> Frame<'a> {
                             },
                             per_vertex: false,
                         },
-                        // Gouraud: only the diffuse and specular maps apply, by the sampler
-                        // (`VectorMaps::lit_per_vertex`); the second set takes the colours'
-                        // planes.
-                        Interpolation::Gouraud
+                        // Gouraud and flat: only the diffuse and specular maps apply, by the
+                        // sampler (`VectorMaps::lit_per_vertex`); the second set takes the
+                        // colours' planes.
+                        Interpolation::Gouraud | Interpolation::Flat
                             if !(second_set && colors)
                                 && VectorMaps::new(m).and_then(VectorMaps::lit_per_vertex).is_some() =>
                         {
@@ -196,8 +196,8 @@ impl<'a> Frame<'a> {
                         Prepared::new(&scene.lighting, &o.material, &o.shading.options, view),
                         term,
                     ),
-                    Interpolation::Gouraud => Mode::Gouraud,
-                    Interpolation::Flat => Mode::Scalar,
+                    // Flat: the triangle's colour, planes without slope.
+                    Interpolation::Gouraud | Interpolation::Flat => Mode::Gouraud,
                 }
             })
             .collect();
@@ -250,12 +250,21 @@ impl<'a> Frame<'a> {
         // Opaque objects first, then blended ones back to front (the bins keep this order).
         for oi in scene.draw_order() {
             let obj = &scene.objects[oi];
+            let alpha_tested = frame.visibility[oi] == Visibility::AlphaTested;
             let chunks = if path == Path::Reference || matches!(frame.modes[oi], Mode::Scalar) {
-                frame.setup_object_full(oi, obj, clip_from_world, false)
-            } else if frame.visibility[oi] == Visibility::AlphaTested {
-                // The alpha test reads the reference's coordinates (`Corners`); the shading,
-                // the planes.
-                frame.setup_object_full(oi, obj, clip_from_world, true)
+                let keep = Keep {
+                    corners: true,
+                    planes: false,
+                };
+                frame.setup_object_full(oi, obj, clip_from_world, keep)
+            } else if alpha_tested || obj.shading.interpolation == Interpolation::Flat {
+                // The alpha test reads the reference's coordinates (`Corners`), the shading the
+                // planes; flat triangles' colours are the reference's too (one per triangle).
+                let keep = Keep {
+                    corners: alpha_tested,
+                    planes: true,
+                };
+                frame.setup_object_full(oi, obj, clip_from_world, keep)
             } else {
                 frame.setup_object_fast(oi, obj, clip_from_world, scratch, &spare)
             };
@@ -485,8 +494,8 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
 
     /// A Gouraud-shaded textured object is drawn by the vector sampler from its vertices'
     /// primary and specular colours (only its diffuse and specular maps apply, so its other
-    /// maps do not matter, nor does their filter); with a metallic-roughness map, vertex colours
-    /// beside a second set, or flat shading, it is shaded per pixel.
+    /// maps do not matter, nor does their filter), a flat-shaded one from its triangles'; with
+    /// a metallic-roughness map, or vertex colours beside a second set, it is shaded per pixel.
     #[test]
     fn gouraud_textured_objects_take_the_vector_sampler() {
         let src = r#"
@@ -531,8 +540,26 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
             Extra::Colors,
             "no tangents: the normal map does not apply"
         );
-        assert!(matches!(frame.modes[2], Mode::Scalar));
+        assert!(matches!(frame.modes[2], Mode::Textured { per_vertex: true, .. }));
         assert!(matches!(frame.modes[3], Mode::Scalar));
+        // A flat triangle's planes give its one colour everywhere (perspective-correct: the
+        // colour over `w`, divided by `1/w`), and triangles differ.
+        let flat = frame.tris.iter().filter(|c| c.object == 2);
+        let planes: Vec<&Planes> = flat.flat_map(|c| &c.planes).collect();
+        assert!(!planes.is_empty());
+        let at = |k: [f32; 3], (dx, dy): (f32, f32)| k[0] + k[1] * dx + k[2] * dy;
+        let colour = |p: &Planes, d| at(p.attr[0], d) / at(p.inv_w, d);
+        for p in &planes {
+            let c = colour(p, (0.0, 0.0));
+            for d in [(3.0, 0.0), (0.0, -5.0), (7.5, 2.5)] {
+                assert!((colour(p, d) - c).abs() <= 1e-4, "{c} vs {}", colour(p, d));
+            }
+        }
+        assert!(
+            planes
+                .iter()
+                .any(|p| colour(p, (0.0, 0.0)) != colour(planes[0], (0.0, 0.0)))
+        );
     }
 
     /// Nearest filtering (`GL_NEAREST`, no mipmaps) is one gather of level 0: such maps take

@@ -1179,7 +1179,7 @@ material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/
     let texels: Vec<[u16; 4]> = (0..w * h)
         .map(|i| {
             let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
-            let a = 0.5 + 0.5 * (6.283 * x).sin() * (3.1416 * y).cos();
+            let a = 0.5 + 0.5 * (std::f32::consts::TAU * x).sin() * (std::f32::consts::PI * y).cos();
             [r.f(), r.f(), r.f(), a].map(|c| (c * 255.0).round() as u16 * 257)
         })
         .collect();
@@ -1221,10 +1221,11 @@ material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/
 }
 
 /// Textured objects with several samples a pixel (one shading per visible pixel and triangle,
-/// at the pixel's centre, by the vector sampler) against the reference path, both builds, 4
-/// and 16 samples: diffuse and specular maps, ambient and emission maps, a bump map, a
-/// shininess map, Gouraud shading, vertex colours, flat shading (per pixel), edges between
-/// textured objects and the background.
+/// at the pixel's centre, by the vector sampler), and flat-shaded objects (their triangles'
+/// colours in planes without slope), against the reference path, both builds, 1, 4 and 16
+/// samples: diffuse and specular maps, ambient and emission maps, a bump map, a shininess map,
+/// Gouraud shading, vertex colours, flat shading textured and not, two-sided, edges between
+/// objects and the background.
 #[test]
 fn fast_path_matches_reference_with_textures_and_several_samples() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
@@ -1274,11 +1275,28 @@ scale = 0.5
 rotation = [30.0, 40.0, 0.0]
 interpolation = "gouraud"
 material = {{ base = "chrome", specular_map = "assets/checker.png", diffuse_map = "assets/bricks.png" }}
+[[object]]
+shape = "torus"
+position = [-0.6, -0.2, 2.5]
+scale = 0.5
+rotation = [75.0, 0.0, 0.0]
+interpolation = "flat"
+material = "ruby"
+[[object]]
+shape = "plane"
+position = [1.0, 0.1, 2.0]
+scale = 0.6
+rotation = [-80.0, 20.0, 0.0]
+interpolation = "flat"
+material = {{ base = "silver", diffuse_map = "assets/bricks.png" }}
 "#,
         tinted = tinted.display()
     );
     let mut scene = phong_scene::parse_scene(&src, &root.join("multi.toml")).unwrap().scene;
-    for samples in [Samples::Four, Samples::Sixteen] {
+    for o in &mut scene.objects[6..] {
+        o.shading.options.two_sided = true;
+    }
+    for samples in [Samples::One, Samples::Four, Samples::Sixteen] {
         scene.image.samples = samples;
         assert_fast_matches_reference(&scene, &format!("{samples:?}"));
     }

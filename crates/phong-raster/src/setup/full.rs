@@ -14,10 +14,10 @@ use phong_core::{Color, Interpolation, Object};
 use rayon::prelude::*;
 
 impl Frame<'_> {
-    /// Sets up object `oi` with [`Corners`] for scalar shading (and with `planes`, its
-    /// fast-path planes too: an alpha-tested object), in chunks of [`SETUP_CHUNK`] input
-    /// triangles, each binned.
-    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4, planes: bool) -> Vec<Chunk> {
+    /// Sets up object `oi` with what `keep` asks for: [`Corners`] for scalar shading (or the
+    /// alpha test), fast-path planes (a flat-shaded or alpha-tested object on the fast path),
+    /// in chunks of [`SETUP_CHUNK`] input triangles, each binned.
+    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4, keep: Keep) -> Vec<Chunk> {
         let scene = self.scene;
         let interpolation = obj.shading.interpolation;
         let two_sided = obj.shading.options.two_sided;
@@ -83,7 +83,7 @@ impl Frame<'_> {
                 if let Some((t, p, c, uv)) = r {
                     out.tris.push(t);
                     out.corners.extend(c);
-                    if planes {
+                    if keep.planes {
                         out.planes.push(p);
                         out.uv.extend(uv);
                     }
@@ -105,21 +105,15 @@ impl Frame<'_> {
                 });
                 if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
                     let proj = tri.map(|i| projected[i as usize]);
-                    push(self.setup(t, Some(proj), flat, oi as u32, Keep { corners: true, planes }));
+                    push(self.setup(t, Some(proj), flat, oi as u32, keep));
                     continue;
                 }
                 match clip_triangle(&t) {
                     Clipped::Rejected => {}
-                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, Keep { corners: true, planes })),
+                    Clipped::Inside => push(self.setup(t, None, flat, oi as u32, keep)),
                     Clipped::Polygon(p) => {
                         for i in 1..p.len() - 1 {
-                            push(self.setup(
-                                [p[0], p[i], p[i + 1]],
-                                None,
-                                flat,
-                                oi as u32,
-                                Keep { corners: true, planes },
-                            ));
+                            push(self.setup([p[0], p[i], p[i + 1]], None, flat, oi as u32, keep));
                         }
                     }
                 }

@@ -363,7 +363,8 @@ impl Frame<'_> {
 
     /// Projects (unless `proj` is given), snaps, culls and sets up one triangle of clip-space
     /// vertices, with what `keep` asks for: its [`Corners`] for scalar shading, its fast-path
-    /// [`Planes`] (and a textured object's [`uv_planes`]).
+    /// [`Planes`] (and a textured object's [`uv_planes`]). `flat`: a flat-shaded triangle's
+    /// colours, front and back.
     pub(crate) fn setup(
         &self,
         v: [ClipVertex; 3],
@@ -394,14 +395,22 @@ impl Frame<'_> {
                 let attrs = [v.map(|v| v.world), v.map(|v| v.normal * sign)];
                 plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
             }
-            Mode::Gouraud => {
-                let c = v.map(|v| if s.front { v.color } else { v.color_back });
-                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, [Vec3::ZERO; 3]], true)
-            }
-            Mode::Textured { per_vertex: true, .. } => {
+            Mode::Gouraud | Mode::Textured { per_vertex: true, .. } => {
+                // The colours seen at the vertices (Gouraud), or the triangle's (flat: planes
+                // with no slope, `Σ a_i = Σ b_i = 0`).
                 let side = usize::from(!s.front);
-                let c = v.map(|v| if s.front { v.color } else { v.color_back });
-                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, v.map(|v| v.spec[side])], false)
+                let (c, spec) = match flat {
+                    Some(f) => {
+                        let (c, spec, _) = f[side];
+                        ([Vec3::from(c.to_array()); 3], [Vec3::from(spec.to_array()); 3])
+                    }
+                    None => (
+                        v.map(|v| if s.front { v.color } else { v.color_back }),
+                        v.map(|v| v.spec[side]),
+                    ),
+                };
+                let colour_only = matches!(mode, Mode::Gouraud);
+                plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, [c, spec], colour_only)
             }
         };
         Some((s.tri, planes, corners, uv))
