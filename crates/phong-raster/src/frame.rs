@@ -26,7 +26,7 @@ pub(crate) enum Path {
 pub(crate) enum Mode {
     /// Interpolated position and normal, the vector kernel; the term shown.
     Phong(Prepared, Term),
-    /// Interpolated vertex colours.
+    /// Interpolated vertex colours (flat: the triangle's colour).
     Gouraud,
     /// A textured object's colour, Phong-interpolated: light and maps
     /// by the vector sampler where it covers the maps ([`Frame::vector_maps`]), else the light
@@ -37,8 +37,8 @@ pub(crate) enum Mode {
     /// primary and specular colours, which the triangle's planes carry instead of position and
     /// normal.
     Textured { prep: Prepared, per_vertex: bool },
-    /// One pixel at a time, as the reference path (flat shading, textured objects the vector
-    /// kernels do not cover, normal and depth outputs, blended objects).
+    /// One pixel at a time, as the reference path (textured objects the vector kernels do not
+    /// cover, normal and depth outputs, blended objects).
     Scalar,
 }
 

@@ -1,7 +1,8 @@
-//! The setup of an object for the reference path, or for the fast path's scalar shading (flat,
-//! textured, normal and depth outputs): every vertex in full, lit per vertex (Gouraud) or per
-//! triangle (flat) by `Object::shade` (a textured object: its primary and specular colours,
-//! for the texels applied per pixel), [`Corners`] kept.
+//! The setup of an object for the reference path, for the fast path's scalar shading
+//! (textured objects it does not cover, normal and depth outputs, blended objects), and for
+//! its flat-shaded and alpha-tested objects: every vertex in full, lit per vertex (Gouraud) or
+//! per triangle (flat) by `Object::vertex_light` (a textured object: its primary and specular
+//! colours, for the texels applied per pixel), [`Corners`] and planes kept as asked.
 
 use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
