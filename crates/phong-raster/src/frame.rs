@@ -33,9 +33,9 @@ pub(crate) enum Mode {
     /// by the vector kernel (`shade_batch_lit`) and the maps sampled per pixel from the planes
     /// of its texture coordinates (maps that change the light, normal, shininess and
     /// metallic-roughness maps, need the vector sampler: without it they are [`Mode::Scalar`]'s).
-    /// With `per_vertex` (Gouraud, always with the vector sampler), the vertices are lit into
-    /// primary and specular colours, which the triangle's planes carry instead of position and
-    /// normal.
+    /// With `per_vertex` (Gouraud and flat, always with the vector sampler), the vertices (flat:
+    /// the triangle) are lit into primary and specular colours, which the triangle's planes
+    /// carry instead of position and normal.
     Textured { prep: Prepared, per_vertex: bool },
     /// One pixel at a time, as the reference path (textured objects the vector kernels do not
     /// cover, normal and depth outputs, blended objects).

@@ -551,16 +551,22 @@ impl Frame<'_> {
     /// Whether triangle `id` (an alpha-tested object's) passes the alpha test at the centre of
     /// pixel `(px, py)`: the alpha [`Frame::shade_pixel`] tests, from the same coordinates.
     pub(crate) fn alpha_passes(&self, id: u32, px: u32, py: u32) -> bool {
+        let obj = &self.scene.objects[self.object(id)];
+        !obj.maps
+            .discards(obj.maps.alpha_sets(&obj.material, &self.uv_sets(id, px, py)))
+    }
+
+    /// Triangle `id`'s two sets of texture coordinates (the first twice where no map reads the
+    /// second) at the centre of pixel `(px, py)`, as [`Frame::uv_at`] gives them.
+    fn uv_sets(&self, id: u32, px: u32, py: u32) -> [[Vec2; 3]; 2] {
         let (t, corners) = (self.tri(id), self.corners(id));
-        let object = self.object(id);
-        let obj = &self.scene.objects[object];
         let first = Self::uv_at(t, corners, px, py, |v| v.uv);
-        let second = if self.second_sets[object] {
+        let second = if self.second_sets[self.object(id)] {
             Self::uv_at(t, corners, px, py, |v| v.uv1)
         } else {
             first
         };
-        !obj.maps.discards(obj.maps.alpha_sets(&obj.material, &[first, second]))
+        [first, second]
     }
 
     /// [`Frame::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
@@ -571,16 +577,11 @@ impl Frame<'_> {
         let (t, corners) = (self.tri(id), self.corners(id));
         let object = self.object(id);
         let obj = &self.scene.objects[object];
-        let first = Self::uv_at(t, corners, px, py, |v| v.uv);
-        let second = if self.second_sets[object] {
-            Self::uv_at(t, corners, px, py, |v| v.uv1)
-        } else {
-            first
-        };
+        let sets = self.uv_sets(id, px, py);
         let q = Self::weights(t, corners, px, py);
         let v = &corners.v;
         let lerp3 = |f: &dyn Fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
-        let mut texels = obj.maps.sample_sets(&[first, second]);
+        let mut texels = obj.maps.sample_sets(&sets);
         if !obj.mesh.colors().is_empty() {
             let c = lerp3(&|v| v.rgb);
             texels = texels.tinted(Color::new(c.x, c.y, c.z));
