@@ -128,8 +128,9 @@ pub fn load_model_full(
     // A glTF's external buffers, beside it (each added to `sources`).
     let dir = path.parent().unwrap_or(Path::new(""));
     let read = std::cell::RefCell::new(Vec::new());
+    let moved = std::cell::RefCell::new(Vec::new());
     let resource = |uri: &str| -> Result<Vec<u8>, String> {
-        let p = dir.join(uri);
+        let p = crate::obj::found(dir, uri, true, path, &moved);
         read.borrow_mut().push(p.clone());
         read_bounded(&p, MAX_MODEL_BYTES, WHAT).map_err(|e| match e {
             Error::Read { source, .. } => format!("cannot read {}: {source}", p.display()),
@@ -137,6 +138,7 @@ pub fn load_model_full(
         })
     };
     let model = read_bytes(path, &bytes, format, &resource, warnings);
+    warnings.extend(moved.into_inner());
     sources.extend(read.into_inner());
     model
 }

@@ -4,7 +4,7 @@
 
 use crate::Error;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The bytes of `path`, a regular file of at most `limit` bytes (`what` names the kind and its
 /// limit's constant in messages).
@@ -66,6 +66,118 @@ pub(crate) fn text_of(path: &Path, bytes: Vec<u8>, what: &str) -> Result<String,
     })
 }
 
+/// Where a file that a model names is, looked up from the model's folder `dir`: the name as
+/// written (`\\` read as `/`); else, for a name written on another machine (an absolute
+/// Windows path, another letter case, the images moved into a subfolder), the file it means:
+/// the path with each folder and file matched regardless of case, then a file of its name
+/// (regardless of case) in `dir` or in its subfolders two deep, as Blender's OBJ importer
+/// searches (where `by_name`). The second value is true where the file was found elsewhere than written (the
+/// caller warns). Nothing found: the path as written, for the caller's error to name.
+pub(crate) fn locate(dir: &Path, name: &str, by_name: bool) -> (PathBuf, bool) {
+    let written = name.replace('\\', "/");
+    let as_written = dir.join(&written);
+    if as_written.exists() {
+        return (as_written, false);
+    }
+    // A model named without a folder is in the working one.
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let found = matched_case(dir, &written).or_else(|| {
+        if !by_name {
+            return None;
+        }
+        let base = Path::new(&written).file_name()?.to_str()?;
+        by_file_name(dir, base)
+    });
+    match found {
+        Some(p) => (p, true),
+        None => (as_written, false),
+    }
+}
+
+/// The entries of `dir` in name order (none where it cannot be read), each with whether it
+/// is a folder; at most `budget` entries read, `budget` reduced by those read.
+fn entries(dir: &Path, budget: &mut usize) -> Vec<(String, PathBuf, bool)> {
+    let Ok(read) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for e in read.flatten() {
+        if *budget == 0 {
+            break;
+        }
+        *budget -= 1;
+        let Ok(name) = e.file_name().into_string() else {
+            continue;
+        };
+        // `metadata` follows links: a link to a folder is searched as one.
+        let dir = std::fs::metadata(e.path()).is_ok_and(|m| m.is_dir());
+        out.push((name, e.path(), dir));
+    }
+    out.sort();
+    out
+}
+
+/// Entries read at most while looking for a file: a model in a large folder (a home folder)
+/// costs a bounded look, not a walk of the disk.
+const SEARCH_BUDGET: usize = 4096;
+
+/// `relative` (`/`-separated) from `dir` with each component matched regardless of ASCII
+/// case (`.` and `..` as they are); `None` for an absolute path or where a component has no
+/// match.
+fn matched_case(dir: &Path, relative: &str) -> Option<PathBuf> {
+    if relative.starts_with('/') {
+        return None;
+    }
+    let mut budget = SEARCH_BUDGET;
+    let mut at = dir.to_path_buf();
+    let parts: Vec<&str> = relative.split('/').filter(|c| !c.is_empty() && *c != ".").collect();
+    for (i, part) in parts.iter().enumerate() {
+        let last = i + 1 == parts.len();
+        if *part == ".." {
+            at.push("..");
+            continue;
+        }
+        if at.join(part).exists() {
+            at.push(part);
+            continue;
+        }
+        let (_, path, _) = entries(&at, &mut budget)
+            .into_iter()
+            .find(|(n, _, is_dir)| n.eq_ignore_ascii_case(part) && (*is_dir != last))?;
+        at = path;
+    }
+    at.is_file().then_some(at)
+}
+
+/// A file named `base` regardless of ASCII case in `dir` or its subfolders up to two deep:
+/// the shallowest, one of exactly that name first, then in name order.
+fn by_file_name(dir: &Path, base: &str) -> Option<PathBuf> {
+    let mut budget = SEARCH_BUDGET;
+    let mut level = vec![dir.to_path_buf()];
+    for _depth in 0..3 {
+        let mut next = Vec::new();
+        let mut found: Vec<(bool, PathBuf)> = Vec::new();
+        for d in &level {
+            for (name, path, is_dir) in entries(d, &mut budget) {
+                if is_dir {
+                    next.push(path);
+                } else if name.eq_ignore_ascii_case(base) {
+                    found.push((name != base, path));
+                }
+            }
+        }
+        if let Some((_, p)) = found.into_iter().min() {
+            return Some(p);
+        }
+        level = next;
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,6 +208,61 @@ mod tests {
         std::fs::write(&big, b"a = 1\nb = \"\xff\"\n").unwrap();
         let e = read_text(&big, 1024, "scene").unwrap_err().to_string();
         assert!(e.contains(":2:6:") && e.contains("not UTF-8"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Names written on another machine find their file; the name as written wins where it
+    /// is there; nothing found gives the name as written back.
+    #[test]
+    fn locate_finds_files_named_from_another_machine() {
+        let dir = std::env::temp_dir().join(format!("phong-locate-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for f in [
+            "Textures/Skin.PNG",
+            "a/b/deep.png",
+            "a/b/c/deeper.png",
+            "x.png",
+            "sub/X.png",
+            "sub/x.png",
+        ] {
+            let p = dir.join(f);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(&p, f).unwrap();
+        }
+        let at = |name: &str| locate(&dir, name, true);
+        let rel = |p: PathBuf| p.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/");
+        // As written (backslashes are separators): not moved.
+        assert_eq!(at("Textures\\Skin.PNG"), (dir.join("Textures/Skin.PNG"), false));
+        assert_eq!(at("x.png"), (dir.join("x.png"), false));
+        // Another letter case, folder and file.
+        let (p, moved) = at("textures/skin.png");
+        assert_eq!((rel(p), moved), ("Textures/Skin.PNG".to_string(), true));
+        // An absolute Windows path, or a folder that is not there: the file name, searched.
+        let (p, moved) = at("C:\\Users\\bob\\Desktop\\SKIN.png");
+        assert_eq!((rel(p), moved), ("Textures/Skin.PNG".to_string(), true));
+        let (p, moved) = at("/home/bob/model/maps/deep.png");
+        assert_eq!((rel(p), moved), ("a/b/deep.png".to_string(), true));
+        // Two deep at most.
+        assert_eq!(at("deeper.png"), (dir.join("deeper.png"), false));
+        // The shallowest, then the exact name: `x.png` beside the model, `sub/x.png` below it.
+        let (p, _) = at("elsewhere/x.png");
+        assert_eq!(rel(p), "x.png");
+        std::fs::remove_file(dir.join("x.png")).unwrap();
+        let (p, _) = at("elsewhere/x.png");
+        assert_eq!(rel(p), "sub/x.png");
+        let (p, _) = at("elsewhere/X.png");
+        assert_eq!(rel(p), "sub/X.png");
+        // Not searched by name where the caller says so (another case still found).
+        assert!(at("x/deep.png").1);
+        assert_eq!(locate(&dir, "x/deep.png", false), (dir.join("x/deep.png"), false));
+        assert!(locate(&dir, "a/B/DEEP.png", false).1);
+        // Nothing of that name.
+        assert_eq!(at("maps/none.png"), (dir.join("maps/none.png"), false));
+        // A model given without a folder looks in the working one.
+        assert_eq!(
+            locate(Path::new(""), "no-such-file.png", true),
+            (PathBuf::from("no-such-file.png"), false)
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

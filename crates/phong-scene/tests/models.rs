@@ -706,6 +706,94 @@ end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 51\n3 0 1 2\n";
     assert_eq!(c, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.2]]);
 }
 
+/// Models made on another machine: an MTL named in another case, a texture named by an
+/// absolute Windows path and one in another case, a glTF's buffer and image moved into a
+/// folder: each file is found by its name, with a warning naming what was read; the maps are
+/// the images' (their texels compared).
+#[test]
+fn files_named_on_another_machine_are_found() {
+    let d = dir("moved");
+    let red = phong_core::Image::new(2, 2, [1.0, 0.0, 0.0, 1.0]).unwrap();
+    let green = phong_core::Image::new(2, 2, [0.0, 1.0, 0.0, 1.0]).unwrap();
+    write(
+        &d,
+        "Maps/Red.PNG",
+        &phong_scene::encode_png(&red, phong_core::Encoding::Linear).unwrap(),
+    );
+    write(
+        &d,
+        "maps/green.png",
+        &phong_scene::encode_png(&green, phong_core::Encoding::Linear).unwrap(),
+    );
+    write(
+        &d,
+        "Q.MTL",
+        b"newmtl m\nmap_Kd C:\\Users\\bob\\model\\red.png\nmap_Ks MAPS/GREEN.PNG\n",
+    );
+    let obj = write(
+        &d,
+        "q.obj",
+        b"mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n",
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&obj, &mut w).unwrap();
+    let texel = |m: &Option<phong_core::TextureMap>| {
+        let t = &m.as_ref().expect("a map").texture;
+        t.sample(
+            &phong_core::Sampler::nearest(phong_core::Wrap::Repeat),
+            Vec2::new(0.5, 0.5),
+            0.0,
+        )
+    };
+    assert_eq!(texel(&parts[0].maps.diffuse), [1.0, 0.0, 0.0, 1.0]);
+    assert_eq!(texel(&parts[0].maps.specular), [0.0, 1.0, 0.0, 1.0]);
+    assert_eq!(w.len(), 3, "{w:?}");
+    for (name, read) in [
+        ("q.mtl", "Q.MTL"),
+        ("red.png", "Maps/Red.PNG"),
+        ("GREEN.PNG", "maps/green.png"),
+    ] {
+        assert!(
+            w.iter()
+                .any(|w| w.contains(name) && w.contains(read) && w.contains("not there as written")),
+            "{name}: {w:?}"
+        );
+    }
+    // A glTF whose buffer and image were moved into a folder.
+    let mut bin = Vec::new();
+    for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        bin.extend(v.iter().flat_map(|x| x.to_le_bytes()));
+    }
+    for t in [[0f32, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+        bin.extend(t.iter().flat_map(|x| x.to_le_bytes()));
+    }
+    write(&d, "data/Tri.bin", &bin);
+    let gltf = write(
+        &d,
+        "t.gltf",
+        br#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"material":0}]}],
+"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+"textures":[{"source":0}],"images":[{"uri":"red.png"}],
+"buffers":[{"uri":"tri.bin","byteLength":60}],
+"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":24}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+{"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}]}"#,
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&gltf, &mut w).unwrap();
+    assert_eq!(parts.len(), 1);
+    assert!(parts[0].maps.diffuse.is_some(), "{w:?}");
+    assert!(
+        w.iter().any(|w| w.contains("tri.bin") && w.contains("data/Tri.bin")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter().any(|w| w.contains("red.png") && w.contains("Maps/Red.PNG")),
+        "{w:?}"
+    );
+}
+
 /// Normal maps from each source: a scene's `normal_map` (with `normal_scale` and
 /// `normal_green`), an MTL's `norm`; the object gets MikkTSpace tangents (a plane's: +x).
 #[test]

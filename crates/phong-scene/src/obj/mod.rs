@@ -130,11 +130,15 @@ pub(crate) fn obj_from_text(
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_mtl = std::cell::RefCell::new(Vec::new());
     let latin1 = std::cell::RefCell::new(Vec::new());
+    let moved = std::cell::RefCell::new(Vec::new());
     let out = load_obj_text(
         path,
         src,
         &|mtl| {
-            let p = dir.join(mtl);
+            // A name with spaces may be a whole `mtllib` statement tried as one name (see
+            // `load_obj_text`): not searched by its last word.
+            let name = mtl.to_string_lossy();
+            let p = found(&dir, &name, !name.contains(char::is_whitespace), path, &moved);
             read_mtl.borrow_mut().push(p.clone());
             let bytes = crate::read_bounded(
                 &p,
@@ -148,13 +152,7 @@ pub(crate) fn obj_from_text(
             Ok(decode_text(&p, bytes, &mut latin1.borrow_mut()))
         },
         &|name| {
-            // As written, else the file name beside the OBJ (a path from another machine).
-            let p = dir.join(name);
-            let base = Path::new(name).file_name().map(|b| dir.join(b));
-            let found = match base {
-                Some(b) if !p.exists() && b.exists() => b,
-                _ => p,
-            };
+            let found = found(&dir, name, true, path, &moved);
             read_mtl.borrow_mut().push(found.clone());
             crate::read_bounded(&found, phong_core::limits::MAX_IMAGE_FILE_BYTES, "texture image").map_err(
                 |e| match e {
@@ -166,8 +164,34 @@ pub(crate) fn obj_from_text(
         warnings,
     );
     warnings.extend(latin1.into_inner());
+    warnings.extend(moved.into_inner());
     sources.extend(read_mtl.into_inner());
     out
+}
+
+/// The file a model at `model` names `name` (relative to the model's folder `dir`): as
+/// written, else where [`crate::read::locate`] finds it (by its file name where `by_name`),
+/// with a warning in `moved`.
+pub(crate) fn found(
+    dir: &Path,
+    name: &str,
+    by_name: bool,
+    model: &Path,
+    moved: &std::cell::RefCell<Vec<String>>,
+) -> PathBuf {
+    let (p, elsewhere) = crate::read::locate(dir, name, by_name);
+    if elsewhere {
+        let msg = format!(
+            "{}: `{name}` is not there as written; reading {} (found by its name)",
+            model.display(),
+            p.display()
+        );
+        let mut moved = moved.borrow_mut();
+        if !moved.contains(&msg) {
+            moved.push(msg);
+        }
+    }
+    p
 }
 
 /// [`load_obj`] of an OBJ's text `src` (named `path` in messages), its MTL libraries read by
