@@ -228,6 +228,7 @@ impl<'a> Frame<'a> {
                 .map(|((o, mode), &second)| match mode {
                     Mode::Textured { per_vertex: false, .. } if o.maps.normal.is_some() => Extra::Tangents,
                     _ if second => Extra::SecondSet,
+                    _ if o.mesh.colors().is_empty() => Extra::Nothing,
                     _ => Extra::Colors,
                 })
                 .collect(),
@@ -470,7 +471,8 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         }
         assert!(matches!(frame.modes[2], Mode::Scalar));
         assert!(matches!(frame.modes[3], Mode::Textured { .. }));
-        assert_eq!(frame.extras[3], Extra::Colors);
+        // No vertex colours, second set or tangents: the coordinates' planes alone.
+        assert_eq!(frame.extras[3], Extra::Nothing);
         assert!(matches!(frame.modes[4], Mode::Scalar));
         assert_eq!(frame.extras[4], Extra::SecondSet);
         assert!(matches!(frame.modes[5], Mode::Textured { .. }));
@@ -537,7 +539,7 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         }
         assert_eq!(
             frame.extras[1],
-            Extra::Colors,
+            Extra::Nothing,
             "no tangents: the normal map does not apply"
         );
         assert!(matches!(frame.modes[2], Mode::Textured { per_vertex: true, .. }));

@@ -114,7 +114,7 @@ impl Frame<'_> {
                         }
                         if textured {
                             let idx = each3(|k| tri[s.order[k]]);
-                            out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of)));
+                            out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of), extra));
                         }
                         out.tris.push(s.tri);
                     }

@@ -280,7 +280,10 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
 /// `extra`), decided per object and frame ([`crate::frame::Frame::extras`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Extra {
-    /// The vertex colours (white where the mesh has none).
+    /// Nothing: the first set alone (the mesh has no vertex colours, the maps read no second
+    /// set and no normal map); only its planes are made.
+    Nothing,
+    /// The vertex colours.
     Colors,
     /// The second set of texture coordinates (the object has no vertex colours).
     SecondSet,
@@ -293,6 +296,7 @@ impl Extra {
     #[inline(always)]
     pub(crate) fn of(self, rgb: Vec3, uv1: glam::Vec2, tangent: glam::Vec4) -> glam::Vec4 {
         match self {
+            Extra::Nothing => glam::Vec4::ZERO,
             Extra::Colors => rgb.extend(0.0),
             Extra::SecondSet => glam::Vec4::new(uv1.x, uv1.y, 0.0, 0.0),
             Extra::Tangents => tangent,
@@ -302,14 +306,14 @@ impl Extra {
 
 /// The planes of texture coordinates `uv` and extra attributes `extra` (per set-up vertex; see
 /// [`Extra`]) of triangle `s`: `u/w`, `v/w` in `attr[0]`, `attr[1]`, the extra attributes over
-/// `w` in `attr[2..6]`.
+/// `w` in `attr[2..6]` (not made where `what` is [`Extra::Nothing`]).
 #[inline]
-pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], extra: [glam::Vec4; 3]) -> Planes {
+pub(crate) fn uv_planes(s: &Setup, uv: [glam::Vec2; 3], extra: [glam::Vec4; 3], what: Extra) -> Planes {
     let attrs = [
         crate::fixed::each3(|k| Vec3::new(uv[k].x, uv[k].y, extra[k].x)),
         crate::fixed::each3(|k| Vec3::new(extra[k].y, extra[k].z, extra[k].w)),
     ];
-    plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
+    plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, what == Extra::Nothing)
 }
 
 /// Plane equations (see [`Planes`]) of two vector attributes (only the first with `first_only`),
@@ -385,9 +389,10 @@ impl Frame<'_> {
             return Some((s.tri, Planes::default(), corners, None));
         }
         let mode = &self.modes[object as usize];
-        let extra = self.extras[object as usize];
-        let extra = |v: &ClipVertex| extra.of(v.rgb, v.uv1, v.tangent);
-        let uv = matches!(mode, Mode::Textured { .. }).then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra)));
+        let what = self.extras[object as usize];
+        let extra = |v: &ClipVertex| what.of(v.rgb, v.uv1, v.tangent);
+        let uv = matches!(mode, Mode::Textured { .. })
+            .then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra), what));
         let planes = match mode {
             Mode::Scalar => Planes::default(),
             Mode::Phong(..) | Mode::Textured { per_vertex: false, .. } => {
