@@ -36,6 +36,9 @@ pub struct VectorMap<'a> {
     unit: f32,
     /// `GL_NEAREST` both ways without mipmaps: level 0's texel under the coordinates.
     nearest: bool,
+    /// The coordinates come transformed already (the sampler folded `transform` into the
+    /// coordinates' planes: [`VectorMap::folded`]).
+    folded: bool,
 }
 
 impl<'a> VectorMap<'a> {
@@ -76,7 +79,18 @@ impl<'a> VectorMap<'a> {
                 && levels[0].1.is_power_of_two(),
             unit: if t.bits() == 8 { 1.0 / 255.0 } else { 1.0 / 65535.0 },
             nearest,
+            folded: false,
         })
+    }
+
+    /// The map's transform of texture coordinates.
+    pub(super) fn transform(&self) -> UvTransform {
+        self.transform
+    }
+
+    /// This map reading coordinates that its transform was applied to already.
+    pub(super) fn folded(self) -> VectorMap<'a> {
+        VectorMap { folded: true, ..self }
     }
 }
 
@@ -274,26 +288,33 @@ fn sample<V: Sampling>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
 }
 
 /// A map's RGB (`[0, 1]`) at the mesh's coordinates and their derivatives
-/// `uv = [u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]` (through the map's transform); `None` where a
-/// lane's coordinates are too large for exact `f32` wrapping (beyond ±2^21 texels) or NaN.
+/// `uv = [u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]` (through the map's transform, unless
+/// [folded](VectorMap::folded)); `None` where a lane's coordinates are too large for exact
+/// `f32` wrapping (beyond ±2^21 texels) or NaN.
 #[inline(always)]
 pub(super) fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
     let (l, o) = (map.transform.linear, map.transform.offset);
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let [u, v, ux, vx, uy, vy] = uv;
-    let tu = linear(u, v, l.x_axis.x, l.y_axis.x).add(V::splat(o.x));
-    let tv = linear(u, v, l.x_axis.y, l.y_axis.y).add(V::splat(o.y));
+    let (tu, tv, d) = if map.folded {
+        (u, v, [ux, vx, uy, vy])
+    } else {
+        (
+            linear(u, v, l.x_axis.x, l.y_axis.x).add(V::splat(o.x)),
+            linear(u, v, l.x_axis.y, l.y_axis.y).add(V::splat(o.y)),
+            [
+                linear(ux, vx, l.x_axis.x, l.y_axis.x),
+                linear(ux, vx, l.x_axis.y, l.y_axis.y),
+                linear(uy, vy, l.x_axis.x, l.y_axis.x),
+                linear(uy, vy, l.x_axis.y, l.y_axis.y),
+            ],
+        )
+    };
     let limit = 2_097_152.0;
     let inside = V::and(within(tu.mul(V::splat(w0)), limit), within(tv.mul(V::splat(h0)), limit));
     if V::any(V::not(inside)) {
         return None;
     }
-    let d = [
-        linear(ux, vx, l.x_axis.x, l.y_axis.x),
-        linear(ux, vx, l.x_axis.y, l.y_axis.y),
-        linear(uy, vy, l.x_axis.x, l.y_axis.x),
-        linear(uy, vy, l.x_axis.y, l.y_axis.y),
-    ];
     let mut t = sample(map, tu, tv, d);
     for c in &mut t {
         *c = c.mul(V::splat(map.unit));

@@ -843,6 +843,12 @@ impl<V: Vf32> Broadcast<V> {
     /// The first `attrs` attributes at pixel centres `(x, y)`, as [`interpolate`] computes them.
     #[inline(always)]
     pub(super) fn at(&self, x: V, y: V, attrs: usize) -> [V; 6] {
+        self.at_w(x, y, attrs).0
+    }
+
+    /// [`Broadcast::at`], with where it evaluated the planes: `(x − ox, y − oy, w)`.
+    #[inline(always)]
+    pub(super) fn at_w(&self, x: V, y: V, attrs: usize) -> ([V; 6], (V, V, V)) {
         let (dx, dy) = (x.sub(self.origin.0), y.sub(self.origin.1));
         let w = self.inv_w[2]
             .mul_add(dy, self.inv_w[1].mul_add(dx, self.inv_w[0]))
@@ -851,7 +857,7 @@ impl<V: Vf32> Broadcast<V> {
         for (o, k) in q.iter_mut().zip(&self.attr).take(attrs) {
             *o = k[2].mul_add(dy, k[1].mul_add(dx, k[0])).mul(w);
         }
-        q
+        (q, (dx, dy, w))
     }
 }
 
@@ -881,6 +887,12 @@ pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], rows: usize) -> [V; 24] 
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
 #[inline(always)]
 pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
+    interpolate_at::<V>(planes, attrs, x, y).0
+}
+
+/// [`interpolate`], with where it evaluated the planes: `(x − ox, y − oy, w)`.
+#[inline(always)]
+pub(super) fn interpolate_at<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> ([V; 6], (V, V, V)) {
     let k = coefficients::<V>(planes, if attrs > 3 { 3 } else { 2 });
     let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
     // `c + gx·dx + gy·dy` from floats `i..i + 3`.
@@ -890,7 +902,7 @@ pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V)
     for (a, o) in out.iter_mut().enumerate().take(attrs) {
         *o = plane(5 + 3 * a).mul(w);
     }
-    out
+    (out, (dx, dy, w))
 }
 
 #[cfg(test)]

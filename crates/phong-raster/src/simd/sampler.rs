@@ -15,11 +15,11 @@
 
 use super::filter::{VectorMap, bilinear_lanes, mapped};
 use super::kernel::{
-    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal, shade,
+    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate_at, perturb, position_normal, shade,
     shade_shininess,
 };
 use super::vector::{Portable, Vf32};
-use phong_core::{Channel, Maps, MetalRough, NormalMap, TextureMap};
+use phong_core::{Channel, Maps, MetalRough, NormalMap, TextureMap, UvTransform};
 
 /// The maps of an object that the vector sampler covers.
 #[derive(Clone, Copy)]
@@ -45,6 +45,10 @@ pub struct VectorMaps<'a> {
     /// Gouraud: the light was made per vertex, its primary and specular colours are the
     /// triangle's planes (see [`VectorMaps::lit_per_vertex`]).
     per_vertex: bool,
+    /// The one transform of every map, applied to the coordinates' planes once (per triangle
+    /// where a triangle has every lane) instead of per map and vector: see
+    /// [`VectorMaps::with_second`].
+    fold: Option<UvTransform>,
 }
 
 impl<'a> VectorMaps<'a> {
@@ -110,6 +114,7 @@ impl<'a> VectorMaps<'a> {
                 tinted: false,
                 second: false,
                 per_vertex: false,
+                fold: None,
             }
             .with_second(),
         )
@@ -176,19 +181,38 @@ impl<'a> VectorMaps<'a> {
         self.ambient.is_some() || self.occlusion.is_some()
     }
 
-    /// These maps with `second` found from their maps' sets.
+    /// These maps with `second` found from their maps' sets, and their transform folded into
+    /// the coordinates where every map has the same one and reads the first set, and no map
+    /// changes the light (such maps' lanes the vector wrap cannot take are sampled per lane,
+    /// from the coordinates before the transform).
     fn with_second(self) -> VectorMaps<'a> {
         let maps = [self.diffuse, self.specular, self.ambient, self.emission];
         let occlusion = self.occlusion.map(|(m, _)| m);
         let normal = self.normal.map(|(m, _)| m);
         let shininess = self.shininess.map(|(m, ..)| m);
         let metal_rough = self.metal_rough.map(|(m, _)| m);
-        let second = maps
-            .iter()
-            .chain([&occlusion, &normal, &shininess, &metal_rough])
-            .flatten()
-            .any(|m| m.second);
-        VectorMaps { second, ..self }
+        let all = || {
+            maps.iter()
+                .chain([&occlusion, &normal, &shininess, &metal_rough])
+                .flatten()
+        };
+        let second = all().any(|m| m.second);
+        let first = all().next().map(VectorMap::transform);
+        let fold = match first {
+            Some(t) if !second && !self.changes_light() && all().all(|m| m.transform() == t) => Some(t),
+            _ => None,
+        };
+        let folded = |m: Option<VectorMap<'a>>| if fold.is_some() { m.map(VectorMap::folded) } else { m };
+        VectorMaps {
+            second,
+            fold,
+            diffuse: folded(self.diffuse),
+            specular: folded(self.specular),
+            ambient: folded(self.ambient),
+            emission: folded(self.emission),
+            occlusion: self.occlusion.map(|(m, s)| (folded(Some(m)).unwrap_or(m), s)),
+            ..self
+        }
     }
 
     /// These maps, the diffuse texel tinted by the mesh's vertex colours where `tinted` (their
@@ -214,7 +238,7 @@ pub(crate) trait Sampling: Vf32 {
         prep: &Prepared,
         maps: &VectorMaps,
         q: [Self; 6],
-        xy: (Self, Self),
+        at: (Self, Self, Self),
         k: &[Self; 24],
     ) -> Result<[Self; 3], [[Self; 3]; 3]>;
 }
@@ -232,10 +256,10 @@ macro_rules! sampling {
                 prep: &Prepared,
                 maps: &VectorMaps,
                 q: [Self; 6],
-                xy: (Self, Self),
+                at: (Self, Self, Self),
                 k: &[Self; 24],
             ) -> Result<[Self; 3], [[Self; 3]; 3]> {
-                textured_lanes::<Self, FULL, PER_VERTEX>(prep, maps, q, xy, k)
+                textured_lanes::<Self, FULL, PER_VERTEX>(prep, maps, q, at, k)
             }
         }
     };
@@ -253,36 +277,63 @@ fn mapped_set<V: Sampling, const FULL: bool>(map: &VectorMap, uv: [V; 6], uv1: [
     mapped(map, if FULL && map.second { uv1 } else { uv })
 }
 
-/// The coordinates at centres `(x, y)` from their planes `k`: the first set
-/// `[u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`, the second (the first where no map reads it or
-/// `FULL` is off), and `(x − ox, y − oy, w)`.
+/// The coordinates where the light's planes were evaluated, `(dx, dy, w) = (x − ox, y − oy,
+/// w)` (a triangle's planes share their origin and `1/w`), from their planes `k`: the first
+/// set `[u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`, the second (the first where no map reads it or
+/// `FULL` is off), and `(dx, dy, w)`. With `q = 1/w`, `u = (u/w)·w` and `∂u/∂x = (∂(u/w)/∂x −
+/// u·∂q/∂x)·w`.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn coordinates<V: Vf32, const FULL: bool>(maps: &VectorMaps, k: &[V; 24], x: V, y: V) -> ([V; 6], [V; 6], (V, V, V)) {
-    let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
-    // `c + gx·dx + gy·dy` of the planes at 2 (1/w), 5 (u/w) and 8 (v/w).
-    let mut p = [V::splat(0.0); 3];
-    for (j, i) in [2, 5, 8].into_iter().enumerate() {
-        p[j] = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy));
-    }
-    let rq = p[0].recip();
-    let (u, v) = (p[1].mul(rq), p[2].mul(rq));
-    let (ux, vx) = (k[6].sub(u.mul(k[3])).mul(rq), k[9].sub(v.mul(k[3])).mul(rq));
-    let (uy, vy) = (k[7].sub(u.mul(k[4])).mul(rq), k[10].sub(v.mul(k[4])).mul(rq));
-    let uv = [u, v, ux, vx, uy, vy];
+fn coordinates<V: Vf32, const FULL: bool>(
+    maps: &VectorMaps,
+    k: &[V; 24],
+    (dx, dy, w): (V, V, V),
+) -> ([V; 6], [V; 6], (V, V, V)) {
+    let uv = coordinate_set(k, 5, (dx, dy, w));
     // The second set, where a map reads it, from the planes at 11 and 14 (in the vertex
     // colours' place: such objects have none).
     let uv1 = if FULL && maps.second {
-        let p1 = k[11].add(k[12].mul(dx)).add(k[13].mul(dy));
-        let p2 = k[14].add(k[15].mul(dx)).add(k[16].mul(dy));
-        let (u1, v1) = (p1.mul(rq), p2.mul(rq));
-        let (ux1, vx1) = (k[12].sub(u1.mul(k[3])).mul(rq), k[15].sub(v1.mul(k[3])).mul(rq));
-        let (uy1, vy1) = (k[13].sub(u1.mul(k[4])).mul(rq), k[16].sub(v1.mul(k[4])).mul(rq));
-        [u1, v1, ux1, vx1, uy1, vy1]
+        coordinate_set(k, 11, (dx, dy, w))
     } else {
         uv
     };
-    (uv, uv1, (dx, dy, rq))
+    (uv, uv1, (dx, dy, w))
+}
+
+/// One set of [`coordinates`], its planes of `u/w` and `v/w` at `a` and `a + 3`.
+#[inline(always)]
+fn coordinate_set<V: Vf32>(k: &[V; 24], a: usize, (dx, dy, w): (V, V, V)) -> [V; 6] {
+    let zero = V::splat(0.0);
+    let (nqx, nqy) = (zero.sub(k[3]), zero.sub(k[4]));
+    let b = a + 3;
+    let u = k[a + 2].mul_add(dy, k[a + 1].mul_add(dx, k[a])).mul(w);
+    let v = k[b + 2].mul_add(dy, k[b + 1].mul_add(dx, k[b])).mul(w);
+    [
+        u,
+        v,
+        u.mul_add(nqx, k[a + 1]).mul(w),
+        v.mul_add(nqx, k[b + 1]).mul(w),
+        u.mul_add(nqy, k[a + 2]).mul(w),
+        v.mul_add(nqy, k[b + 2]).mul(w),
+    ]
+}
+
+/// The coordinates' planes `k` with the maps' one transform folded in (where
+/// [`VectorMaps::with_second`] found one): `u'/w = a·u/w + b·v/w + o·(1/w)` for the planes of
+/// `u/w` (5), `v/w` (8) and `1/w` (2), so the coordinates come transformed.
+#[inline(always)]
+fn folded<V: Vf32>(maps: &VectorMaps, k: [V; 24]) -> [V; 24] {
+    let Some(t) = maps.fold else {
+        return k;
+    };
+    let (l, o) = (t.linear, t.offset);
+    let mut out = k;
+    for j in 0..3 {
+        let (u, v, q) = (k[5 + j], k[8 + j], k[2 + j]);
+        out[5 + j] = V::splat(l.x_axis.x).mul_add(u, V::splat(l.y_axis.x).mul_add(v, V::splat(o.x).mul(q)));
+        out[8 + j] = V::splat(l.x_axis.y).mul_add(u, V::splat(l.y_axis.y).mul_add(v, V::splat(o.y).mul(q)));
+    }
+    out
 }
 
 /// The normal `nrm` tilted by the normal map of `maps` (if any) in the frame of the tangent
@@ -417,7 +468,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     q: [V; 6],
-    (x, y): (V, V),
+    at: (V, V, V),
     k: &[V; 24],
 ) -> Result<[V; 3], [[V; 3]; 3]> {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
@@ -425,15 +476,15 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     // The common case lights first, then finds the coordinates, as before normal maps were
     // covered (BENCHMARKS.md, "Normal and bump maps on the fast path"); a normal map needs the
     // coordinates first. Gouraud's light is the planes' (`PER_VERTEX` is `maps.per_vertex()`).
-    let (lit, (uv, uv1, (dx, dy, rq)), mr) = if PER_VERTEX {
-        (None, coordinates::<V, FULL>(maps, k, x, y), None)
+    let (lit, (uv, uv1, (dx, dy, w)), mr) = if PER_VERTEX {
+        (None, coordinates::<V, FULL>(maps, k, at), None)
     } else if FULL && maps.changes_light() {
-        let c = coordinates::<V, FULL>(maps, k, x, y);
+        let c = coordinates::<V, FULL>(maps, k, at);
         let nrm = tilted::<V, FULL>(maps, nrm, k, c);
         let (sv, mr) = shininess_lanes::<V, FULL>(prep, maps, (c.0, c.1));
         (Some(shade_shininess(prep, pos, nrm, sv)), c, mr)
     } else {
-        (Some(shade(prep, pos, nrm)), coordinates::<V, FULL>(maps, k, x, y), None)
+        (Some(shade(prep, pos, nrm)), coordinates::<V, FULL>(maps, k, at), None)
     };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive through the sampling, nor
@@ -510,7 +561,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     if maps.tinted {
         for (c, t) in tint.iter_mut().enumerate() {
             let i = 11 + 3 * c;
-            *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(rq);
+            *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(w);
         }
     }
     let (td, ts, ta, te) = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten());
@@ -644,9 +695,9 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_
             uv[i] = q;
         }
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
-        let q = interpolate::<V>(&planes[..V::N], 6, xs, ys);
-        let k = coefficients::<V>(&uv[..V::N], maps.rows());
-        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, (xs, ys), &k);
+        let (q, at) = interpolate_at::<V>(&planes[..V::N], 6, xs, ys);
+        let k = folded(maps, coefficients::<V>(&uv[..V::N], maps.rows()));
+        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, at, &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
     }
@@ -671,11 +722,11 @@ pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool, const PER_VERT
         return 0;
     }
     let planes = Broadcast::<V>::new(planes, 6);
-    let k = coefficients::<V>(&[uv], maps.rows());
+    let k = folded(maps, coefficients::<V>(&[uv], maps.rows()));
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
-        let q = planes.at(x, y, 6);
-        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, (x, y), &k);
+        let (q, at) = planes.at_w(x, y, 6);
+        let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, at, &k);
         emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
     }
     full
