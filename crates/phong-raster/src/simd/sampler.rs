@@ -15,7 +15,7 @@
 
 use super::filter::{VectorMap, bilinear_lanes, mapped};
 use super::kernel::{
-    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate_at, perturb, position_normal, shade,
+    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate_at, perturb, position_normal,
     shade_shininess,
 };
 use super::vector::{Portable, Vf32};
@@ -473,22 +473,57 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
 ) -> Result<[V; 3], [[V; 3]; 3]> {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (pos, nrm) = position_normal(q);
-    // The common case lights first, then finds the coordinates, as before normal maps were
-    // covered (BENCHMARKS.md, "Normal and bump maps on the fast path"); a normal map needs the
-    // coordinates first. Gouraud's light is the planes' (`PER_VERTEX` is `maps.per_vertex()`).
-    let (lit, (uv, uv1, (dx, dy, w)), mr) = if PER_VERTEX {
-        (None, coordinates::<V, FULL>(maps, k, at), None)
-    } else if FULL && maps.changes_light() {
-        let c = coordinates::<V, FULL>(maps, k, at);
+    // The coordinates, then the maps that change the light (a normal map tilts the normal, a
+    // shininess or metallic-roughness map sets the shininess), then the colour maps, and the
+    // light last: the texels wait in fewer registers than the light would (BENCHMARKS.md,
+    // "The textured 100k sphere's instructions"). Gouraud's light is the planes'
+    // (`PER_VERTEX` is `maps.per_vertex()`).
+    let c = coordinates::<V, FULL>(maps, k, at);
+    let (uv, uv1, (dx, dy, w)) = c;
+    let (nrm, sv, mr) = if !PER_VERTEX && FULL && maps.changes_light() {
         let nrm = tilted::<V, FULL>(maps, nrm, k, c);
-        let (sv, mr) = shininess_lanes::<V, FULL>(prep, maps, (c.0, c.1));
-        (Some(shade_shininess(prep, pos, nrm, sv)), c, mr)
+        let (sv, mr) = shininess_lanes::<V, FULL>(prep, maps, (uv, uv1));
+        (nrm, sv, mr)
     } else {
-        (Some(shade(prep, pos, nrm)), coordinates::<V, FULL>(maps, k, at), None)
+        (nrm, None, None)
+    };
+    // (Matches, not closures: see `modulo`.)
+    #[allow(clippy::manual_map)]
+    let td = match &maps.diffuse {
+        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        None => None,
+    };
+    #[allow(clippy::manual_map)]
+    let ts = match &maps.specular {
+        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        None => None,
+    };
+    // Only the general form has ambient, emission and occlusion maps.
+    let ta = match (FULL, &maps.ambient) {
+        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        _ => None,
+    };
+    let te = match (FULL, &maps.emission) {
+        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
+        _ => None,
+    };
+    // The occlusion's red channel (`None` inside: not wrapped).
+    #[allow(clippy::manual_map)]
+    let ao = match (FULL, &maps.occlusion) {
+        (true, Some((m, _))) => Some(match mapped_set::<V, FULL>(m, uv, uv1) {
+            Some(t) => Some(t[0]),
+            None => None,
+        }),
+        _ => None,
+    };
+    let lit = if PER_VERTEX {
+        None
+    } else {
+        Some(shade_shininess(prep, pos, nrm, sv))
     };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
-    // maps on the first set) does not keep the ambient terms alive through the sampling, nor
-    // choose a set per map (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
+    // maps on the first set) does not keep the ambient terms alive, nor choose a set per map
+    // (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
     let split = FULL && maps.split();
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
     // Gouraud: the vertices' colours interpolated, clamped per vertex where the options clamp
@@ -523,35 +558,6 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
             specular[c] = s;
         }
     }
-    // (Matches, not closures: see `modulo`.)
-    #[allow(clippy::manual_map)]
-    let td = match &maps.diffuse {
-        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
-        None => None,
-    };
-    #[allow(clippy::manual_map)]
-    let ts = match &maps.specular {
-        Some(m) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
-        None => None,
-    };
-    // Only the general form has ambient, emission and occlusion maps.
-    let ta = match (FULL, &maps.ambient) {
-        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
-        _ => None,
-    };
-    let te = match (FULL, &maps.emission) {
-        (true, Some(m)) => Some(mapped_set::<V, FULL>(m, uv, uv1)),
-        _ => None,
-    };
-    // The occlusion's red channel (`None` inside: not wrapped).
-    #[allow(clippy::manual_map)]
-    let ao = match (FULL, &maps.occlusion) {
-        (true, Some((m, _))) => Some(match mapped_set::<V, FULL>(m, uv, uv1) {
-            Some(t) => Some(t[0]),
-            None => None,
-        }),
-        _ => None,
-    };
     let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
     if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
         return Err([primary, specular, if FULL { ambient } else { [zero; 3] }]);
