@@ -720,7 +720,7 @@ pub(super) fn lanes<'p, V: Vf32>(
     }
     (
         m,
-        interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys)),
+        interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys)).0,
     )
 }
 
@@ -789,7 +789,7 @@ pub(crate) fn shade_group<V: Vf32>(
     let planes = Broadcast::<V>::new(planes, attrs);
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>((x0, y0), chunk);
-        let q = planes.at(x, y, attrs);
+        let (q, _) = planes.at(x, y, attrs);
         let rgb = batch_color(batch, q).map(V::to_array);
         for (i, &p) in chunk.iter().enumerate() {
             out(p, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
@@ -840,15 +840,10 @@ impl<V: Vf32> Broadcast<V> {
         }
     }
 
-    /// The first `attrs` attributes at pixel centres `(x, y)`, as [`interpolate`] computes them.
+    /// The first `attrs` attributes at pixel centres `(x, y)`, and where, as [`interpolate`]
+    /// computes them.
     #[inline(always)]
-    pub(super) fn at(&self, x: V, y: V, attrs: usize) -> [V; 6] {
-        self.at_w(x, y, attrs).0
-    }
-
-    /// [`Broadcast::at`], with where it evaluated the planes: `(x − ox, y − oy, w)`.
-    #[inline(always)]
-    pub(super) fn at_w(&self, x: V, y: V, attrs: usize) -> ([V; 6], (V, V, V)) {
+    pub(super) fn at(&self, x: V, y: V, attrs: usize) -> ([V; 6], (V, V, V)) {
         let (dx, dy) = (x.sub(self.origin.0), y.sub(self.origin.1));
         let w = self.inv_w[2]
             .mul_add(dy, self.inv_w[1].mul_add(dx, self.inv_w[0]))
@@ -884,15 +879,11 @@ pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], rows: usize) -> [V; 24] 
     k
 }
 
-/// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`.
+/// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`;
+/// with where it evaluated them, `(x − ox, y − oy, w)` (the texture coordinates' planes share
+/// the origin and `1/w`).
 #[inline(always)]
-pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> [V; 6] {
-    interpolate_at::<V>(planes, attrs, x, y).0
-}
-
-/// [`interpolate`], with where it evaluated the planes: `(x − ox, y − oy, w)`.
-#[inline(always)]
-pub(super) fn interpolate_at<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> ([V; 6], (V, V, V)) {
+pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> ([V; 6], (V, V, V)) {
     let k = coefficients::<V>(planes, if attrs > 3 { 3 } else { 2 });
     let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
     // `c + gx·dx + gy·dy` from floats `i..i + 3`.

@@ -15,7 +15,7 @@
 
 use super::filter::{VectorMap, bilinear_lanes, mapped};
 use super::kernel::{
-    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate_at, perturb, position_normal,
+    Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal,
     shade_shininess,
 };
 use super::vector::{Portable, Vf32};
@@ -701,7 +701,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_
             uv[i] = q;
         }
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
-        let (q, at) = interpolate_at::<V>(&planes[..V::N], 6, xs, ys);
+        let (q, at) = interpolate::<V>(&planes[..V::N], 6, xs, ys);
         let k = folded(maps, coefficients::<V>(&uv[..V::N], maps.rows()));
         let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, at, &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
@@ -731,9 +731,61 @@ pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool, const PER_VERT
     let k = folded(maps, coefficients::<V>(&[uv], maps.rows()));
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
-        let (q, at) = planes.at_w(x, y, 6);
+        let (q, at) = planes.at(x, y, 6);
         let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, at, &k);
         emit::<V, u32>(r, V::N, |i| chunk[i], &mut out, unsampled);
     }
     full
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use phong_core::{Sampler, Texture, Wrap};
+    use std::sync::Arc;
+
+    /// The maps' transform is folded into the coordinates where every map has the same one and
+    /// none changes the light; else each map applies its own.
+    #[test]
+    fn one_transform_is_folded() {
+        let texture = Arc::new(Texture::new(4, 4, &[[65535u16; 4]; 16], 8).unwrap());
+        let map = |t: UvTransform| TextureMap {
+            texture: texture.clone(),
+            sampler: Sampler::trilinear(Wrap::Repeat),
+            transform: t,
+            set: 0,
+        };
+        let a = UvTransform::scale_offset(glam::Vec2::new(4.0, 2.0), glam::Vec2::new(0.5, 0.0));
+        let b = UvTransform::scale_offset(glam::Vec2::new(4.0, 2.0), glam::Vec2::ZERO);
+        let maps = |d: UvTransform, s: UvTransform| Maps {
+            diffuse: Some(map(d)),
+            specular: Some(map(s)),
+            ..Maps::default()
+        };
+        let same = maps(a, a);
+        let v = VectorMaps::new(&same).unwrap();
+        assert_eq!(v.fold, Some(a));
+        // A folded map reads its coordinates as they come; the others transform them. A 2×1
+        // image, red then green, at u = 0.25: red as it comes, green past the offset of ½.
+        let two = Arc::new(Texture::new(2, 1, &[[65535, 0, 0, 65535], [0, 65535, 0, 65535]], 8).unwrap());
+        let nearest = TextureMap {
+            texture: two,
+            sampler: Sampler::nearest(Wrap::Repeat),
+            transform: a,
+            set: 0,
+        };
+        let plain = VectorMap::of(&nearest).unwrap();
+        let uv = [0.25, 0.5, 0.0, 0.0, 0.0, 0.0].map(Portable::splat);
+        let red = |m: VectorMap| mapped::<Portable>(&m, uv).unwrap()[0].0[0];
+        assert_eq!((red(plain.folded()), red(plain)), (1.0, 0.0));
+        let other = maps(a, b);
+        assert_eq!(VectorMaps::new(&other).unwrap().fold, None);
+        // A shininess map changes the light: its lanes outside the vector wrap are sampled per
+        // lane, from the coordinates before the transform.
+        let mut shiny = maps(a, a);
+        shiny.shininess = Some((map(a), Channel::R));
+        assert_eq!(VectorMaps::new(&shiny).unwrap().fold, None);
+        // Gouraud: the shininess map does not apply, so the colour maps' one transform folds.
+        assert_eq!(VectorMaps::new(&shiny).unwrap().lit_per_vertex().unwrap().fold, Some(a));
+    }
 }
