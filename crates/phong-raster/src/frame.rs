@@ -260,7 +260,7 @@ impl<'a> Frame<'a> {
                 frame.setup_object_full(oi, obj, clip_from_world, keep)
             } else if alpha_tested || obj.shading.interpolation == Interpolation::Flat {
                 // The alpha test reads the reference's coordinates (`Corners`), the shading the
-                // planes; flat triangles' colours are the reference's too (one per triangle).
+                // planes; flat triangles are lit at their centroids by the vector kernel.
                 let keep = Keep {
                     corners: alpha_tested,
                     planes: true,

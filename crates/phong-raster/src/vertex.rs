@@ -107,6 +107,31 @@ impl VertexLighting {
         }
     }
 
+    /// Every point of `ps` (normals `ns`) lit, on all cores: [`VertexLighting::light`]'s four
+    /// outputs, each as long as `ps` where it is written, else empty.
+    pub fn light_all(&self, ps: &[Vec3], ns: &[Vec3]) -> [Vec<Vec3>; 4] {
+        let n = ps.len();
+        let mut colors = [
+            n,
+            if self.two_sided { n } else { 0 },
+            if self.textured { n } else { 0 },
+            if self.textured && self.two_sided { n } else { 0 },
+        ]
+        .map(|len| vec![Vec3::ZERO; len]);
+        let [front, back, front_specular, back_specular] = &mut colors;
+        let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
+        let jobs: Vec<_> = front
+            .chunks_mut(LIGHT_CHUNK)
+            .map(|f| (f, others.each_mut().map(|o| o.next().unwrap_or_default())))
+            .enumerate()
+            .collect();
+        jobs.into_par_iter().for_each(|(j, (f, [b, fs, bs]))| {
+            let range = j * LIGHT_CHUNK..j * LIGHT_CHUNK + f.len();
+            self.light(&ps[range.clone()], &ns[range], [f, b, fs, bs]);
+        });
+        colors
+    }
+
     /// Lights, into `colors` (as [`VertexLighting::light`]'s `out`, resized to the mesh; the
     /// other vertices keep what they held), the vertices that `used` marks, by runs of
     /// 16-vertex groups with a used vertex, one kernel call a run.

@@ -2,13 +2,16 @@
 //! (textured objects it does not cover, normal and depth outputs, blended objects), and for
 //! its flat-shaded and alpha-tested objects: every vertex in full, lit per vertex (Gouraud) or
 //! per triangle (flat) by `Object::vertex_light` (a textured object: its primary and specular
-//! colours, for the texels applied per pixel), [`Corners`] and planes kept as asked.
+//! colours, for the texels applied per pixel; on the fast path, flat triangles by the vector
+//! kernel, all at once), [`Corners`] and planes kept as asked.
 
 use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::frame::Frame;
+use crate::frame::lit_term;
 use crate::simd::Planes;
-use crate::vertex::Projected;
+use crate::simd::Prepared;
+use crate::vertex::{Projected, VertexLighting};
 use glam::{Mat4, Vec3, Vec4};
 use phong_core::mesh::facet_normal;
 use phong_core::{Color, Interpolation, Object};
@@ -30,6 +33,31 @@ impl Frame<'_> {
         let tangents = mesh.tangents();
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
         let vec3 = |c: Color| Vec3::from(c.to_array());
+        let color = |v: Vec3| Color::new(v.x, v.y, v.z);
+        // Flat on the fast path: every triangle lit at once at its centroid by the vector
+        // kernel, as Gouraud vertices are (the reference lights each with `vertex_light`).
+        let flat_lit = (keep.planes && interpolation == Interpolation::Flat)
+            .then(|| lit_term(obj.shading.output))
+            .flatten()
+            .map(|term| {
+                let lighting = VertexLighting {
+                    isa: self.isa,
+                    prepared: Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view),
+                    term,
+                    two_sided,
+                    textured: obj.textured(),
+                };
+                let p = mesh.positions();
+                let (centroids, normals): (Vec<Vec3>, Vec<Vec3>) = mesh
+                    .triangles()
+                    .par_iter()
+                    .map(|t| {
+                        let [a, b, c] = t.map(|i| p[i as usize]);
+                        ((a + b + c) / 3.0, facet_normal(a, b, c))
+                    })
+                    .unzip();
+                lighting.light_all(&centroids, &normals)
+            });
         let verts: Vec<ClipVertex> = mesh
             .positions()
             .par_iter()
@@ -74,7 +102,7 @@ impl Frame<'_> {
                 }
             })
             .collect();
-        let setup_chunk = |chunk: &[[u32; 3]]| {
+        let setup_chunk = |(ci, chunk): (usize, &[[u32; 3]])| {
             let mut out = Chunk {
                 object: oi as u32,
                 tris: Vec::with_capacity(chunk.len()),
@@ -90,7 +118,7 @@ impl Frame<'_> {
                     }
                 }
             };
-            for tri in chunk {
+            for (k, tri) in chunk.iter().enumerate() {
                 let c = tri.map(|i| codes[i as usize]);
                 if c[0] & c[1] & c[2] & OUTSIDE_VIEW != 0 {
                     continue;
@@ -99,9 +127,19 @@ impl Frame<'_> {
                 // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
                 let flat = (interpolation == Interpolation::Flat).then(|| -> [Flat; 2] {
                     let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
-                    let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
-                    let front = lit(centroid, fnorm);
-                    let back = if two_sided { lit(centroid, -fnorm) } else { front };
+                    let (front, back) = match &flat_lit {
+                        Some([f, b, fs, bs]) => {
+                            let i = ci * SETUP_CHUNK + k;
+                            let at = |v: &Vec<Vec3>| v.get(i).map_or(Color::BLACK, |&c| color(c));
+                            let front = (at(f), at(fs));
+                            (front, if two_sided { (at(b), at(bs)) } else { front })
+                        }
+                        None => {
+                            let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
+                            let front = lit(centroid, fnorm);
+                            (front, if two_sided { lit(centroid, -fnorm) } else { front })
+                        }
+                    };
                     [(front.0, front.1, fnorm), (back.0, back.1, -fnorm)]
                 });
                 if (c[0] | c[1] | c[2]) & (OUTSIDE_CLIP | NOT_FINITE) == 0 {
@@ -122,6 +160,10 @@ impl Frame<'_> {
             self.bin_entries(&mut out);
             out
         };
-        mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect()
+        mesh.triangles()
+            .par_chunks(SETUP_CHUNK)
+            .enumerate()
+            .map(setup_chunk)
+            .collect()
     }
 }
