@@ -90,6 +90,19 @@ pub(crate) struct VertexLighting {
     pub textured: bool,
 }
 
+/// The four outputs of [`VertexLighting::light`] cut into pieces of [`LIGHT_CHUNK`] points,
+/// numbered: the front colours' piece with the others' (empty where they are).
+#[allow(clippy::type_complexity)]
+fn pieces(colors: &mut [Vec<Vec3>; 4]) -> Vec<(usize, (&mut [Vec3], [&mut [Vec3]; 3]))> {
+    let [front, back, front_specular, back_specular] = colors;
+    let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
+    front
+        .chunks_mut(LIGHT_CHUNK)
+        .map(|f| (f, others.each_mut().map(|o| o.next().unwrap_or_default())))
+        .enumerate()
+        .collect()
+}
+
 impl VertexLighting {
     /// The colours of vertices `ps` with normals `ns`: `out[0]` from the front, `out[1]` from
     /// the back (two-sided only); textured, those are the primary colours and `out[2]`,
@@ -110,33 +123,17 @@ impl VertexLighting {
     /// Every point of `ps` (normals `ns`) lit, on all cores: [`VertexLighting::light`]'s four
     /// outputs, each as long as `ps` where it is written, else empty.
     pub fn light_all(&self, ps: &[Vec3], ns: &[Vec3]) -> [Vec<Vec3>; 4] {
-        let n = ps.len();
-        let mut colors = [
-            n,
-            if self.two_sided { n } else { 0 },
-            if self.textured { n } else { 0 },
-            if self.textured && self.two_sided { n } else { 0 },
-        ]
-        .map(|len| vec![Vec3::ZERO; len]);
-        let [front, back, front_specular, back_specular] = &mut colors;
-        let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
-        let jobs: Vec<_> = front
-            .chunks_mut(LIGHT_CHUNK)
-            .map(|f| (f, others.each_mut().map(|o| o.next().unwrap_or_default())))
-            .enumerate()
-            .collect();
-        jobs.into_par_iter().for_each(|(j, (f, [b, fs, bs]))| {
+        let mut colors = <[Vec<Vec3>; 4]>::default();
+        self.size(&mut colors, ps.len());
+        pieces(&mut colors).into_par_iter().for_each(|(j, (f, [b, fs, bs]))| {
             let range = j * LIGHT_CHUNK..j * LIGHT_CHUNK + f.len();
             self.light(&ps[range.clone()], &ns[range], [f, b, fs, bs]);
         });
         colors
     }
 
-    /// Lights, into `colors` (as [`VertexLighting::light`]'s `out`, resized to the mesh; the
-    /// other vertices keep what they held), the vertices that `used` marks, by runs of
-    /// 16-vertex groups with a used vertex, one kernel call a run.
-    pub fn light_used(&self, positions: &[Vec3], normals: &[Vec3], used: &[AtomicBool], colors: &mut [Vec<Vec3>; 4]) {
-        let n = positions.len();
+    /// `colors` resized to `n` points where [`VertexLighting::light`] writes them, else empty.
+    fn size(&self, colors: &mut [Vec<Vec3>; 4], n: usize) {
         let lengths = [
             n,
             if self.two_sided { n } else { 0 },
@@ -146,13 +143,14 @@ impl VertexLighting {
         for (c, len) in colors.iter_mut().zip(lengths) {
             c.resize(len, Vec3::ZERO);
         }
-        let [front, back, front_specular, back_specular] = colors;
-        let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
-        let jobs: Vec<_> = front
-            .chunks_mut(LIGHT_CHUNK)
-            .map(|f| (f, others.each_mut().map(|o| o.next().unwrap_or_default())))
-            .enumerate()
-            .collect();
+    }
+
+    /// Lights, into `colors` (as [`VertexLighting::light`]'s `out`, resized to the mesh; the
+    /// other vertices keep what they held), the vertices that `used` marks, by runs of
+    /// 16-vertex groups with a used vertex, one kernel call a run.
+    pub fn light_used(&self, positions: &[Vec3], normals: &[Vec3], used: &[AtomicBool], colors: &mut [Vec<Vec3>; 4]) {
+        self.size(colors, positions.len());
+        let jobs = pieces(colors);
         jobs.into_par_iter().for_each(|(j, (f, mut o))| {
             let at = j * LIGHT_CHUNK;
             let range = at..at + f.len();
