@@ -159,26 +159,30 @@ fn half_log2<V: Vf32>(rho2: V) -> V {
     t.mul_add(p, e).mul(V::splat(0.5))
 }
 
-/// The bilinear filter of every lane's level `level` (a whole number per lane) at `(u, v)`,
-/// RGB in texel units (0 to 255): the levels present gathered one by one, each lane keeping
-/// its own.
+/// The bilinear filter of every lane's level `level` (a whole number per lane; `None`: level 0
+/// in every lane) at `(u, v)`, RGB in texel units (0 to 255): the levels present gathered one
+/// by one, each lane keeping its own.
 #[inline(always)]
-pub(super) fn bilinear_lanes<V: Vf32>(map: &VectorMap, level: V, u: V, v: V) -> [V; 3] {
+pub(super) fn bilinear_lanes<V: Vf32>(map: &VectorMap, level: Option<V>, u: V, v: V) -> [V; 3] {
     let (zero, one, half) = (V::splat(0.0), V::splat(1.0), V::splat(0.5));
     // The lanes' levels: usually one (checked by vector), else scanned.
-    let l = level.to_array();
-    let first = l.as_ref()[0];
-    let one_level = !V::any(V::or(level.lt(V::splat(first)), level.gt(V::splat(first))));
-    let (lo, hi) = if one_level {
-        let f = (first as usize).min(map.count - 1);
-        (f, f)
-    } else {
-        let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
-        for &x in l.as_ref() {
-            lo = lo.min(x);
-            hi = hi.max(x);
+    let (level, lo, hi) = match level {
+        None => (zero, 0, 0),
+        Some(level) => {
+            let l = level.to_array();
+            let first = l.as_ref()[0];
+            if !V::any(V::or(level.lt(V::splat(first)), level.gt(V::splat(first)))) {
+                let f = (first as usize).min(map.count - 1);
+                (level, f, f)
+            } else {
+                let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+                for &x in l.as_ref() {
+                    lo = lo.min(x);
+                    hi = hi.max(x);
+                }
+                (level, lo as usize, (hi as usize).min(map.count - 1))
+            }
         }
-        (lo as usize, (hi as usize).min(map.count - 1))
     };
     // A level's size: the halved size rounded down, at least 1 (one level: its own).
     let (w, h, inv_w, inv_h) = if lo == hi {
@@ -265,21 +269,23 @@ fn sample<V: Sampling>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let last = (map.count - 1) as f32;
-    let (level, t) = if map.mipmaps {
-        let (ax, bx) = (d[0].mul(V::splat(w0)), d[1].mul(V::splat(h0)));
-        let (ay, by) = (d[2].mul(V::splat(w0)), d[3].mul(V::splat(h0)));
-        let rho2 = ax.mul(ax).add(bx.mul(bx)).max(ay.mul(ay).add(by.mul(by)));
-        // λ > 0 exactly where ρ² > 1 (and not for NaN): minified.
-        let minify = rho2.gt(one);
-        let lod = half_log2(rho2).min(V::splat(last));
-        let whole = lod.floor();
-        (V::select(minify, whole, zero), V::select(minify, lod.sub(whole), zero))
-    } else {
-        (zero, zero)
-    };
-    let mut texel = V::bilinear(map, level, u, v);
+    if !map.mipmaps {
+        return V::bilinear(map, None, u, v);
+    }
+    let (ax, bx) = (d[0].mul(V::splat(w0)), d[1].mul(V::splat(h0)));
+    let (ay, by) = (d[2].mul(V::splat(w0)), d[3].mul(V::splat(h0)));
+    let rho2 = ax.mul(ax).add(bx.mul(bx)).max(ay.mul(ay).add(by.mul(by)));
+    // λ > 0 exactly where ρ² > 1 (and not for NaN): minified. No lane minified: level 0.
+    let minify = rho2.gt(one);
+    if !V::any(minify) {
+        return V::bilinear(map, None, u, v);
+    }
+    let lod = half_log2(rho2).min(V::splat(last));
+    let whole = lod.floor();
+    let (level, t) = (V::select(minify, whole, zero), V::select(minify, lod.sub(whole), zero));
+    let mut texel = V::bilinear(map, Some(level), u, v);
     if V::any(t.gt(zero)) {
-        let b = V::bilinear(map, level.add(one).min(V::splat(last)), u, v);
+        let b = V::bilinear(map, Some(level.add(one).min(V::splat(last))), u, v);
         for c in 0..3 {
             texel[c] = b[c].sub(texel[c]).mul_add(t, texel[c]);
         }
@@ -395,15 +401,20 @@ mod tests {
                         ..Maps::default()
                     };
                     let map = VectorMap::of(maps.diffuse.as_ref().expect("set")).expect("covered");
-                    for _ in 0..200 {
+                    for round in 0..200 {
                         let mut u = [0f32; 8];
                         let mut v = [0f32; 8];
                         let mut d = [[0f32; 8]; 4];
                         for i in 0..8 {
                             u[i] = r.next() * 6.0 - 3.0;
                             v[i] = r.next() * 6.0 - 3.0;
-                            // Texels per pixel from 1/8 to 256.
-                            let scale = (r.next() * 11.0 - 3.0).exp2() / w.max(h) as f32;
+                            // Texels per pixel from 1/8 to 256; every fourth vector magnified in
+                            // every lane (ρ below 2^-½ texels per pixel: level 0 alone).
+                            let scale = if round % 4 == 0 {
+                                (r.next() * 2.5 - 3.0).exp2() / w.max(h) as f32
+                            } else {
+                                (r.next() * 11.0 - 3.0).exp2() / w.max(h) as f32
+                            };
                             for dk in &mut d {
                                 dk[i] = (r.next() * 2.0 - 1.0) * scale;
                             }

@@ -231,7 +231,7 @@ impl<'a> VectorMaps<'a> {
 /// at every map, level and entry point took minutes to compile (BENCHMARKS.md, C10).
 pub(crate) trait Sampling: Vf32 {
     /// [`bilinear_lanes`].
-    fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3];
+    fn bilinear(map: &VectorMap, level: Option<Self>, u: Self, v: Self) -> [Self; 3];
     /// [`textured_lanes`].
     #[allow(clippy::type_complexity)]
     fn textured<const FULL: bool, const PER_VERTEX: bool>(
@@ -248,7 +248,7 @@ macro_rules! sampling {
     ($v:ty, $inline:meta) => {
         impl Sampling for $v {
             #[$inline]
-            fn bilinear(map: &VectorMap, level: Self, u: Self, v: Self) -> [Self; 3] {
+            fn bilinear(map: &VectorMap, level: Option<Self>, u: Self, v: Self) -> [Self; 3] {
                 bilinear_lanes(map, level, u, v)
             }
             #[$inline]
