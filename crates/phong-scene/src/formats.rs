@@ -130,7 +130,7 @@ pub fn load_model_full(
     let read = std::cell::RefCell::new(Vec::new());
     let moved = std::cell::RefCell::new(Vec::new());
     let resource = |uri: &str| -> Result<Vec<u8>, String> {
-        let p = crate::obj::found(dir, uri, true, path, &moved);
+        let p = crate::read::found(dir, uri, true, path, &moved);
         read.borrow_mut().push(p.clone());
         read_bounded(&p, MAX_MODEL_BYTES, WHAT).map_err(|e| match e {
             Error::Read { source, .. } => format!("cannot read {}: {source}", p.display()),

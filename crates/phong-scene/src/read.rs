@@ -98,6 +98,31 @@ pub(crate) fn locate(dir: &Path, name: &str, by_name: bool) -> (PathBuf, bool) {
     }
 }
 
+/// The file a model at `model` names `name` (relative to the model's folder `dir`): as
+/// written, else where [`locate`] finds it (by its file name where `by_name`),
+/// with a warning in `moved`.
+pub(crate) fn found(
+    dir: &Path,
+    name: &str,
+    by_name: bool,
+    model: &Path,
+    moved: &std::cell::RefCell<Vec<String>>,
+) -> PathBuf {
+    let (p, elsewhere) = crate::read::locate(dir, name, by_name);
+    if elsewhere {
+        let msg = format!(
+            "{}: `{name}` is not there as written; reading {} (found by its name)",
+            model.display(),
+            p.display()
+        );
+        let mut moved = moved.borrow_mut();
+        if !moved.contains(&msg) {
+            moved.push(msg);
+        }
+    }
+    p
+}
+
 /// The entries of `dir` in name order (none where it cannot be read), each with whether it
 /// is a folder; at most `budget` entries read, `budget` reduced by those read.
 fn entries(dir: &Path, budget: &mut usize) -> Vec<(String, PathBuf, bool)> {

@@ -47,7 +47,7 @@ pub struct VectorMaps<'a> {
     per_vertex: bool,
     /// The one transform of every map, applied to the coordinates' planes once (per triangle
     /// where a triangle has every lane) instead of per map and vector: see
-    /// [`VectorMaps::with_second`].
+    /// [`VectorMaps::derived`].
     fold: Option<UvTransform>,
 }
 
@@ -116,7 +116,7 @@ impl<'a> VectorMaps<'a> {
                 per_vertex: false,
                 fold: None,
             }
-            .with_second(),
+            .derived(),
         )
     }
 
@@ -146,7 +146,7 @@ impl<'a> VectorMaps<'a> {
                 per_vertex: true,
                 ..self
             }
-            .with_second(),
+            .derived(),
         )
     }
 
@@ -181,11 +181,11 @@ impl<'a> VectorMaps<'a> {
         self.ambient.is_some() || self.occlusion.is_some()
     }
 
-    /// These maps with `second` found from their maps' sets, and their transform folded into
-    /// the coordinates where every map has the same one and reads the first set, and no map
-    /// changes the light (such maps' lanes the vector wrap cannot take are sampled per lane,
-    /// from the coordinates before the transform).
-    fn with_second(self) -> VectorMaps<'a> {
+    /// These maps with the fields derived from the maps themselves: `second` from their sets,
+    /// and `fold`, their transform folded into the coordinates where every map has the same one
+    /// and reads the first set, and no map changes the light (such maps' lanes the vector wrap
+    /// cannot take are sampled per lane, from the coordinates before the transform).
+    fn derived(self) -> VectorMaps<'a> {
         let maps = [self.diffuse, self.specular, self.ambient, self.emission];
         let occlusion = self.occlusion.map(|(m, _)| m);
         let normal = self.normal.map(|(m, _)| m);
@@ -319,7 +319,7 @@ fn coordinate_set<V: Vf32>(k: &[V; 24], a: usize, (dx, dy, w): (V, V, V)) -> [V;
 }
 
 /// The coordinates' planes `k` with the maps' one transform folded in (where
-/// [`VectorMaps::with_second`] found one): `u'/w = a·u/w + b·v/w + o·(1/w)` for the planes of
+/// [`VectorMaps::derived`] found one): `u'/w = a·u/w + b·v/w + o·(1/w)` for the planes of
 /// `u/w` (5), `v/w` (8) and `1/w` (2), so the coordinates come transformed.
 #[inline(always)]
 fn folded<V: Vf32>(maps: &VectorMaps, k: [V; 24]) -> [V; 24] {

@@ -138,7 +138,7 @@ pub(crate) fn obj_from_text(
             // A name with spaces may be a whole `mtllib` statement tried as one name (see
             // `load_obj_text`): not searched by its last word.
             let name = mtl.to_string_lossy();
-            let p = found(&dir, &name, !name.contains(char::is_whitespace), path, &moved);
+            let p = crate::read::found(&dir, &name, !name.contains(char::is_whitespace), path, &moved);
             read_mtl.borrow_mut().push(p.clone());
             let bytes = crate::read_bounded(
                 &p,
@@ -152,7 +152,7 @@ pub(crate) fn obj_from_text(
             Ok(decode_text(&p, bytes, &mut latin1.borrow_mut()))
         },
         &|name| {
-            let found = found(&dir, name, true, path, &moved);
+            let found = crate::read::found(&dir, name, true, path, &moved);
             read_mtl.borrow_mut().push(found.clone());
             crate::read_bounded(&found, phong_core::limits::MAX_IMAGE_FILE_BYTES, "texture image").map_err(
                 |e| match e {
@@ -167,31 +167,6 @@ pub(crate) fn obj_from_text(
     warnings.extend(moved.into_inner());
     sources.extend(read_mtl.into_inner());
     out
-}
-
-/// The file a model at `model` names `name` (relative to the model's folder `dir`): as
-/// written, else where [`crate::read::locate`] finds it (by its file name where `by_name`),
-/// with a warning in `moved`.
-pub(crate) fn found(
-    dir: &Path,
-    name: &str,
-    by_name: bool,
-    model: &Path,
-    moved: &std::cell::RefCell<Vec<String>>,
-) -> PathBuf {
-    let (p, elsewhere) = crate::read::locate(dir, name, by_name);
-    if elsewhere {
-        let msg = format!(
-            "{}: `{name}` is not there as written; reading {} (found by its name)",
-            model.display(),
-            p.display()
-        );
-        let mut moved = moved.borrow_mut();
-        if !moved.contains(&msg) {
-            moved.push(msg);
-        }
-    }
-    p
 }
 
 /// [`load_obj`] of an OBJ's text `src` (named `path` in messages), its MTL libraries read by
