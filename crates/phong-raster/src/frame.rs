@@ -385,10 +385,10 @@ pub fn coverage_counts(scene: &Scene) -> Vec<u16> {
 mod tests {
     use super::*;
 
-    /// Ambient, emission and occlusion maps with linear filters, and maps on the second set of
-    /// coordinates, are drawn by the vector sampler (the fast path's textured mode), not per
-    /// pixel; one it does not cover (a level filter of `GL_NEAREST`, as `GL_LINEAR_MIPMAP_NEAREST`)
-    /// is.
+    /// Ambient, emission and occlusion maps, and maps on the second set of coordinates, are
+    /// drawn by the vector sampler (the fast path's textured mode), not per pixel; so is one of
+    /// filters it samples lane by lane (`GL_LINEAR_MIPMAP_NEAREST`), whose transform it does
+    /// not fold.
     #[test]
     fn ambient_emission_occlusion_and_second_set_maps_take_the_vector_sampler() {
         let src = r#"
@@ -419,16 +419,15 @@ material = { base = "brass", ambient_map = "assets/checker.png" }
         o.maps.ambient.as_mut().unwrap().set = 1;
         scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
-        for i in [0, 1, 3, 4] {
+        for i in [0, 1, 2, 3, 4] {
             assert!(matches!(frame.modes[i], Mode::Textured { .. }), "object {i}");
             assert!(frame.vector_maps[i].is_some_and(|m| m.split()), "object {i}");
         }
-        assert!(matches!(frame.modes[2], Mode::Scalar));
     }
 
     /// An object with a normal (or bump) map is drawn by the vector sampler, its tangents in
-    /// its coordinates' planes; with a second set of coordinates, or a filter it does not cover, it is
-    /// shaded per pixel. So is one with a shininess map, unless the map reads its alpha (not
+    /// its coordinates' planes, whatever the map's filters; with a second set of coordinates it
+    /// is shaded per pixel. So is one with a shininess map, unless the map reads its alpha (not
     /// gathered).
     #[test]
     fn normal_and_shininess_maps_take_the_vector_sampler() {
@@ -464,12 +463,11 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         o.maps.shininess.as_mut().unwrap().1 = phong_core::Channel::A;
         scene.objects.push(o);
         let frame = Frame::build(&scene, Path::Fast, Isa::PORTABLE, &mut Scratch::default());
-        for i in [0, 1] {
+        for i in [0, 1, 2] {
             assert!(matches!(frame.modes[i], Mode::Textured { .. }), "object {i}");
             assert!(frame.vector_maps[i].is_some(), "object {i}");
             assert_eq!(frame.extras[i], Extra::Tangents, "object {i}");
         }
-        assert!(matches!(frame.modes[2], Mode::Scalar));
         assert!(matches!(frame.modes[3], Mode::Textured { .. }));
         // No vertex colours, second set or tangents: the coordinates' planes alone.
         assert_eq!(frame.extras[3], Extra::Nothing);
@@ -486,7 +484,8 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         phong_scene::parse_scene(src, &at).unwrap().scene
     }
 
-    /// `GL_LINEAR_MIPMAP_NEAREST` (glTF can ask for it), which the vector sampler does not cover.
+    /// `GL_LINEAR_MIPMAP_NEAREST` (glTF can ask for it), which the vector sampler samples lane by
+    /// lane.
     fn linear_mipmap_nearest() -> phong_core::Sampler {
         phong_core::Sampler {
             mip: phong_core::MipFilter::Nearest,

@@ -1106,6 +1106,66 @@ material = {{ base = "chrome", diffuse_map = "assets/checker.png", filter = "nea
     assert_fast_matches_reference(&scene, "nearest");
 }
 
+/// Maps of every other combination of filters (glTF's samplers: a nearest mipmap, nearest
+/// texels with mipmaps, magnification and minification filters that differ), which the vector
+/// kernels sample lane by lane with `phong_core`'s sampler: magnified (the close sphere) and
+/// minified (the far torus, the grazing plane), diffuse, specular and emission maps with a
+/// transform, Phong and Gouraud. The fast path within 1/255 of the reference.
+#[test]
+fn fast_path_matches_reference_with_any_filters() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let src = r#"
+[image]
+width = 200
+height = 120
+[camera]
+position = [0.0, 0.0, 6.0]
+[[light]]
+type = "point"
+position = [2.0, 2.0, 4.0]
+[[object]]
+shape = "sphere"
+position = [-1.8, 0.6, 2.0]
+material = { base = "brass", diffuse_map = "assets/bricks.png", specular_map = "assets/checker.png", uv_scale = [2.0, 1.0] }
+[[object]]
+shape = "torus"
+position = [0.5, 0.8, -9.0]
+rotation = [60.0, 0.0, 0.0]
+material = { base = "jade", emission = [0.3, 0.2, 0.1], diffuse_map = "assets/checker.png", emission_map = "assets/bricks.png", wrap = "mirror", uv_scale = [7.0, 3.0] }
+[[object]]
+shape = "plane"
+position = [1.8, -1.0, 0.0]
+rotation = [82.0, 0.0, 0.0]
+material = { base = "ruby", diffuse_map = "assets/bricks.png", wrap = "clamp", uv_scale = [4.0, 4.0] }
+[[object]]
+shape = "teapot"
+position = [-1.0, -1.3, 0.0]
+scale = 0.6
+interpolation = "gouraud"
+material = { base = "gold", diffuse_map = "assets/checker.png", uv_scale = [3.0, 3.0] }
+"#;
+    let base = phong_scene::parse_scene(src, &root.join("filters.toml")).unwrap().scene;
+    for mag in [Filter::Linear, Filter::Nearest] {
+        for min in [Filter::Linear, Filter::Nearest] {
+            for mip in [MipFilter::Nearest, MipFilter::Linear, MipFilter::None] {
+                let mut scene = base.clone();
+                for o in &mut scene.objects {
+                    let m = &mut o.maps;
+                    for t in [&mut m.diffuse, &mut m.specular, &mut m.emission].into_iter().flatten() {
+                        t.sampler = Sampler {
+                            mag,
+                            min,
+                            mip,
+                            ..t.sampler
+                        };
+                    }
+                }
+                assert_fast_matches_reference(&scene, &format!("{mag:?} {min:?} {mip:?}"));
+            }
+        }
+    }
+}
+
 /// Alpha-tested and blended objects on the fast path (visibility with the reference's alpha
 /// test, blended objects laid over the shaded image in drawing order) against the reference
 /// path, both builds: a map whose alpha crosses the cutoff smoothly (magnified and minified,

@@ -2,8 +2,10 @@
 //! `phong_core::Texture::sample` filters one (bilinear in a level, the two levels of
 //! `GL_LINEAR_MIPMAP_LINEAR` blended at `phong_core::Texture::lod`'s level of detail,
 //! repeat/clamp/mirror wrap), the texels of every lane fetched by gathers, one per corner and
-//! level ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]). The sampler (`sampler.rs`) calls
-//! it for each of an object's maps.
+//! level ([`Vf32::gather_rgb8`], [`Vf32::gather_rgb16`]). Maps of other filters (a nearest
+//! mipmap, nearest texels with mipmaps, magnification and minification filters that differ:
+//! glTF samplers) are sampled lane by lane by `phong_core`'s sampler. The sampler
+//! (`sampler.rs`) calls it for each of an object's maps.
 
 use super::sampler::Sampling;
 use super::vector::Vf32;
@@ -39,19 +41,18 @@ pub struct VectorMap<'a> {
     /// The coordinates come transformed already (the sampler folded `transform` into the
     /// coordinates' planes: [`VectorMap::folded`]).
     folded: bool,
+    /// A map of other filters, sampled lane by lane ([`texels_per_lane`]).
+    per_lane: Option<&'a TextureMap>,
 }
 
 impl<'a> VectorMap<'a> {
-    /// `map` if the sampler covers it: linear magnification and minification, mipmaps blended
-    /// (`GL_LINEAR_MIPMAP_LINEAR`) or none (`GL_LINEAR`); or nearest both ways without
-    /// mipmaps (`GL_NEAREST`).
+    /// `map` in the sampler's form: filtered by vector where linear both ways with mipmaps
+    /// blended (`GL_LINEAR_MIPMAP_LINEAR`) or none (`GL_LINEAR`), or nearest both ways without
+    /// mipmaps (`GL_NEAREST`); else sampled lane by lane. `None` past the levels it holds.
     pub(super) fn of(map: &'a TextureMap) -> Option<VectorMap<'a>> {
         let s = map.sampler;
         let linear = s.mag == Filter::Linear && s.min == Filter::Linear && s.mip != MipFilter::Nearest;
         let nearest = s.mag == Filter::Nearest && s.min == Filter::Nearest && s.mip == MipFilter::None;
-        if !linear && !nearest {
-            return None;
-        }
         let t = &map.texture;
         let count = t.level_count();
         if count > MAX_LEVELS {
@@ -80,12 +81,18 @@ impl<'a> VectorMap<'a> {
             unit: if t.bits() == 8 { 1.0 / 255.0 } else { 1.0 / 65535.0 },
             nearest,
             folded: false,
+            per_lane: (!linear && !nearest).then_some(map),
         })
     }
 
     /// The map's transform of texture coordinates.
     pub(super) fn transform(&self) -> UvTransform {
         self.transform
+    }
+
+    /// Whether its lanes are sampled one by one (filters the vector filter does not take).
+    pub(super) fn per_lane(&self) -> bool {
+        self.per_lane.is_some()
     }
 
     /// This map reading coordinates that its transform was applied to already.
@@ -299,6 +306,10 @@ fn sample<V: Sampling>(map: &VectorMap, u: V, v: V, d: [V; 4]) -> [V; 3] {
 /// `f32` wrapping (beyond ±2^21 texels) or NaN.
 #[inline(always)]
 pub(super) fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]> {
+    if let Some(source) = map.per_lane {
+        // (Never folded: `VectorMaps::derived`.)
+        return Some(texels_per_lane(source, uv));
+    }
     let (l, o) = (map.transform.linear, map.transform.offset);
     let (w0, h0) = (map.levels[0].0 as f32, map.levels[0].1 as f32);
     let [u, v, ux, vx, uy, vy] = uv;
@@ -326,6 +337,27 @@ pub(super) fn mapped<V: Sampling>(map: &VectorMap, uv: [V; 6]) -> Option<[V; 3]>
         *c = c.mul(V::splat(map.unit));
     }
     Some(t)
+}
+
+/// A map's RGB (`[0, 1]`) lane by lane by `phong_core::TextureMap::sample` at the map's set's
+/// coordinates `uv` (before its transform): for maps of filters the vector filter does not
+/// take, and for lanes whose coordinates its wrap cannot take (NaN, or past ±2^21 texels).
+#[inline(never)]
+pub(super) fn texels_per_lane<V: Vf32>(map: &TextureMap, uv: [V; 6]) -> [V; 3] {
+    let a = uv.map(V::to_array);
+    let mut out = [V::A::default(); 3];
+    for i in 0..V::N {
+        let at = |k: usize| a[k].as_ref()[i];
+        let t = map.sample(
+            glam::Vec2::new(at(0), at(1)),
+            glam::Vec2::new(at(2), at(3)),
+            glam::Vec2::new(at(4), at(5)),
+        );
+        for c in 0..3 {
+            out[c].as_mut()[i] = t[c];
+        }
+    }
+    out.map(V::from_array)
 }
 
 #[cfg(test)]
@@ -358,8 +390,8 @@ mod tests {
     /// The vector sampler against `phong_core::Texture::sample` at `Texture::lod`: random 8-
     /// and 16-bit textures of odd and even sizes, every wrap (the same both ways and not),
     /// trilinear, bilinear and nearest, coordinates over
-    /// several copies of the image and derivatives from magnified to the last level, on both
-    /// builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they differ in rounding only.
+    /// several copies of the image and derivatives from magnified to the last level (now and
+    /// then a ρ² past the largest float, or NaN), on both builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they differ in rounding only.
     #[test]
     fn the_vector_sampler_is_texture_sample() {
         let mut r = Lcg(5);
@@ -417,6 +449,13 @@ mod tests {
                             };
                             for dk in &mut d {
                                 dk[i] = (r.next() * 2.0 - 1.0) * scale;
+                            }
+                            // Now and then a lane's ρ² past the largest float, or NaN.
+                            if round % 16 == 5 && i == 2 {
+                                d[0][i] = 1e30;
+                            }
+                            if round % 16 == 9 && i == 3 {
+                                d[1][i] = f32::NAN;
                             }
                         }
                         let want: Vec<[f32; 4]> = (0..8)

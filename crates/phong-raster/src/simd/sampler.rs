@@ -13,7 +13,7 @@
 //! that change the light itself, normal, shininess and metallic-roughness, are sampled per
 //! lane here for such a vector).
 
-use super::filter::{VectorMap, bilinear_lanes, mapped};
+use super::filter::{VectorMap, bilinear_lanes, mapped, texels_per_lane};
 use super::kernel::{
     Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal,
     shade_shininess,
@@ -198,8 +198,11 @@ impl<'a> VectorMaps<'a> {
         };
         let second = all().any(|m| m.second);
         let first = all().next().map(VectorMap::transform);
+        // (A map sampled lane by lane transforms its coordinates itself.)
         let fold = match first {
-            Some(t) if !second && !self.changes_light() && all().all(|m| m.transform() == t) => Some(t),
+            Some(t) if !second && !self.changes_light() && all().all(|m| m.transform() == t && !m.per_lane()) => {
+                Some(t)
+            }
             _ => None,
         };
         let folded = |m: Option<VectorMap<'a>>| if fold.is_some() { m.map(VectorMap::folded) } else { m };
@@ -429,26 +432,6 @@ fn tangent_space<V: Vf32>(map: &NormalMap, t: [V; 3]) -> [V; 3] {
         t[1].mul_add(two, V::splat(-1.0)).mul(V::splat(y)),
         t[2].mul(two).sub(one),
     ]
-}
-
-/// A map's RGB for lanes whose coordinates `uv` (the map's set) the vector wrap cannot take:
-/// each sampled by `phong_core::TextureMap::sample` (rare: NaN, or past ±2^21 texels).
-#[inline(never)]
-fn texels_per_lane<V: Vf32>(map: &TextureMap, uv: [V; 6]) -> [V; 3] {
-    let a = uv.map(V::to_array);
-    let mut out = [V::A::default(); 3];
-    for i in 0..V::N {
-        let at = |k: usize| a[k].as_ref()[i];
-        let t = map.sample(
-            glam::Vec2::new(at(0), at(1)),
-            glam::Vec2::new(at(2), at(3)),
-            glam::Vec2::new(at(4), at(5)),
-        );
-        for c in 0..3 {
-            out[c].as_mut()[i] = t[c];
-        }
-    }
-    out.map(V::from_array)
 }
 
 /// A pixel the vector sampler leaves to the caller's per-pixel sampler, with its light
@@ -780,6 +763,13 @@ mod tests {
         assert_eq!((red(plain.folded()), red(plain)), (1.0, 0.0));
         let other = maps(a, b);
         assert_eq!(VectorMaps::new(&other).unwrap().fold, None);
+        // A map sampled lane by lane (`GL_LINEAR_MIPMAP_NEAREST`) transforms its coordinates
+        // itself: nothing folds.
+        let mut per_lane = maps(a, a);
+        per_lane.specular.as_mut().unwrap().sampler.mip = phong_core::MipFilter::Nearest;
+        let v = VectorMaps::new(&per_lane).unwrap();
+        assert!(v.specular.unwrap().per_lane() && !v.diffuse.unwrap().per_lane());
+        assert_eq!(v.fold, None);
         // A shininess map changes the light: its lanes outside the vector wrap are sampled per
         // lane, from the coordinates before the transform.
         let mut shiny = maps(a, a);
