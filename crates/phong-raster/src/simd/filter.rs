@@ -389,9 +389,10 @@ mod tests {
 
     /// The vector sampler against `phong_core::Texture::sample` at `Texture::lod`: random 8-
     /// and 16-bit textures of odd and even sizes, every wrap (the same both ways and not),
-    /// trilinear, bilinear and nearest, coordinates over
-    /// several copies of the image and derivatives from magnified to the last level (now and
-    /// then a ρ² past the largest float, or NaN), on both builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they differ in rounding only.
+    /// trilinear, bilinear and nearest, coordinates over several copies of the image and
+    /// derivatives from magnified to the last level (now and then a ρ² past the largest float,
+    /// or NaN), on both builds. Within 10⁻⁴ of the value (0.026/255; measured 3·10⁻⁶): they
+    /// differ in rounding only.
     #[test]
     fn the_vector_sampler_is_texture_sample() {
         let mut r = Lcg(5);
