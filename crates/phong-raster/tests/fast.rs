@@ -406,6 +406,12 @@ fn assert_fast_matches_reference(scene: &Scene, what: &str) {
     }
 }
 
+/// Scene TOML of `objects` in a 200×120 image, the camera at `z = 6` and one point light.
+fn in_small_frame(objects: &str) -> String {
+    let head = "[image]\nwidth = 200\nheight = 120\n[camera]\nposition = [0.0, 0.0, 6.0]\n";
+    format!("{head}[[light]]\ntype = \"point\"\nposition = [2.0, 2.0, 4.0]\n{objects}")
+}
+
 /// A folder of the temporary directory, removed when dropped (when its test ends, failed too).
 struct Dir(std::path::PathBuf);
 
@@ -639,15 +645,8 @@ material = {{ base = "chrome", emission = [0.2, 0.1, 0.3], emission_map = "asset
 #[test]
 fn fast_path_matches_reference_with_maps_on_the_second_set() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let src = r#"
-[image]
-width = 200
-height = 120
-[camera]
-position = [0.0, 0.0, 6.0]
-[[light]]
-type = "point"
-position = [2.0, 2.0, 4.0]
+    let src = in_small_frame(
+        r#"
 [[object]]
 shape = "sphere"
 position = [-2.0, 0.6, 0.0]
@@ -663,8 +662,9 @@ position = [0.0, -1.5, 0.0]
 scale = 3.0
 rotation = [60.0, 0.0, 0.0]
 material = { base = "pewter", diffuse_map = "assets/checker.png" }
-"#;
-    let mut scene = phong_scene::parse_scene(src, &root.join("second.toml")).unwrap().scene;
+"#,
+    );
+    let mut scene = phong_scene::parse_scene(&src, &root.join("second.toml")).unwrap().scene;
     // The second set: the first turned a quarter and scaled (the plane's far past the wrap).
     for (i, scale) in [(0, 3.0), (1, 2.0), (2, 3.0e5)] {
         let o = &mut scene.objects[i];
@@ -1114,15 +1114,8 @@ material = {{ base = "chrome", diffuse_map = "assets/checker.png", filter = "nea
 #[test]
 fn fast_path_matches_reference_with_any_filters() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let src = r#"
-[image]
-width = 200
-height = 120
-[camera]
-position = [0.0, 0.0, 6.0]
-[[light]]
-type = "point"
-position = [2.0, 2.0, 4.0]
+    let src = in_small_frame(
+        r#"
 [[object]]
 shape = "sphere"
 position = [-1.8, 0.6, 2.0]
@@ -1143,8 +1136,11 @@ position = [-1.0, -1.3, 0.0]
 scale = 0.6
 interpolation = "gouraud"
 material = { base = "gold", diffuse_map = "assets/checker.png", uv_scale = [3.0, 3.0] }
-"#;
-    let base = phong_scene::parse_scene(src, &root.join("filters.toml")).unwrap().scene;
+"#,
+    );
+    let base = phong_scene::parse_scene(&src, &root.join("filters.toml"))
+        .unwrap()
+        .scene;
     for mag in [Filter::Linear, Filter::Nearest] {
         for min in [Filter::Linear, Filter::Nearest] {
             for mip in [MipFilter::Nearest, MipFilter::Linear, MipFilter::None] {
