@@ -387,8 +387,7 @@ mod tests {
 
     /// Ambient, emission and occlusion maps, and maps on the second set of coordinates, are
     /// drawn by the vector sampler (the fast path's textured mode), not per pixel; so is one of
-    /// filters it samples lane by lane (`GL_LINEAR_MIPMAP_NEAREST`), whose transform it does
-    /// not fold.
+    /// filters it samples lane by lane (`GL_LINEAR_MIPMAP_NEAREST`).
     #[test]
     fn ambient_emission_occlusion_and_second_set_maps_take_the_vector_sampler() {
         let src = r#"
