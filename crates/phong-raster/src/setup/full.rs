@@ -35,7 +35,8 @@ impl Frame<'_> {
         let vec3 = |c: Color| Vec3::from(c.to_array());
         let color = |v: Vec3| Color::new(v.x, v.y, v.z);
         // Flat on the fast path: every triangle lit at once at its centroid by the vector
-        // kernel, as Gouraud vertices are (the reference lights each with `vertex_light`).
+        // kernel, as Gouraud vertices are (the reference lights each with `vertex_light`); with
+        // the facet normals, kept for the triangles' planes.
         let flat_lit = (keep.planes && interpolation == Interpolation::Flat)
             .then(|| lit_term(obj.shading.output))
             .flatten()
@@ -56,7 +57,7 @@ impl Frame<'_> {
                         ((a + b + c) / 3.0, facet_normal(a, b, c))
                     })
                     .unzip();
-                lighting.light_all(&centroids, &normals)
+                (lighting.light_all(&centroids, &normals), normals)
             });
         let verts: Vec<ClipVertex> = mesh
             .positions()
@@ -126,18 +127,18 @@ impl Frame<'_> {
                 let t = tri.map(|i| verts[i as usize]);
                 // Flat: front and (two-sided) back colours, from the facet normal at the centroid.
                 let flat = (interpolation == Interpolation::Flat).then(|| -> [Flat; 2] {
-                    let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
-                    let (front, back) = match &flat_lit {
-                        Some([f, b, fs, bs]) => {
+                    let (fnorm, front, back) = match &flat_lit {
+                        Some(([f, b, fs, bs], normals)) => {
                             let i = ci * SETUP_CHUNK + k;
                             let at = |v: &Vec<Vec3>| v.get(i).map_or(Color::BLACK, |&c| color(c));
                             let front = (at(f), at(fs));
-                            (front, if two_sided { (at(b), at(bs)) } else { front })
+                            (normals[i], front, if two_sided { (at(b), at(bs)) } else { front })
                         }
                         None => {
+                            let fnorm = facet_normal(t[0].world, t[1].world, t[2].world);
                             let centroid = (t[0].world + t[1].world + t[2].world) / 3.0;
                             let front = lit(centroid, fnorm);
-                            (front, if two_sided { lit(centroid, -fnorm) } else { front })
+                            (fnorm, front, if two_sided { lit(centroid, -fnorm) } else { front })
                         }
                     };
                     [(front.0, front.1, fnorm), (back.0, back.1, -fnorm)]
