@@ -51,6 +51,10 @@ pub struct RunArgs {
     /// CPU: the scalar reference path instead of the fast path.
     #[arg(long)]
     pub reference: bool,
+    /// CPU: the shading kernels' AVX2 build even where the CPU has AVX-512 (whose build has
+    /// twice the vector registers; the images are the same). For comparisons.
+    #[arg(long)]
+    pub no_avx512: bool,
     /// Print counts, the backend and the time of each stage.
     #[arg(short, long)]
     pub verbose: bool,
@@ -156,6 +160,7 @@ pub struct Job {
     pub backend: Backend,
     pub gpu_path: GpuPathArg,
     pub reference: bool,
+    pub no_avx512: bool,
     pub verbose: bool,
 }
 
@@ -253,6 +258,7 @@ impl RunArgs {
             backend: self.backend,
             gpu_path: self.gpu_path,
             reference: self.reference,
+            no_avx512: self.no_avx512,
             verbose: self.verbose,
         })
     }
@@ -285,6 +291,7 @@ impl Job {
             progress,
             reference: self.reference,
             no_avx2: false,
+            no_avx512: self.no_avx512,
         }
     }
 

@@ -29,7 +29,8 @@ pub fn backend(job: &Job, gpu: Option<&phong_gpu::Gpu>, compute: bool) -> String
             let n = job
                 .threads
                 .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-            format!("cpu, {n} threads")
+            let kernels = phong_raster::kernels(&job.options(None));
+            format!("cpu, {n} threads, {kernels}")
         }
     }
 }

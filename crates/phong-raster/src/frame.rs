@@ -336,7 +336,7 @@ pub(crate) fn render<P: Pixel>(
 ) -> Result<RenderStats, Error> {
     let t0 = Instant::now();
     let path = if options.reference { Path::Reference } else { Path::Fast };
-    let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2), scratch);
+    let frame = Frame::build(scene, path, Isa::detect(!options.no_avx2, !options.no_avx512), scratch);
     let setup = t0.elapsed();
     let t1 = Instant::now();
     let clock = StageClock::default();

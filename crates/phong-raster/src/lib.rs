@@ -96,6 +96,25 @@ pub struct RenderOptions<'a> {
     /// Fast path: do not use the AVX2 build of the kernel even where the CPU has AVX2 (for
     /// tests; the images are the same).
     pub no_avx2: bool,
+    /// Fast path: do not use the wide-register (AVX-512VL) build of the shading kernels even
+    /// where the CPU has AVX-512 (for tests and comparisons; the images are the same, bit for
+    /// bit).
+    pub no_avx512: bool,
+}
+
+/// The CPU path and kernel build `options` render with on this CPU, in words: `reference
+/// path`, or the fast path's kernels: `AVX2 kernels (AVX-512 registers)`, `AVX2 kernels` or
+/// `portable kernels`.
+pub fn kernels(options: &RenderOptions) -> &'static str {
+    if options.reference {
+        return "reference path";
+    }
+    let isa = crate::simd::Isa::detect(!options.no_avx2, !options.no_avx512);
+    match (isa.is_avx2(), isa.wide()) {
+        (true, true) => "AVX2 kernels (AVX-512 registers)",
+        (true, false) => "AVX2 kernels",
+        _ => "portable kernels",
+    }
 }
 
 /// Renders `scene` into a linear RGBA image.
@@ -251,7 +270,7 @@ pub(crate) mod testkit {
     /// The AVX2 build, or `None` (the test skips, saying so) on a CPU without it; with
     /// `PHONG_REQUIRE_AVX2=1` a CPU without it fails the test instead.
     pub fn avx2() -> Option<Isa> {
-        let isa = Isa::detect(true);
+        let isa = Isa::detect(true, true);
         if isa.is_avx2() {
             return Some(isa);
         }

@@ -152,3 +152,68 @@ fn example_scenes_match_their_golden_images() {
          this CPU's estimates differ from the blessing CPU's)"
     );
 }
+
+/// The shading kernels' wide-register build (their AVX2 code compiled with AVX-512VL, so that
+/// LLVM has 32 vector registers: `Isa::wide`) draws the AVX2 build's images bit for bit: every
+/// example scene and the textured benchmark scenes (diffuse, specular, ambient, emission,
+/// normal and shininess maps; Gouraud), each at 320×180 with 1 and 3 threads, every channel's
+/// `f32`. Skipped, saying
+/// so, on a CPU without AVX-512F, VL, BW and DQ.
+#[test]
+fn wide_registers_draw_the_avx2_images() {
+    if !phong_raster::internals::Isa::detect(true, true).wide() {
+        eprintln!("skipped: this CPU has no AVX-512F, VL, BW and DQ");
+        return;
+    }
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    for name in [
+        "sphere_100k_textured_1",
+        "sphere_100k_textured_maps_1",
+        "sphere_100k_normal_1",
+        "sphere_100k_shininess_1",
+        "sphere_100k_gouraud_textured_1",
+        "fill_4lights",
+        "fill_4lights_textured",
+    ] {
+        scenes.push(root().join(format!("benches/scenes/{name}.toml")));
+    }
+    for path in &scenes {
+        let mut scene = phong_scene::load(path).unwrap().scene;
+        (scene.image.width, scene.image.height) = (320, 180);
+        for threads in [1, 3] {
+            let image = |no_avx512| {
+                let options = RenderOptions {
+                    threads: Some(threads),
+                    no_avx512,
+                    ..Default::default()
+                };
+                assert_eq!(
+                    phong_raster::kernels(&options),
+                    if no_avx512 {
+                        "AVX2 kernels"
+                    } else {
+                        "AVX2 kernels (AVX-512 registers)"
+                    }
+                );
+                let image = phong_raster::render(&scene, &options).unwrap();
+                image
+                    .pixels()
+                    .iter()
+                    .flatten()
+                    .map(|c| c.to_bits())
+                    .collect::<Vec<u32>>()
+            };
+            // Compared in f32, bit for bit (a rounding apart rarely changes an 8-bit value).
+            assert!(
+                image(false) == image(true),
+                "{}, {threads} threads: the wide build's image differs",
+                path.display()
+            );
+        }
+    }
+}

@@ -7,7 +7,10 @@
 //! vectorises what it can) or, when the CPU has AVX2 and FMA and the caller allows it, on
 //! `vector::Avx2` inside a `#[target_feature(enable = "avx2,fma")]` function. The two builds
 //! differ in rounding (fused multiply-adds, refined reciprocal estimates): both are tested
-//! against `phong_core::shade`, and the images of both against the reference path.
+//! against `phong_core::shade`, and the images of both against the reference path. The
+//! per-pixel shading entry points have a third build where the CPU has AVX-512: the AVX2 code
+//! compiled with AVX-512VL as well, for its 32 vector registers ([`Isa::wide`]); its images
+//! are the AVX2 build's, bit for bit.
 
 mod filter;
 pub mod kernel;
@@ -36,29 +39,73 @@ pub fn avx2_available() -> bool {
     }
 }
 
+/// Whether the CPU has the AVX-512 features (F, VL, BW, DQ) that the shading kernels'
+/// wide-register build is compiled with (see [`Isa::wide`]).
+#[cfg(target_arch = "x86_64")]
+fn avx512_available() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+}
+
 /// The instruction set the kernels run on, chosen once per frame. An AVX2 `Isa` is made only
-/// by [`Isa::detect`] on a CPU with AVX2 and FMA, so holding one is what the AVX2 builds'
-/// `unsafe` calls rely on.
+/// by [`Isa::detect`] on a CPU with AVX2 and FMA (and a wide one only on a CPU with AVX-512F,
+/// VL, BW and DQ too), so holding one is what the AVX2 builds' `unsafe` calls rely on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Isa {
     avx2: bool,
+    wide: bool,
 }
 
 impl Isa {
     /// Plain Rust (`[f32; 8]` loops): any CPU.
-    pub const PORTABLE: Isa = Isa { avx2: false };
+    pub const PORTABLE: Isa = Isa {
+        avx2: false,
+        wide: false,
+    };
 
-    /// AVX2 and FMA where the CPU has them and `allow_avx2`, else [`Isa::PORTABLE`].
-    pub fn detect(allow_avx2: bool) -> Isa {
-        Isa {
-            avx2: allow_avx2 && avx2_available(),
-        }
+    /// AVX2 and FMA where the CPU has them and `allow_avx2`, else [`Isa::PORTABLE`]; with wide
+    /// registers ([`Isa::wide`]) where the CPU has AVX-512 and `allow_avx512`.
+    pub fn detect(allow_avx2: bool, allow_avx512: bool) -> Isa {
+        let avx2 = allow_avx2 && avx2_available();
+        #[cfg(target_arch = "x86_64")]
+        let wide = avx2 && allow_avx512 && avx512_available();
+        #[cfg(not(target_arch = "x86_64"))]
+        let wide = {
+            let _ = allow_avx512;
+            false
+        };
+        Isa { avx2, wide }
     }
 
     /// Whether this is the AVX2 build.
     pub fn is_avx2(self) -> bool {
         self.avx2
     }
+
+    /// Whether the per-pixel shading kernels run in their wide-register build: the same AVX2
+    /// code compiled with AVX-512VL, so that LLVM has 32 vector registers instead of 16 (the
+    /// textured kernels' 16-lane values no longer spill to the stack). The arithmetic is the
+    /// same instructions: the images are the AVX2 build's, bit for bit (tested).
+    pub fn wide(self) -> bool {
+        self.wide
+    }
+}
+
+/// Defines one kernel entry point twice: `$avx2`, compiled with AVX2 and FMA, and `$wide`, the
+/// same body compiled with AVX-512F, VL, BW and DQ as well (see [`Isa::wide`]). Generics go
+/// in brackets.
+macro_rules! avx2_and_wide {
+    (fn $avx2:ident / $wide:ident [$($g:tt)*] ($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        fn $avx2<$($g)*>($($arg: $ty),*) $(-> $ret)? $body
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+        fn $wide<$($g)*>($($arg: $ty),*) $(-> $ret)? $body
+    };
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -110,17 +157,17 @@ pub fn shade_batch_lit<'p>(
     kernel::shade_batch_lit::<vector::Portable>(prep, n, lane, out)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn shade_batch_textured_avx2<'p, const FULL: bool, const PER_VERTEX: bool>(
-    prep: &Prepared,
-    maps: &VectorMaps,
-    n: usize,
-    lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
-    out: impl FnMut(usize, [f32; 3]),
-    unsampled: &mut Vec<Unsampled<usize>>,
-) {
-    sampler::shade_batch_textured::<vector::Avx2x2, FULL, PER_VERTEX>(prep, maps, n, lane, out, unsampled)
+avx2_and_wide! {
+    fn shade_batch_textured_avx2 / shade_batch_textured_wide ['p, const FULL: bool, const PER_VERTEX: bool] (
+        prep: &Prepared,
+        maps: &VectorMaps,
+        n: usize,
+        lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
+        out: impl FnMut(usize, [f32; 3]),
+        unsampled: &mut Vec<Unsampled<usize>>,
+    ) {
+        sampler::shade_batch_textured::<vector::Avx2x2, FULL, PER_VERTEX>(prep, maps, n, lane, out, unsampled)
+    }
 }
 
 /// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
@@ -139,13 +186,18 @@ pub fn shade_batch_textured<'p>(
 ) {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
-        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
         unsafe {
-            match (maps.full(), maps.per_vertex()) {
-                (true, true) => shade_batch_textured_avx2::<true, true>(prep, maps, n, lane, out, unsampled),
-                (true, false) => shade_batch_textured_avx2::<true, false>(prep, maps, n, lane, out, unsampled),
-                (false, true) => shade_batch_textured_avx2::<false, true>(prep, maps, n, lane, out, unsampled),
-                (false, false) => shade_batch_textured_avx2::<false, false>(prep, maps, n, lane, out, unsampled),
+            match (isa.wide(), maps.full(), maps.per_vertex()) {
+                (false, true, true) => shade_batch_textured_avx2::<true, true>(prep, maps, n, lane, out, unsampled),
+                (false, true, false) => shade_batch_textured_avx2::<true, false>(prep, maps, n, lane, out, unsampled),
+                (false, false, true) => shade_batch_textured_avx2::<false, true>(prep, maps, n, lane, out, unsampled),
+                (false, false, false) => shade_batch_textured_avx2::<false, false>(prep, maps, n, lane, out, unsampled),
+                (true, true, true) => shade_batch_textured_wide::<true, true>(prep, maps, n, lane, out, unsampled),
+                (true, true, false) => shade_batch_textured_wide::<true, false>(prep, maps, n, lane, out, unsampled),
+                (true, false, true) => shade_batch_textured_wide::<false, true>(prep, maps, n, lane, out, unsampled),
+                (true, false, false) => shade_batch_textured_wide::<false, false>(prep, maps, n, lane, out, unsampled),
             }
         };
         return;
@@ -160,20 +212,20 @@ pub fn shade_batch_textured<'p>(
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn shade_group_textured_avx2<const FULL: bool, const PER_VERTEX: bool>(
-    prep: &Prepared,
-    maps: &VectorMaps,
-    planes: (&Planes, &Planes),
-    origin: (u32, u32),
-    pixels: &[u32],
-    out: impl FnMut(u32, [f32; 3]),
-    unsampled: &mut Vec<Unsampled<u32>>,
-) -> usize {
-    sampler::shade_group_textured::<vector::Avx2x2, FULL, PER_VERTEX>(
-        prep, maps, planes, origin, pixels, out, unsampled,
-    )
+avx2_and_wide! {
+    fn shade_group_textured_avx2 / shade_group_textured_wide [const FULL: bool, const PER_VERTEX: bool] (
+        prep: &Prepared,
+        maps: &VectorMaps,
+        planes: (&Planes, &Planes),
+        origin: (u32, u32),
+        pixels: &[u32],
+        out: impl FnMut(u32, [f32; 3]),
+        unsampled: &mut Vec<Unsampled<u32>>,
+    ) -> usize {
+        sampler::shade_group_textured::<vector::Avx2x2, FULL, PER_VERTEX>(
+            prep, maps, planes, origin, pixels, out, unsampled,
+        )
+    }
 }
 
 /// [`shade_batch_textured`] for the pixels of one triangle, its planes and its coordinates'
@@ -191,21 +243,19 @@ pub fn shade_group_textured(
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
-        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
         return unsafe {
-            match (maps.full(), maps.per_vertex()) {
-                (true, true) => {
-                    shade_group_textured_avx2::<true, true>(prep, maps, planes, origin, pixels, out, unsampled)
-                }
-                (true, false) => {
-                    shade_group_textured_avx2::<true, false>(prep, maps, planes, origin, pixels, out, unsampled)
-                }
-                (false, true) => {
-                    shade_group_textured_avx2::<false, true>(prep, maps, planes, origin, pixels, out, unsampled)
-                }
-                (false, false) => {
-                    shade_group_textured_avx2::<false, false>(prep, maps, planes, origin, pixels, out, unsampled)
-                }
+            let (p, m, o, u) = (prep, maps, origin, unsampled);
+            match (isa.wide(), maps.full(), maps.per_vertex()) {
+                (false, true, true) => shade_group_textured_avx2::<true, true>(p, m, planes, o, pixels, out, u),
+                (false, true, false) => shade_group_textured_avx2::<true, false>(p, m, planes, o, pixels, out, u),
+                (false, false, true) => shade_group_textured_avx2::<false, true>(p, m, planes, o, pixels, out, u),
+                (false, false, false) => shade_group_textured_avx2::<false, false>(p, m, planes, o, pixels, out, u),
+                (true, true, true) => shade_group_textured_wide::<true, true>(p, m, planes, o, pixels, out, u),
+                (true, true, false) => shade_group_textured_wide::<true, false>(p, m, planes, o, pixels, out, u),
+                (true, false, true) => shade_group_textured_wide::<false, true>(p, m, planes, o, pixels, out, u),
+                (true, false, false) => shade_group_textured_wide::<false, false>(p, m, planes, o, pixels, out, u),
             }
         };
     }
@@ -227,15 +277,15 @@ pub fn shade_group_textured(
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn shade_batch_avx2<'p>(
-    batch: Batch,
-    n: usize,
-    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
-    out: impl FnMut(usize, [f32; 3]),
-) {
-    kernel::shade_batch::<vector::Avx2x2>(batch, n, lane, out)
+avx2_and_wide! {
+    fn shade_batch_avx2 / shade_batch_wide ['p] (
+        batch: Batch,
+        n: usize,
+        lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+        out: impl FnMut(usize, [f32; 3]),
+    ) {
+        kernel::shade_batch::<vector::Avx2x2>(batch, n, lane, out)
+    }
 }
 
 /// Interpolates and shades `n` pixels, 8 at a time: `lane(i)` gives pixel `i`'s centre and its
@@ -250,8 +300,15 @@ pub fn shade_batch<'p>(
 ) {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
-        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        unsafe { shade_batch_avx2(batch, n, lane, out) };
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
+        unsafe {
+            if isa.wide() {
+                shade_batch_wide(batch, n, lane, out)
+            } else {
+                shade_batch_avx2(batch, n, lane, out)
+            }
+        };
         return;
     }
     let _ = isa;
@@ -323,16 +380,16 @@ pub fn group_lanes(isa: Isa) -> usize {
     <vector::Portable as vector::Vf32>::N
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn shade_group_avx2(
-    batch: Batch,
-    planes: &Planes,
-    origin: (u32, u32),
-    pixels: &[u32],
-    out: impl FnMut(u32, [f32; 3]),
-) -> usize {
-    kernel::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+avx2_and_wide! {
+    fn shade_group_avx2 / shade_group_wide [] (
+        batch: Batch,
+        planes: &Planes,
+        origin: (u32, u32),
+        pixels: &[u32],
+        out: impl FnMut(u32, [f32; 3]),
+    ) -> usize {
+        kernel::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+    }
 }
 
 /// Interpolates and shades the pixels of one triangle (its [`Planes`] broadcast to all lanes):
@@ -349,8 +406,15 @@ pub fn shade_group(
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
-        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        return unsafe { shade_group_avx2(batch, planes, origin, pixels, out) };
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
+        return unsafe {
+            if isa.wide() {
+                shade_group_wide(batch, planes, origin, pixels, out)
+            } else {
+                shade_group_avx2(batch, planes, origin, pixels, out)
+            }
+        };
     }
     let _ = isa;
     kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)

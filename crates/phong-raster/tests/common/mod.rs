@@ -35,7 +35,7 @@ impl Rng {
 #[allow(dead_code)] // each test file uses part of it
 pub fn isas() -> Vec<phong_raster::internals::Isa> {
     use phong_raster::internals::Isa;
-    let avx2 = Isa::detect(true);
+    let avx2 = Isa::detect(true, true);
     if !avx2.is_avx2() {
         assert!(
             std::env::var_os("PHONG_REQUIRE_AVX2").is_none_or(|v| v != "1"),
@@ -80,7 +80,7 @@ pub fn paths() -> Vec<CpuPath> {
         reference,
         no_avx2,
         threads: Some(threads),
-        progress: None,
+        ..Default::default()
     };
     let mut v = vec![
         CpuPath {
