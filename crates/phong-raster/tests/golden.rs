@@ -40,6 +40,17 @@ fn read_png(p: &Path) -> ((u32, u32), bool, Vec<u8>) {
     ((info.width, info.height), info.color_type.samples() == 4, buf)
 }
 
+/// The example scenes' files, in name order.
+fn example_scenes() -> Vec<PathBuf> {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
 /// FNV-1a, 64 bits.
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
@@ -56,12 +67,7 @@ fn example_scenes_match_their_golden_images() {
         .lines()
         .filter_map(|l| l.split_once(' ').map(|(k, v)| (k.to_string(), v.to_string())))
         .collect();
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    scenes.sort();
+    let scenes = example_scenes();
     assert!(scenes.len() >= 7, "{} example scenes", scenes.len());
     let isas = common::isas();
     let (mut checked, mut pngs, mut estimated) = (0, 0, 0);
@@ -165,12 +171,7 @@ fn wide_registers_draw_the_avx2_images() {
         eprintln!("skipped: this CPU has no AVX-512F, VL, BW and DQ");
         return;
     }
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(root().join("examples/scenes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    scenes.sort();
+    let mut scenes = example_scenes();
     for name in [
         "sphere_100k_textured_1",
         "sphere_100k_textured_maps_1",
