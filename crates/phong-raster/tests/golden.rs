@@ -161,9 +161,9 @@ fn example_scenes_match_their_golden_images() {
 
 /// The shading kernels' wide-register build (their AVX2 code compiled with AVX-512VL, so that
 /// LLVM has 32 vector registers: `Isa::wide`) draws the AVX2 build's images bit for bit: every
-/// example scene and the textured benchmark scenes (diffuse, specular, ambient, emission,
-/// normal and shininess maps; Gouraud), each at 320×180 with 1 and 3 threads, every channel's
-/// `f32`. Skipped, saying
+/// example scene and the textured benchmark scenes, each at 320×180 with 1 and 3 threads,
+/// every channel's `f32`. (Textured forms without a wide build, such as normal maps or
+/// Gouraud, run the AVX2 build in both.) Skipped, saying
 /// so, on a CPU without AVX-512F, VL, BW and DQ.
 #[test]
 fn wide_registers_draw_the_avx2_images() {

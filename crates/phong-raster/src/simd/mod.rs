@@ -189,15 +189,17 @@ pub fn shade_batch_textured<'p>(
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
         // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
         unsafe {
-            match (isa.wide(), maps.full(), maps.per_vertex()) {
-                (false, true, true) => shade_batch_textured_avx2::<true, true>(prep, maps, n, lane, out, unsampled),
-                (false, true, false) => shade_batch_textured_avx2::<true, false>(prep, maps, n, lane, out, unsampled),
-                (false, false, true) => shade_batch_textured_avx2::<false, true>(prep, maps, n, lane, out, unsampled),
-                (false, false, false) => shade_batch_textured_avx2::<false, false>(prep, maps, n, lane, out, unsampled),
-                (true, true, true) => shade_batch_textured_wide::<true, true>(prep, maps, n, lane, out, unsampled),
-                (true, true, false) => shade_batch_textured_wide::<true, false>(prep, maps, n, lane, out, unsampled),
-                (true, false, true) => shade_batch_textured_wide::<false, true>(prep, maps, n, lane, out, unsampled),
-                (true, false, false) => shade_batch_textured_wide::<false, false>(prep, maps, n, lane, out, unsampled),
+            // The wide build for the common form only (diffuse and specular maps, light per
+            // pixel): the general and Gouraud forms' wide builds made the release build 47 s
+            // longer (BENCHMARKS.md, "The shading kernels' wide-register build").
+            match (maps.full(), maps.per_vertex()) {
+                (false, false) if isa.wide() => {
+                    shade_batch_textured_wide::<false, false>(prep, maps, n, lane, out, unsampled)
+                }
+                (true, true) => shade_batch_textured_avx2::<true, true>(prep, maps, n, lane, out, unsampled),
+                (true, false) => shade_batch_textured_avx2::<true, false>(prep, maps, n, lane, out, unsampled),
+                (false, true) => shade_batch_textured_avx2::<false, true>(prep, maps, n, lane, out, unsampled),
+                (false, false) => shade_batch_textured_avx2::<false, false>(prep, maps, n, lane, out, unsampled),
             }
         };
         return;
@@ -247,15 +249,15 @@ pub fn shade_group_textured(
         // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
         return unsafe {
             let (p, m, o, u) = (prep, maps, origin, unsampled);
-            match (isa.wide(), maps.full(), maps.per_vertex()) {
-                (false, true, true) => shade_group_textured_avx2::<true, true>(p, m, planes, o, pixels, out, u),
-                (false, true, false) => shade_group_textured_avx2::<true, false>(p, m, planes, o, pixels, out, u),
-                (false, false, true) => shade_group_textured_avx2::<false, true>(p, m, planes, o, pixels, out, u),
-                (false, false, false) => shade_group_textured_avx2::<false, false>(p, m, planes, o, pixels, out, u),
-                (true, true, true) => shade_group_textured_wide::<true, true>(p, m, planes, o, pixels, out, u),
-                (true, true, false) => shade_group_textured_wide::<true, false>(p, m, planes, o, pixels, out, u),
-                (true, false, true) => shade_group_textured_wide::<false, true>(p, m, planes, o, pixels, out, u),
-                (true, false, false) => shade_group_textured_wide::<false, false>(p, m, planes, o, pixels, out, u),
+            // The wide build for the common form only (see `shade_batch_textured`).
+            match (maps.full(), maps.per_vertex()) {
+                (false, false) if isa.wide() => {
+                    shade_group_textured_wide::<false, false>(p, m, planes, o, pixels, out, u)
+                }
+                (true, true) => shade_group_textured_avx2::<true, true>(p, m, planes, o, pixels, out, u),
+                (true, false) => shade_group_textured_avx2::<true, false>(p, m, planes, o, pixels, out, u),
+                (false, true) => shade_group_textured_avx2::<false, true>(p, m, planes, o, pixels, out, u),
+                (false, false) => shade_group_textured_avx2::<false, false>(p, m, planes, o, pixels, out, u),
             }
         };
     }
