@@ -51,8 +51,9 @@ pub struct RunArgs {
     /// CPU: the scalar reference path instead of the fast path.
     #[arg(long)]
     pub reference: bool,
-    /// CPU: the shading kernels' AVX2 build even where the CPU has AVX-512 (whose build has
-    /// twice the vector registers; the images are the same). For comparisons.
+    /// CPU: keep the shading kernels to their AVX2 build where the CPU has AVX-512 (there the
+    /// default is the same code with AVX-512's 32 vector registers; the images are the same).
+    /// For comparisons.
     #[arg(long)]
     pub no_avx512: bool,
     /// Print counts, the backend and the time of each stage.

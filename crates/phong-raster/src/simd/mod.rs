@@ -7,10 +7,10 @@
 //! vectorises what it can) or, when the CPU has AVX2 and FMA and the caller allows it, on
 //! `vector::Avx2` inside a `#[target_feature(enable = "avx2,fma")]` function. The two builds
 //! differ in rounding (fused multiply-adds, refined reciprocal estimates): both are tested
-//! against `phong_core::shade`, and the images of both against the reference path. The
-//! per-pixel shading entry points have a third build where the CPU has AVX-512: the AVX2 code
-//! compiled with AVX-512VL as well, for its 32 vector registers ([`Isa::wide`]); its images
-//! are the AVX2 build's, bit for bit.
+//! against `phong_core::shade`, and the images of both against the reference path. Most
+//! per-pixel shading runs a third build where the CPU has AVX-512: the AVX2 code compiled
+//! with AVX-512VL as well, for its 32 vector registers ([`Isa::wide`]); its images are the
+//! AVX2 build's, bit for bit.
 
 mod filter;
 pub mod kernel;
@@ -84,10 +84,11 @@ impl Isa {
         self.avx2
     }
 
-    /// Whether the per-pixel shading kernels run in their wide-register build: the same AVX2
-    /// code compiled with AVX-512VL, so that LLVM has 32 vector registers instead of 16 (the
-    /// textured kernels' 16-lane values no longer spill to the stack). The arithmetic is the
-    /// same instructions: the images are the AVX2 build's, bit for bit (tested).
+    /// Whether the per-pixel shading kernels (untextured, and textured in the common form:
+    /// diffuse and specular maps, light per pixel) run in their wide-register build: the same
+    /// AVX2 code compiled with AVX-512VL, so that LLVM has 32 vector registers instead of 16
+    /// (the textured kernels spill less). The arithmetic is the same instructions: the images
+    /// are the AVX2 build's, bit for bit (tested).
     pub fn wide(self) -> bool {
         self.wide
     }
