@@ -103,7 +103,8 @@ pub struct RenderOptions<'a> {
 }
 
 /// The CPU path and kernel build `options` render with on this CPU, in words: `reference
-/// path`, or the fast path's kernels: `AVX2 kernels (AVX-512 registers)`, `AVX2 kernels` or
+/// path`, or the fast path's kernels: `AVX2 kernels (AVX-512 registers)` (the untextured
+/// kernels and the common textured form have that build; see `Isa::wide`), `AVX2 kernels` or
 /// `portable kernels`.
 pub fn kernels(options: &RenderOptions) -> &'static str {
     if options.reference {

@@ -163,7 +163,7 @@ fn example_scenes_match_their_golden_images() {
 /// LLVM has 32 vector registers: `Isa::wide`) draws the AVX2 build's images bit for bit: every
 /// example scene and the textured benchmark scenes, each at 320×180 with 1 and 3 threads,
 /// every channel's `f32`. (Textured forms without a wide build, such as normal maps or
-/// Gouraud, run the AVX2 build in both.) Skipped, saying
+/// Gouraud, run the AVX2 build in both: they guard a wide build added later.) Skipped, saying
 /// so, on a CPU without AVX-512F, VL, BW and DQ.
 #[test]
 fn wide_registers_draw_the_avx2_images() {
