@@ -2,6 +2,7 @@
 //! command in its own module; this file maps errors to exit codes.
 
 mod args;
+mod batch;
 mod bench;
 mod fit;
 mod materials;
@@ -50,6 +51,8 @@ fn texture_store(arg: Option<PathBuf>) -> Option<phong_scene::TextureStore> {
 enum Command {
     /// Render a scene file (.toml) or an OBJ model (.obj) to a PNG.
     Render(render::RenderArgs),
+    /// Render many scenes or views from a JSON Lines file (a shard of them on a cluster).
+    Batch(batch::BatchArgs),
     /// Render a scene repeatedly and print the time per frame.
     Bench(bench::BenchArgs),
     /// Serve the live explorer in the browser (until Ctrl-C).
@@ -96,6 +99,7 @@ fn run(cli: Cli) -> Result<()> {
     phong_scene::set_texture_store(texture_store(cli.texture_cache));
     match cli.command {
         Command::Render(args) => render::render(args),
+        Command::Batch(args) => batch::batch(args),
         Command::Bench(args) => bench::bench(args),
         Command::Serve(args) => serve::serve(args),
         Command::Fit(args) => fit::fit(args),
@@ -115,6 +119,7 @@ fn report(result: Result<()>) -> ExitCode {
             || c.is::<phong_core::Error>()
             || c.downcast_ref::<phong_scene::Error>().is_some_and(|e| e.is_input())
             || c.downcast_ref::<phong_raster::Error>().is_some_and(|e| e.is_input())
+            || c.downcast_ref::<phong_run::Error>().is_some_and(|e| e.is_input())
             || c.downcast_ref::<phong_gpu::Error>().is_some_and(|e| e.is_input())
             || c.downcast_ref::<phong_fit::FitError>().is_some_and(|e| e.is_input())
             || c.downcast_ref::<phong_serve::StartError>()

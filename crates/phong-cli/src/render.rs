@@ -2,13 +2,13 @@
 //! a terminal for long renders.
 
 use crate::args::{Job, RunArgs, ShadingArgs};
-use crate::report::Stages;
 use crate::{InputError, refuse_overwriting};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use phong_raster::{Rendered, Renderer};
+use phong_raster::Renderer;
+use phong_run::{Backend, Picture, Stats as Stages};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Once;
 use std::time::{Duration, Instant};
 
@@ -23,47 +23,18 @@ pub struct RenderArgs {
     pub shading: ShadingArgs,
 }
 
-/// An image ready to write: the GPU's in `f32`, the CPU's as its renderer chose.
-enum Image {
-    Linear(phong_core::Image),
-    Eight(phong_core::Image8),
-}
-
-impl Image {
-    fn draw_labels(&mut self, scene: &phong_core::Scene) {
-        match self {
-            Image::Linear(i) => phong_core::text::draw_labels(i, &scene.camera, &scene.labels),
-            Image::Eight(i) => phong_core::text::draw_labels(i, &scene.camera, &scene.labels),
-        }
-    }
-
-    fn write_png(&self, path: &Path, scene: &phong_core::Scene) -> Result<()> {
-        match self {
-            Image::Linear(i) => phong_scene::write_png(path, i, scene.image.encoding)?,
-            Image::Eight(i) => phong_scene::write_png8(path, i)?,
-        }
-        Ok(())
-    }
-}
-
-/// One render: the image and what the renderer measured.
+/// One render, its labels drawn: the picture and what the renderer measured.
 fn render_once(
     job: &Job,
     gpu: Option<&phong_gpu::Gpu>,
     progress: &(dyn Fn(u64, u64) + Sync),
-) -> Result<(Image, Stages)> {
-    if let Some(g) = gpu {
-        let (image, stats) = g.render(&job.scene)?;
-        return Ok((Image::Linear(image), Stages::Gpu(stats)));
-    }
-    let mut renderer = Renderer::new();
-    let (rendered, stats) = renderer.render_for_png(&job.scene, &job.options(Some(progress)))?;
-    let eight = matches!(rendered, Rendered::Eight(_));
-    let image = match eight {
-        true => renderer.into_image8().map(Image::Eight),
-        false => renderer.into_image().map(Image::Linear),
+) -> Result<(Picture, Stages)> {
+    let options = job.options(Some(progress));
+    let backend = match gpu {
+        Some(g) => Backend::Gpu(g),
+        None => Backend::Cpu(&options),
     };
-    Ok((image.expect("an image after its render"), Stages::Cpu(stats)))
+    Ok(phong_run::draw(&job.scene, backend, &mut Renderer::new())?)
 }
 
 /// Renders `a.run.input` to `a.output`.
@@ -90,12 +61,11 @@ pub fn render(a: RenderArgs) -> Result<()> {
         bar.set_length(total);
         bar.set_position(done);
     };
-    let (mut image, stages) =
+    let (picture, stages) =
         render_once(&job, gpu.as_ref(), &progress).with_context(|| format!("rendering {}", job.input.display()))?;
     bar.finish_and_clear();
-    image.draw_labels(&job.scene);
     let t_write = Instant::now();
-    image.write_png(&a.output, &job.scene)?;
+    picture.write_png(&a.output)?;
     if job.verbose {
         let backend = crate::report::backend(&job, gpu.as_ref(), stages.compute());
         crate::report::render(

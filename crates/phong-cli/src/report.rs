@@ -4,18 +4,7 @@ use crate::args::Job;
 use std::path::Path;
 use std::time::Duration;
 
-/// What one render measured, by backend.
-pub enum Stages {
-    Cpu(phong_raster::RenderStats),
-    Gpu(phong_gpu::GpuStats),
-}
-
-impl Stages {
-    /// Drawn by the GPU's compute rasterizer.
-    pub fn compute(&self) -> bool {
-        matches!(self, Stages::Gpu(s) if s.compute)
-    }
-}
+use phong_run::Stats as Stages;
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3

@@ -275,9 +275,15 @@ impl<'a> Frame<'a> {
         frame
     }
 
-    /// Gives the frame's memory back to `scratch`, emptied, for the next frame.
+    /// Gives the frame's memory back to `scratch`, emptied, for the next frame. Spare chunks are kept up to the number this frame used: the full set-up makes chunks
+    /// of its own rather than taking spare ones, and keeping all of them grew the memory of
+    /// every repeated frame that has such objects.
     pub fn recycle(self, scratch: &mut Scratch) {
+        let keep = self.tris.len();
         for mut chunk in self.tris {
+            if scratch.chunks.len() >= keep {
+                break;
+            }
             chunk.clear();
             scratch.chunks.push(chunk);
         }

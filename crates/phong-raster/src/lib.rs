@@ -193,6 +193,16 @@ impl Renderer {
         Ok(Some((self.image8.as_ref().expect("set above"), stats)))
     }
 
+    /// Takes the last `f32` frame's image, if any (the next frame allocates another).
+    pub fn take_image(&mut self) -> Option<Image> {
+        self.image.take()
+    }
+
+    /// Takes the last 8-bit frame's image, if any (the next frame allocates another).
+    pub fn take_image8(&mut self) -> Option<Image8> {
+        self.image8.take()
+    }
+
     /// The last `f32` frame's image, if any.
     pub fn into_image(self) -> Option<Image> {
         self.image

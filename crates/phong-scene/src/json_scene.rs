@@ -3,7 +3,7 @@
 //! and messages. Each line's JSON path is kept, so an error names its key as a path
 //! (`light[1].attenuation`) instead of a line and column.
 
-use crate::toml_scene::{MeshLookup, parse_scene_with};
+use crate::toml_scene::{MeshLookup, parse_scene_from};
 use crate::{Error, Loaded};
 use serde_json::Value;
 use std::fmt::Write;
@@ -190,8 +190,24 @@ fn inline(v: &Value, path: &str) -> Result<String, JsonError> {
 /// Reads a JSON scene as the TOML reader reads the same scene's file, with meshes from
 /// `meshes` (never from the file system).
 pub fn parse_scene_json(scene: &Value, meshes: &MeshLookup) -> Result<Loaded, JsonError> {
+    parse_json_with(scene, Path::new("scene.json"), Some(meshes), false)
+}
+
+/// [`parse_scene_json`] as if the scene were the file `anchor`: its mesh and texture paths
+/// relative to `anchor`'s folder, its meshes from `meshes` where given, else read from there,
+/// its textures read from there.
+pub fn parse_scene_json_at(scene: &Value, anchor: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, JsonError> {
+    parse_json_with(scene, anchor, meshes, true)
+}
+
+fn parse_json_with(
+    scene: &Value,
+    anchor: &Path,
+    meshes: Option<&MeshLookup>,
+    files: bool,
+) -> Result<Loaded, JsonError> {
     let toml = json_to_toml(scene)?;
-    parse_scene_with(&toml.text, Path::new("scene.json"), Some(meshes)).map_err(|e| match e {
+    parse_scene_from(&toml.text, anchor, meshes, files).map_err(|e| match e {
         Error::Parse { line, key, message, .. } => {
             let at = toml.paths.get(line.wrapping_sub(1)).cloned().unwrap_or_default();
             let path = match key {
@@ -207,6 +223,16 @@ pub fn parse_scene_json(scene: &Value, meshes: &MeshLookup) -> Result<Loaded, Js
             message: other.to_string(),
         },
     })
+}
+
+/// A TOML scene file's text as the JSON value of the same scene (what [`parse_scene_json`]
+/// reads), an error at its line and column where it is not TOML.
+pub fn toml_to_json(src: &str, path: &Path) -> Result<Value, Error> {
+    let value: toml::Value = toml::from_str(src).map_err(|e| {
+        let offset = e.span().map_or(0, |s| s.start);
+        Error::at(path, src, offset, None, e.message().trim().to_string())
+    })?;
+    serde_json::to_value(value).map_err(|e| Error::at(path, src, 0, None, e.to_string()))
 }
 
 /// The name of a path's last element: `attenuation` of `light[1].attenuation`, `light` of

@@ -27,16 +27,17 @@ pub use formats::{
     parse_mesh_bytes_with, parse_model_bytes_with,
 };
 pub use gltf_model::{FileCamera, FileLight, MAX_GLTF_SHININESS};
-pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json};
-pub use model::{Axis, ModelOptions, Sides, ViewName, model_scene, model_scene_with};
+pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json, parse_scene_json_at, toml_to_json};
+pub use model::{Axis, ModelOptions, Sides, ViewName, model_scene, model_scene_with, scene_for_loaded};
 pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
-pub use png_out::{encode_png, encode_png8, write_file, write_png, write_png8};
+pub use png_out::{encode_png, encode_png8, encode_rgba8, is_complete_png, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
 pub use texture_file::{ReadFile, TextureStats, decode as decode_texture, last_store_error};
 pub use texture_store::{TextureStore, set_texture_store, texture_store};
 pub use toml_scene::{
-    INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_with,
+    INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_from,
+    parse_scene_with,
 };
 
 use std::path::Path;

@@ -119,12 +119,23 @@ pub struct ModelOptions {
 pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     let (mut warnings, mut sources) = (Vec::new(), Vec::new());
     let model = load_model_full(path, &mut warnings, &mut sources)?;
+    let mut loaded = scene_for_loaded(path, &model, options)?;
+    warnings.append(&mut loaded.warnings);
+    loaded.warnings = warnings;
+    loaded.sources = sources;
+    Ok(loaded)
+}
+
+/// [`scene_for_model`] of a model already read from `path` (a model read once and viewed many
+/// times: `phong batch`, the Python module). `sources` is left empty and `warnings` holds the
+/// scene reader's only.
+pub fn scene_for_loaded(path: &Path, model: &LoadedModel, options: &ModelOptions) -> Result<Loaded, Error> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (json, notes) = model_scene_with(&name, &model, options);
-    let parts = model.parts;
+    let (json, notes) = model_scene_with(&name, model, options);
+    let parts = &model.parts;
     let lookup = |_: &str| Ok(parts.clone());
     let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
@@ -133,9 +144,6 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
         key: Some(e.path),
         message: format!("the model cannot be framed: {}", e.message),
     })?;
-    warnings.append(&mut loaded.warnings);
-    loaded.warnings = warnings;
-    loaded.sources = sources;
     loaded.notes = notes;
     Ok(loaded)
 }

@@ -36,6 +36,40 @@ pub fn encode_png(image: &Image, encoding: Encoding) -> Result<Vec<u8>, std::io:
     encode((image.width(), image.height()), &bytes, alpha, encoding)
 }
 
+/// RGBA bytes (`width`·`height`·4, rows top first) as the PNG file phong writes: RGB where
+/// every alpha is 255, else RGBA, with no colour-space chunk.
+pub fn encode_rgba8(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>, std::io::Error> {
+    if rgba.len() as u64 != u64::from(width) * u64::from(height) * 4 {
+        return Err(std::io::Error::other(format!(
+            "{} bytes are not a {width}x{height} RGBA image",
+            rgba.len()
+        )));
+    }
+    if rgba.chunks_exact(4).all(|p| p[3] == 255) {
+        let rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        encode((width, height), &rgb, false, Encoding::Linear)
+    } else {
+        encode((width, height), rgba, true, Encoding::Linear)
+    }
+}
+
+/// Whether `path` holds a whole PNG file: its signature, and its IEND chunk at the end (what a
+/// write cut short lacks).
+pub fn is_complete_png(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+    const IEND: [u8; 12] = [0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xae, 0x42, 0x60, 0x82];
+    let Ok(mut f) = std::fs::File::open(path) else {
+        return false;
+    };
+    let (mut head, mut tail) = ([0u8; 8], [0u8; 12]);
+    f.read_exact(&mut head).is_ok()
+        && head == SIGNATURE
+        && f.seek(SeekFrom::End(-12)).is_ok()
+        && f.read_exact(&mut tail).is_ok()
+        && tail == IEND
+}
+
 /// `bytes` (RGB, or RGBA with `alpha`) as a PNG at `path`, atomically.
 fn write_bytes(path: &Path, size: (u32, u32), bytes: &[u8], alpha: bool, encoding: Encoding) -> Result<(), Error> {
     let err = |source: std::io::Error| Error::Write {

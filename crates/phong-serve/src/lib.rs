@@ -92,9 +92,7 @@ pub fn initial_scene(
 }
 
 fn toml_to_json(src: &str, path: &Path) -> Result<serde_json::Value, StartError> {
-    let value: toml::Value =
-        toml::from_str(src).map_err(|e| StartError::Usage(format!("{}: {}", path.display(), e.message())))?;
-    serde_json::to_value(value).map_err(|e| StartError::Usage(format!("{}: {e}", path.display())))
+    phong_scene::toml_to_json(src, path).map_err(|e| StartError::Usage(e.to_string()))
 }
 
 /// Binds `addr` (a clear error naming the port when it is taken).

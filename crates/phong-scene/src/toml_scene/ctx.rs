@@ -20,6 +20,8 @@ pub(crate) struct Ctx<'a> {
     /// Where `mesh = "..."` names come from: `None` reads files beside the scene; `Some`
     /// looks them up in memory (the server's uploads) and never opens a file.
     pub meshes: Option<&'a MeshLookup<'a>>,
+    /// Whether texture files may be read (not for a scene sent to `phong serve`).
+    pub files: bool,
     /// Texture images read so far (a file named by several materials is read once).
     pub textures: crate::texture_file::TextureCache,
 }

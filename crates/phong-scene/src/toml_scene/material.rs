@@ -141,7 +141,7 @@ fn maps(ctx: &mut Ctx, m: &RawMaterial, key: &str, base: Maps) -> Result<Maps, E
         });
     }
     let dir = ctx.path.parent().unwrap_or(std::path::Path::new("")).to_path_buf();
-    let server = ctx.meshes.is_some();
+    let server = !ctx.files;
     let read = |name: &str| -> Result<Vec<u8>, String> {
         if server {
             return Err("a scene sent to phong serve names no files (upload an OBJ with its MTL and images)".into());

@@ -39,6 +39,13 @@ pub fn parse_scene(src: &str, path: &Path) -> Result<Loaded, Error> {
 
 /// [`parse_scene`] with meshes from `meshes` instead of the file system (when given).
 pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> Result<Loaded, Error> {
+    parse_scene_from(src, path, meshes, meshes.is_none())
+}
+
+/// [`parse_scene_with`], reading texture files beside `path` where `files` (a scene whose
+/// meshes come from a lookup may still name textures: `phong batch`, the Python module), or
+/// refusing them (a scene sent to `phong serve`).
+pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, files: bool) -> Result<Loaded, Error> {
     let _budget = crate::texture_file::TextureBudget::start();
     let raw: RawScene = toml::from_str(src).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
@@ -74,6 +81,7 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
         sources: Vec::new(),
         triangles: std::cell::Cell::new(0),
         meshes,
+        files,
         textures: Default::default(),
     };
     let scene = build(&mut ctx, raw)?;

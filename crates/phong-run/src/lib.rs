@@ -1,0 +1,18 @@
+//! # phong-run
+//!
+//! One render, from what a user names to pixels: a scene file, a model file or a scene
+//! document ([`Source`]) loaded, the user's settings applied ([`Settings`]: size, samples, the
+//! shading overrides, a model's view, scene tables merged over the scene), then drawn on the
+//! CPU or the GPU with the scene's labels ([`draw`]), ready to encode as the PNG `phong render`
+//! writes. `phong render`, `phong batch` and the Python module all call it, so that they draw
+//! the same pixels. Model files can be read once and viewed many times through [`Models`].
+
+mod error;
+mod frame;
+mod models;
+mod request;
+
+pub use error::Error;
+pub use frame::{Backend, Picture, Pool, Stats, draw, draw_linear};
+pub use models::Models;
+pub use request::{Settings, Source, load, merge_tables};
