@@ -22,8 +22,8 @@ pub(crate) struct Cache {
     /// The last scene built: its key (the document less camera and lights, with the render's
     /// settings) and the scene.
     pub built: Option<(Value, phong_core::Scene)>,
-    /// A model's automatic camera per image aspect (its bits).
-    pub framings: Vec<(u32, Value)>,
+    /// A model's automatic camera per view and image aspect (its bits).
+    pub framings: Vec<(ModelOptions, u32, Value)>,
 }
 
 /// A scene: its document, its anchor and what it is built from.
@@ -118,14 +118,24 @@ impl SceneCore {
         }
     }
 
-    /// A core for a model: its framing at the default aspect.
-    fn framed_model(path: &Path, backing: Arc<Backing>, view: ModelOptions) -> PyResult<SceneCore> {
+    /// A core for a model: its framing at the default aspect. `like` shares its built objects
+    /// (another view of the same model).
+    fn framed_model(
+        path: &Path,
+        backing: Arc<Backing>,
+        view: ModelOptions,
+        like: Option<&SceneCore>,
+    ) -> PyResult<SceneCore> {
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let (doc, _) = phong_scene::model_scene_with(&name, &backing.model, &view);
-        let core = SceneCore::new(doc, path.to_path_buf(), Some(backing), view);
+        let mut core = SceneCore::new(doc, path.to_path_buf(), Some(backing), view);
+        if let Some(like) = like {
+            core.models = like.models.clone();
+            core.cache = like.cache.clone();
+        }
         core.build(&Settings::default()).map_err(py_err)?;
         Ok(core)
     }
@@ -136,8 +146,12 @@ impl SceneCore {
             return (*self.doc).clone();
         };
         let mut cache = self.cache.lock().expect("not poisoned");
-        let camera = match cache.framings.iter().find(|(a, _)| *a == aspect.to_bits()) {
-            Some((_, c)) => c.clone(),
+        let found = cache
+            .framings
+            .iter()
+            .find(|(v, a, _)| *v == self.view && *a == aspect.to_bits());
+        let camera = match found {
+            Some((_, _, c)) => c.clone(),
             None => {
                 let view = ModelOptions {
                     aspect: Some(aspect),
@@ -148,7 +162,7 @@ impl SceneCore {
                 if cache.framings.len() >= 8 {
                     cache.framings.remove(0);
                 }
-                cache.framings.push((aspect.to_bits(), camera.clone()));
+                cache.framings.push((self.view, aspect.to_bits(), camera.clone()));
                 camera
             }
         };
@@ -239,7 +253,7 @@ impl SceneCore {
                     let (mut warnings, mut sources) = (Vec::new(), Vec::new());
                     let model = phong_scene::load_model_full(&path, &mut warnings, &mut sources)
                         .map_err(|e| py_err(e.into()))?;
-                    return SceneCore::framed_model(&path, Arc::new(Backing { model }), options);
+                    return SceneCore::framed_model(&path, Arc::new(Backing { model }), options, None);
                 }
                 if view.given() {
                     return Err(InputError::new_err(format!(
@@ -373,7 +387,7 @@ impl SceneCore {
             origin: glam::DVec3::ZERO,
         };
         let model = LoadedModel::new(vec![part], phong_scene::ModelFormat::Obj);
-        py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options)))
+        py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options, None)))
     }
 
     /// The same model viewed another way (a model's scene only).
@@ -385,8 +399,7 @@ impl SceneCore {
             ));
         };
         let options = view.unwrap_or_default().options()?;
-        let anchor = self.anchor.clone();
-        py.detach(|| guarded(|| SceneCore::framed_model(&anchor, b, options)))
+        py.detach(|| guarded(|| SceneCore::framed_model(&self.anchor, b, options, Some(self))))
     }
 
     /// A new core with the document `text` (checked with the scene reader's messages).

@@ -2,7 +2,7 @@
 //! renderer's own thread pool or on the GPU, never on the async threads.
 
 use phong_core::Scene;
-use phong_raster::{RenderOptions, Rendered, Renderer};
+use phong_raster::{RenderOptions, Renderer};
 use std::sync::Mutex;
 
 /// Which renderer draws the frames.
@@ -46,54 +46,25 @@ impl Backend {
     /// these while the user drags: no encoding here, no decoding in the browser).
     pub fn frame(&self, scene: &Scene, raw: bool) -> Result<Vec<u8>, String> {
         let fail = |e: &dyn std::fmt::Display| format!("rendering failed: {e}");
-        match self {
+        let (picture, _) = match self {
             Backend::Cpu { pool, renderers } => {
                 let mut renderer = renderers.lock().ok().and_then(|mut r| r.pop()).unwrap_or_default();
                 let options = RenderOptions::default();
-                let out = pool.install(|| -> Result<Vec<u8>, String> {
-                    // The target `phong render` writes (the renderer chooses it).
-                    let (image, _) = renderer.render_for_png(scene, &options).map_err(|e| fail(&e))?;
-                    match image {
-                        Rendered::Eight(image) if scene.labels.is_empty() => encode8(image, raw),
-                        Rendered::Eight(image) => {
-                            let mut image = image.clone();
-                            phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                            encode8(&image, raw)
-                        }
-                        Rendered::Linear(image) => {
-                            let mut image = image.clone();
-                            phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                            encode(&image, scene.image.encoding, raw)
-                        }
-                    }
-                });
+                let drawn = pool.install(|| phong_run::draw(scene, phong_run::Backend::Cpu(&options), &mut renderer));
                 if let Ok(mut r) = renderers.lock() {
                     r.push(renderer);
                 }
-                out
+                drawn.map_err(|e| fail(&e))?
             }
             Backend::Gpu(gpu) => {
                 let gpu = gpu.lock().map_err(|_| "the GPU renderer failed earlier".to_string())?;
-                let (mut image, _) = gpu.render(scene).map_err(|e| fail(&e))?;
-                phong_core::text::draw_labels(&mut image, &scene.camera, &scene.labels);
-                encode(&image, scene.image.encoding, raw)
+                phong_run::draw(scene, phong_run::Backend::Gpu(&gpu), &mut Renderer::new()).map_err(|e| fail(&e))?
             }
+        };
+        if raw {
+            Ok(picture.rgba8())
+        } else {
+            picture.png().map_err(|e| e.to_string())
         }
-    }
-}
-
-fn encode8(image: &phong_core::Image8, raw: bool) -> Result<Vec<u8>, String> {
-    if raw {
-        Ok(image.to_bytes(true))
-    } else {
-        phong_scene::encode_png8(image).map_err(|e| format!("encoding the PNG failed: {e}"))
-    }
-}
-
-fn encode(image: &phong_core::Image, encoding: phong_core::Encoding, raw: bool) -> Result<Vec<u8>, String> {
-    if raw {
-        Ok(image.to_bytes(encoding, true))
-    } else {
-        phong_scene::encode_png(image, encoding).map_err(|e| format!("encoding the PNG failed: {e}"))
     }
 }

@@ -467,8 +467,17 @@ class Renderer:
         """The threads the CPU draws each frame on."""
         return self._core.threads
 
-    def render(self, scene: Union[PathLike, Mapping[str, Any], Scene], output: str = "color") -> np.ndarray:
-        """Renders ``scene`` as :func:`render` does (a path is read once and kept)."""
+    def render(
+        self,
+        scene: Union[PathLike, Mapping[str, Any], Scene],
+        output: str = "color",
+        *,
+        width: Optional[int] = None,
+        height: Optional[int] = None,
+        antialias: Optional[int] = None,
+    ) -> np.ndarray:
+        """Renders ``scene`` as :func:`render` does (a path is read once and kept);
+        ``width``, ``height`` and ``antialias`` override the renderer's for this frame."""
         if output not in OUTPUTS:
             raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
         if isinstance(scene, (str, os.PathLike)):
@@ -478,4 +487,4 @@ class Renderer:
                     self._paths.pop(next(iter(self._paths)))
                 self._paths[key] = Scene.load(key)
             scene = self._paths[key]
-        return self._core.render(_as_scene(scene)._core, output)
+        return self._core.render(_as_scene(scene)._core, output, width, height, antialias)
