@@ -82,8 +82,9 @@ for j in jobs:
     if j["scene"] not in meshes:
         meshes.clear()
         tm = trimesh.load(j["scene"], force="mesh")
-        meshes[j["scene"]] = (pyrender.Mesh.from_trimesh(tm, smooth=True), tm.bounding_sphere.primitive.center,
-                              tm.bounding_sphere.primitive.radius)
+        b = tm.bounds
+        meshes[j["scene"]] = (pyrender.Mesh.from_trimesh(tm, smooth=True), b.mean(axis=0),
+                              float(np.linalg.norm(b[1] - b[0])) / 2)
     mesh, c, rad = meshes[j["scene"]]
     scene = pyrender.Scene(ambient_light=[0.2, 0.2, 0.2], bg_color=[0.1, 0.1, 0.1, 1.0])
     scene.add(mesh)

@@ -201,15 +201,12 @@ fn job(line: usize, text: &str, base: &Path) -> Result<Job, String> {
              (give `camera` as a table to set its camera)"
         ));
     }
-    settings.view = phong_scene::ModelOptions {
-        up: choice(&o, "up", &phong_scene::Axis::NAMES)?,
-        view: choice(&o, "view", &phong_scene::ViewName::NAMES)?,
-        camera: match o.get("camera") {
-            None | Some(Value::Null) | Some(Value::Object(_)) => None,
-            Some(v) => Some(camera(v)?),
-        },
-        ..Default::default()
+    let camera = match o.get("camera") {
+        None | Some(Value::Null) | Some(Value::Object(_)) => None,
+        Some(v) => Some(camera(v)?),
     };
+    let quoted = |k: &str| format!("`{k}`");
+    settings.view = phong_run::view_options(str_key(&o, "up")?, str_key(&o, "view")?, camera, None, quoted)?;
     for k in ["image", "shading", "light", "material"] {
         if let Some(v) = o.get(k) {
             settings.tables.insert(k.to_string(), v.clone());
@@ -226,22 +223,16 @@ fn job(line: usize, text: &str, base: &Path) -> Result<Job, String> {
     })
 }
 
-/// A model's camera: `[px, py, pz, tx, ty, tz]`, finite, the position not the target.
-fn camera(v: &Value) -> Result<(glam::DVec3, glam::DVec3), String> {
-    let bad = || format!("`camera`: must be [px, py, pz, tx, ty, tz] (position, target), six finite numbers, got {v}");
-    let n: Vec<f64> = v
+/// A model's camera: `[px, py, pz, tx, ty, tz]`, six numbers (checked further by
+/// [`phong_run::view_options`]).
+fn camera(v: &Value) -> Result<[f64; 6], String> {
+    let n: Option<Vec<f64>> = v
         .as_array()
         .filter(|a| a.len() == 6)
-        .ok_or_else(bad)?
-        .iter()
-        .map(|x| x.as_f64().filter(|x| x.is_finite()))
-        .collect::<Option<_>>()
-        .ok_or_else(bad)?;
-    let (p, t) = (glam::DVec3::new(n[0], n[1], n[2]), glam::DVec3::new(n[3], n[4], n[5]));
-    if p == t {
-        return Err("`camera`: the position and the target are the same point".into());
-    }
-    Ok((p, t))
+        .and_then(|a| a.iter().map(Value::as_f64).collect());
+    n.and_then(|n| n.try_into().ok()).ok_or_else(|| {
+        format!("`camera`: must be [px, py, pz, tx, ty, tz] (position, target), six finite numbers, got {v}")
+    })
 }
 
 /// An output name: a relative `.png` path that stays under the output folder.
@@ -345,6 +336,12 @@ pub fn batch(a: BatchArgs) -> Result<()> {
     }
     let gpu = crate::open_gpu(a.backend, GpuPathArg::Auto)?;
     let pool = phong_run::Pool::new(a.threads)?;
+    // Jobs run in line order on the pool's threads: a few documents' objects at a time.
+    let shared = Shared {
+        models,
+        built: phong_run::Built::new(2 * pool.threads()),
+        gpu: gpu.as_ref(),
+    };
     let results_name = format!("results-{index}-of-{count}.jsonl");
     let results_path = a.out.join(&results_name);
     let tmp_path = a.out.join(format!(".{results_name}.{}.tmp", std::process::id()));
@@ -367,7 +364,7 @@ pub fn batch(a: BatchArgs) -> Result<()> {
             .map_init(Renderer::new, |renderer, j| {
                 let outcome = match j {
                     Err(o) => o,
-                    Ok(j) => run_job(&j, &a, &name, &models, gpu.as_ref(), renderer),
+                    Ok(j) => run_job(&j, &a, &name, &shared, renderer),
                 };
                 if outcome.status == "failed" {
                     failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -430,14 +427,15 @@ pub fn batch(a: BatchArgs) -> Result<()> {
 }
 
 /// Renders one job (or skips it where its output is complete).
-fn run_job(
-    j: &Job,
-    a: &BatchArgs,
-    name: &str,
-    models: &Models,
-    gpu: Option<&phong_gpu::Gpu>,
-    renderer: &mut Renderer,
-) -> Outcome {
+/// What every job of a run shares: models read once, objects built once, the GPU.
+struct Shared<'a> {
+    models: Models,
+    built: phong_run::Built,
+    gpu: Option<&'a phong_gpu::Gpu>,
+}
+
+fn run_job(j: &Job, a: &BatchArgs, name: &str, shared: &Shared, renderer: &mut Renderer) -> Outcome {
+    let Shared { models, built, gpu } = shared;
     let t = Instant::now();
     let path = a.out.join(&j.out);
     let outcome = |status, message: String, input| Outcome {
@@ -461,7 +459,7 @@ fn run_job(
         },
     };
     let result = (|| -> Result<(), phong_run::Error> {
-        let loaded = phong_run::load(source, &j.settings, models, "width, height, antialias")?;
+        let loaded = phong_run::load_viewed(source, &j.settings, models, built, "width, height, antialias")?;
         for w in &loaded.warnings {
             eprintln!("warning: {name}:{}: {w}", j.line);
         }
@@ -492,21 +490,9 @@ fn run_job(
                     };
                     format!("{name}:{}: {at}: {}", j.line, error.message)
                 }
-                _ => format!("{name}:{}: {}", j.line, error_chain(&e)),
+                _ => format!("{name}:{}: {}", j.line, phong_run::message(&e)),
             };
             outcome("failed", message, input)
         }
     }
-}
-
-/// An error and its causes, as the command line prints them.
-fn error_chain(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        s.push_str(": ");
-        s.push_str(&c.to_string());
-        cause = c.source();
-    }
-    s
 }

@@ -24,22 +24,10 @@ pyo3::create_exception!(
 /// A Python exception for a phong error: `InputError` where it is in the input.
 pub(crate) fn py_err(e: phong_run::Error) -> PyErr {
     if e.is_input() {
-        InputError::new_err(chain(&e))
+        InputError::new_err(phong_run::message(&e))
     } else {
-        RenderError::new_err(chain(&e))
+        RenderError::new_err(phong_run::message(&e))
     }
-}
-
-/// An error and its causes, as the command line prints them.
-pub(crate) fn chain(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        s.push_str(": ");
-        s.push_str(&c.to_string());
-        cause = c.source();
-    }
-    s
 }
 
 /// Runs `f`, turning a panic into a `RenderError` (a bug, never an abort of the interpreter).

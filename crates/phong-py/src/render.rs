@@ -299,7 +299,7 @@ pub fn save_png(py: Python<'_>, path: PathBuf, image: numpy::PyReadonlyArray3<'_
     py.detach(|| {
         let png = phong_scene::encode_rgba8(w as u32, h as u32, &rgba)
             .map_err(|e| RenderError::new_err(format!("encoding the PNG failed: {e}")))?;
-        phong_scene::write_file(&path, &png).map_err(|e| RenderError::new_err(crate::chain(&e)))
+        phong_scene::write_file(&path, &png).map_err(|e| RenderError::new_err(phong_run::message(&e)))
     })
 }
 

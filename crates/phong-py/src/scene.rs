@@ -16,12 +16,9 @@ pub(crate) struct Backing {
     pub model: LoadedModel,
 }
 
-/// Scenes built for rendering, kept while only their camera, lights or image change.
+/// A model's automatic cameras.
 #[derive(Default)]
 pub(crate) struct Cache {
-    /// The last scene built: its key (the document less camera and lights, with the render's
-    /// settings) and the scene.
-    pub built: Option<(Value, phong_core::Scene)>,
     /// A model's automatic camera per view and image aspect (its bits).
     pub framings: Vec<(ModelOptions, u32, Value)>,
 }
@@ -38,6 +35,8 @@ pub struct SceneCore {
     pub(crate) camera_auto: bool,
     pub(crate) models: Arc<Models>,
     pub(crate) cache: Arc<Mutex<Cache>>,
+    /// The objects built, shared by the edits and views of one scene.
+    pub(crate) built: Arc<phong_run::Built>,
 }
 
 fn parse_json(text: &str) -> PyResult<Value> {
@@ -63,46 +62,15 @@ impl ViewArgs {
 
     /// The scene reader's options.
     pub(crate) fn options(&self) -> PyResult<ModelOptions> {
-        view_options(self.up.as_deref(), self.view.as_deref(), self.camera, self.two_sided)
+        phong_run::view_options(
+            self.up.as_deref(),
+            self.view.as_deref(),
+            self.camera,
+            self.two_sided,
+            str::to_string,
+        )
+        .map_err(InputError::new_err)
     }
-}
-
-/// The model-alone options from the Python arguments.
-fn view_options(
-    up: Option<&str>,
-    view: Option<&str>,
-    camera: Option<[f64; 6]>,
-    two_sided: Option<bool>,
-) -> PyResult<ModelOptions> {
-    fn choice<T: Copy>(key: &str, v: Option<&str>, table: &[(&str, T)]) -> PyResult<Option<T>> {
-        v.map(|v| phong_scene::parse_choice(key, v, table))
-            .transpose()
-            .map_err(InputError::new_err)
-    }
-    let camera = match camera {
-        None => None,
-        Some(c) if c.iter().all(|x| x.is_finite()) && c[..3] != c[3..] => {
-            Some((glam::DVec3::new(c[0], c[1], c[2]), glam::DVec3::new(c[3], c[4], c[5])))
-        }
-        Some(c) => {
-            return Err(InputError::new_err(format!(
-                "camera must be six finite numbers (px, py, pz, tx, ty, tz) with the position apart from the target, got {c:?}"
-            )));
-        }
-    };
-    Ok(ModelOptions {
-        up: choice("up", up, &phong_scene::Axis::NAMES)?,
-        view: choice("view", view, &phong_scene::ViewName::NAMES)?,
-        camera,
-        sides: two_sided.map(|t| {
-            if t {
-                phong_scene::Sides::TwoSided
-            } else {
-                phong_scene::Sides::Cull
-            }
-        }),
-        aspect: None,
-    })
 }
 
 impl SceneCore {
@@ -115,6 +83,7 @@ impl SceneCore {
             view,
             models: Arc::new(Models::keep_all()),
             cache: Arc::default(),
+            built: Arc::new(phong_run::Built::new(1)),
         }
     }
 
@@ -134,6 +103,7 @@ impl SceneCore {
         let mut core = SceneCore::new(doc, path.to_path_buf(), Some(backing), view);
         if let Some(like) = like {
             core.models = like.models.clone();
+            core.built = like.built.clone();
             core.cache = like.cache.clone();
         }
         core.build(&Settings::default()).map_err(py_err)?;
@@ -178,64 +148,21 @@ impl SceneCore {
             .unwrap_or_default()
     }
 
-    /// The scene built with `settings`. Its objects are built once per document (less its
-    /// camera, lights and image) and kept; each call reads the camera, lights and image alone
-    /// and applies the settings to a copy.
+    /// The scene built with `settings`: its objects built once per document (less its
+    /// camera, lights and image) and kept ([`phong_run::Built`]).
     pub(crate) fn build(&self, settings: &Settings) -> Result<phong_core::Scene, phong_run::Error> {
         let default = phong_core::ImageSettings::default();
         let aspect = (settings.width.is_some() || settings.height.is_some())
             .then(|| settings.width.unwrap_or(default.width) as f32 / settings.height.unwrap_or(default.height) as f32);
         let doc = self.doc_for(aspect.or(Some(4.0 / 3.0)).filter(|_| self.camera_auto));
-        let mut key = doc.clone();
-        if let Value::Object(o) = &mut key {
-            o.remove("camera");
-            o.remove("light");
-            o.remove("image");
-        }
-        let cached = {
-            let cache = self.cache.lock().expect("not poisoned");
-            cache.built.as_ref().filter(|(k, _)| *k == key).map(|(_, s)| s.clone())
+        let name = self.mesh_name();
+        let parts = self.backing.as_ref().map(|b| &b.model.parts);
+        let lookup = |n: &str| match parts {
+            Some(p) if n == name => Ok(p.clone()),
+            _ => Err(format!("no model named {n:?} in this scene")),
         };
-        let mut scene = match cached {
-            Some(s) => s,
-            None => {
-                let name = self.mesh_name();
-                let parts = self.backing.as_ref().map(|b| &b.model.parts);
-                let lookup = |n: &str| match parts {
-                    Some(p) if n == name => Ok(p.clone()),
-                    _ => Err(format!("no model named {n:?} in this scene")),
-                };
-                let source = Source::Document {
-                    scene: &doc,
-                    anchor: &self.anchor,
-                    meshes: parts.map(|_| &lookup as &phong_scene::MeshLookup),
-                };
-                let loaded = phong_run::load(source, &Settings::default(), &self.models, "")?;
-                let mut cache = self.cache.lock().expect("not poisoned");
-                cache.built = Some((key, loaded.scene.clone()));
-                loaded.scene
-            }
-        };
-        // The camera, lights and image of this document, read alone (no objects), with the
-        // size and samples asked for.
-        let mut mini = serde_json::Map::new();
-        for k in ["image", "camera", "light", "shading"] {
-            if let Some(v) = doc.get(k) {
-                mini.insert(k.into(), v.clone());
-            }
-        }
-        let mini = Value::Object(mini);
-        let source = Source::Document {
-            scene: &mini,
-            anchor: &self.anchor,
-            meshes: None,
-        };
-        let small = phong_run::load(source, settings, &self.models, "width, height, antialias")?;
-        scene.image = small.scene.image;
-        scene.camera = small.scene.camera;
-        scene.lighting = small.scene.lighting;
-        settings.overrides.apply_to_scene(&mut scene);
-        Ok(scene)
+        let meshes = parts.map(|_| &lookup as &phong_scene::MeshLookup);
+        self.built.load(&doc, &self.anchor, meshes, settings, &self.models)
     }
 }
 

@@ -44,3 +44,15 @@ impl Error {
         }
     }
 }
+
+/// An error and its causes, one after the other, as the command line prints them.
+pub fn message(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cause = c.source();
+    }
+    s
+}

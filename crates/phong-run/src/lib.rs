@@ -7,12 +7,14 @@
 //! writes. `phong render`, `phong batch` and the Python module all call it, so that they draw
 //! the same pixels. Model files can be read once and viewed many times through [`Models`].
 
+mod built;
 mod error;
 mod frame;
 mod models;
 mod request;
 
-pub use error::Error;
+pub use built::Built;
+pub use error::{Error, message};
 pub use frame::{Backend, Picture, Pool, Stats, draw, draw_linear};
 pub use models::Models;
-pub use request::{Settings, Source, load, merge_tables};
+pub use request::{Settings, Source, load, load_viewed, merge_tables, view_options};

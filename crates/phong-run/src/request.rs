@@ -88,6 +88,51 @@ pub fn load(source: Source, settings: &Settings, models: &Models, size_names: &s
     Ok(loaded)
 }
 
+/// [`load`] for many views of few scenes (`phong batch`): a model file's or a document's
+/// objects built once through `built` while only its camera, lights or image change. The same
+/// scene as [`load`] gives; a scene file is read as [`load`] reads it.
+pub fn load_viewed(
+    source: Source,
+    settings: &Settings,
+    models: &Models,
+    built: &crate::Built,
+    size_names: &str,
+) -> Result<Loaded, Error> {
+    let default = phong_core::ImageSettings::default();
+    let mut view = settings.view;
+    if settings.width.is_some() || settings.height.is_some() {
+        view.aspect =
+            Some(settings.width.unwrap_or(default.width) as f32 / settings.height.unwrap_or(default.height) as f32);
+    }
+    let loaded = |scene, warnings, sources| Loaded {
+        scene,
+        warnings,
+        sources,
+        notes: Vec::new(),
+        textures: Default::default(),
+    };
+    match source {
+        Source::Path(path) if phong_scene::is_model_path(path) => {
+            let (read, fresh) = models.get(path)?;
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let (doc, _) = phong_scene::model_scene_with(&name, &read.model, &view);
+            let parts = &read.model.parts;
+            let lookup = |_: &str| Ok(parts.clone());
+            let scene = built.load(&doc, path, Some(&lookup), settings, models)?;
+            let warnings = if fresh { read.warnings.clone() } else { Vec::new() };
+            Ok(loaded(scene, warnings, read.sources.clone()))
+        }
+        Source::Document { scene, anchor, meshes } => {
+            let scene = built.load(scene, anchor, meshes, settings, models)?;
+            Ok(loaded(scene, Vec::new(), Vec::new()))
+        }
+        _ => load(source, settings, models, size_names),
+    }
+}
+
 fn json_error(anchor: &Path, error: JsonError) -> Error {
     Error::Json {
         what: anchor.display().to_string(),
@@ -205,6 +250,51 @@ fn file_lookup<'a>(
         Ok(read.model.parts.clone())
     };
     (lookup, found)
+}
+
+/// How a model alone is viewed, from values a caller has read: `up` and `view` by name,
+/// `camera` as `[px, py, pz, tx, ty, tz]`, `two_sided` (`false`: cull). `key` names a value in
+/// messages as the caller's user knows it (`` `camera` ``, `camera`).
+pub fn view_options(
+    up: Option<&str>,
+    view: Option<&str>,
+    camera: Option<[f64; 6]>,
+    two_sided: Option<bool>,
+    key: impl Fn(&str) -> String,
+) -> Result<ModelOptions, String> {
+    let camera = match camera {
+        None => None,
+        Some(c) if !c.iter().all(|x| x.is_finite()) => {
+            return Err(format!(
+                "{}: must be [px, py, pz, tx, ty, tz] (position, target), six finite numbers, got {c:?}",
+                key("camera")
+            ));
+        }
+        Some(c) if c[..3] == c[3..] => {
+            return Err(format!(
+                "{}: the position and the target are the same point",
+                key("camera")
+            ));
+        }
+        Some(c) => Some((glam::DVec3::new(c[0], c[1], c[2]), glam::DVec3::new(c[3], c[4], c[5]))),
+    };
+    Ok(ModelOptions {
+        up: up
+            .map(|v| phong_scene::parse_choice(&key("up"), v, &phong_scene::Axis::NAMES))
+            .transpose()?,
+        view: view
+            .map(|v| phong_scene::parse_choice(&key("view"), v, &phong_scene::ViewName::NAMES))
+            .transpose()?,
+        camera,
+        sides: two_sided.map(|t| {
+            if t {
+                phong_scene::Sides::TwoSided
+            } else {
+                phong_scene::Sides::Cull
+            }
+        }),
+        aspect: None,
+    })
 }
 
 /// Merges scene tables over a scene document, as the command line's flags override a scene:

@@ -41,6 +41,8 @@ pub struct LoadedModel {
     pub double_sided: Option<bool>,
     /// Its format.
     pub format: ModelFormat,
+    /// Whether it is closed and how it is wound, found when it is first framed.
+    pub(crate) closed: std::sync::OnceLock<crate::model::Closed>,
 }
 
 impl LoadedModel {
@@ -53,6 +55,7 @@ impl LoadedModel {
             lights: Vec::new(),
             double_sided: None,
             format,
+            closed: Default::default(),
         }
     }
 }
@@ -163,6 +166,7 @@ fn read_bytes(
                 lights: m.lights,
                 double_sided: Some(m.double_sided),
                 format,
+                closed: Default::default(),
             })
         }
         ModelFormat::Obj => Err(model_error(

@@ -251,7 +251,8 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         Axis::NegX => Vec3::Z,
     };
     // A glTF says its front and its faces: its edges are not examined.
-    let closed = (!gltf).then(|| closedness(parts));
+    // Computed once per model read: its views all ask.
+    let closed = (!gltf).then(|| *model.closed.get_or_init(|| closedness(parts)));
     let detected = closed.and_then(|c| detect_front(parts, u, f, c));
     let f = match detected {
         Some((front, why)) => {
@@ -548,7 +549,7 @@ fn detect_up(parts: &[ObjPart]) -> Axis {
 
 /// Whether a model is closed, and which way it is wound.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Closed {
+pub(crate) enum Closed {
     /// Every edge is shared by two faces wound opposite ways, and the volume is positive.
     Outward,
     /// Closed and consistent, but the volume is negative (normals point in).
