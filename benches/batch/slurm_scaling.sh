@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `phong batch` over 1, 2 and 4 shards of one thumbnail jobs file on a Slurm cluster
-# (.ci/slurm-up starts a one-node one): the wall time of each array, submitted with
-# `sbatch --wait`, alternating the shard counts over ROUNDS rounds.
+# (.ci/slurm-up starts a one-node one): the wall time of each array from its submission to
+# the end of its last task (squeue polled every 0.05 s: `sbatch --wait` polls every 10 s),
+# alternating the shard counts over ROUNDS rounds.
 #
 #   benches/batch/slurm_scaling.sh [RENDERS] [ROUNDS] [PHONG]
 set -euo pipefail
@@ -21,9 +22,10 @@ for r in $(seq 1 "$rounds"); do
   for n in 1 2 4; do
     out="$work/out-$n-$r"
     t0=$(date +%s.%N)
-    JOBS="$work/jobs.jsonl" OUT="$out" PHONG="$phong" \
-      sbatch --wait --quiet --array=0-$((n - 1)) --chdir="$work" --output="$work/log-%A_%a.txt" \
-      --export=ALL "$root/examples/batch/slurm.sh" >/dev/null
+    id=$(JOBS="$work/jobs.jsonl" OUT="$out" PHONG="$phong" \
+      sbatch --parsable --array=0-$((n - 1)) --chdir="$work" --output="$work/log-%A_%a.txt" \
+      --export=ALL "$root/examples/batch/slurm.sh")
+    while [ -n "$(squeue -h -j "$id" 2>/dev/null)" ]; do sleep 0.05; done
     t1=$(date +%s.%N)
     made=$(find "$out" -name '*.png' | wc -l)
     printf 'round %d shards %d: %.2f s, %d images, %.1f images/s\n' "$r" "$n" "$(echo "$t1 - $t0" | bc)" \

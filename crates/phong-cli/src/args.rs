@@ -201,10 +201,21 @@ impl RunArgs {
                 self.input.display()
             )));
         }
-        let default = phong_core::ImageSettings::default();
-        let aspect = (self.width.is_some() || self.height.is_some())
-            .then(|| self.width.unwrap_or(default.width) as f32 / self.height.unwrap_or(default.height) as f32);
-        let loaded = phong_scene::load_with(&self.input, &self.view.options(aspect)?)?;
+        let settings = phong_run::Settings {
+            width: self.width,
+            height: self.height,
+            samples,
+            overrides,
+            view: self.view.options(None)?,
+            tables: Default::default(),
+        };
+        let source = phong_run::Source::Path(&self.input);
+        let loaded = phong_run::load(
+            source,
+            &settings,
+            &phong_run::Models::new(),
+            "--width, --height, --antialias",
+        )?;
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
         }
@@ -234,23 +245,7 @@ impl RunArgs {
                 );
             }
         }
-        let mut scene = loaded.scene;
-        if let Some(w) = self.width {
-            scene.image.width = w;
-        }
-        if let Some(h) = self.height {
-            scene.image.height = h;
-        }
-        if let Some(s) = samples {
-            scene.image.samples = s;
-        }
-        if self.width.is_some() || self.height.is_some() || samples.is_some() {
-            scene
-                .image
-                .check()
-                .map_err(|e| InputError(format!("--width, --height, --antialias: {e}")))?;
-        }
-        overrides.apply_to_scene(&mut scene);
+        let scene = loaded.scene;
         Ok(Job {
             scene,
             sources: loaded.sources,
