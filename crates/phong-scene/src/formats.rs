@@ -157,7 +157,7 @@ fn read_bytes(
 ) -> Result<LoadedModel, Error> {
     match format {
         ModelFormat::Ply => Ok(LoadedModel::new(read_ply(path, bytes)?, format)),
-        ModelFormat::Stl => Ok(LoadedModel::new(read_stl(path, bytes)?, format)),
+        ModelFormat::Stl => Ok(LoadedModel::new(crate::stl::read_stl(path, bytes)?, format)),
         ModelFormat::Gltf => {
             let m = crate::gltf_model::read_gltf(path, bytes, resource, warnings)?;
             Ok(LoadedModel {
@@ -209,13 +209,13 @@ pub fn load_model(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart
 }
 
 /// The name of a model's one part: its file name.
-fn part_name(path: &Path) -> String {
+pub(crate) fn part_name(path: &Path) -> String {
     path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default()
 }
 
-fn model_error(path: &Path, message: String) -> Error {
+pub(crate) fn model_error(path: &Path, message: String) -> Error {
     Error::Model {
         path: path.to_path_buf(),
         message,
@@ -435,30 +435,6 @@ pub(crate) fn vertex_color_material() -> phong_core::Material {
 /// An STL file (ASCII or binary) as one part, its vertices shared where they are equal
 /// (stl_io's indexing); the facets' normals are not used (the scene's `normals` choice makes
 /// them).
-fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
-    let fail = |m: String| model_error(path, format!("malformed STL: {m}"));
-    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| fail(e.to_string()))?;
-    let points: Vec<DVec3> = mesh.vertices.iter().map(|v| Vec3::from_array(v.0).as_dvec3()).collect();
-    if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| !p.is_finite()) {
-        return Err(fail(format!("vertex {i} is not finite: {p}")));
-    }
-    let (positions, origin) = recentred(&points);
-    let triangles: Vec<[u32; 3]> = mesh.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
-    if triangles.is_empty() {
-        return Err(fail("no facets: nothing to render".into()));
-    }
-    let normals = vec![Vec3::ZERO; positions.len()];
-    let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
-    Ok(vec![ObjPart {
-        name: part_name(path),
-        mesh,
-        material: None,
-        maps: phong_core::Maps::default(),
-        has_normals: false,
-        origin,
-    }])
-}
-
 /// Where a model with vertices `points` is re-centred: the centre of its bounding box where
 /// that lies far from the origin for its size (more than 4 times its largest side: f32 would
 /// lose its detail there), else the origin (a model near the origin keeps its coordinates

@@ -17,6 +17,7 @@ mod overrides;
 mod png_out;
 mod polygon;
 mod read;
+mod stl;
 mod texture_file;
 mod texture_store;
 mod toml_scene;

@@ -266,3 +266,69 @@ fn broken_ply_and_stl_are_errors() {
     }
     let _ = std::fs::remove_dir_all(d);
 }
+
+/// An ASCII STL of `solids` (name, triangles), each `solid NAME` ... `endsolid NAME`.
+fn ascii_stl(solids: &[(&str, Vec<[[f32; 3]; 3]>)]) -> String {
+    let mut s = String::new();
+    for (name, tris) in solids {
+        s += &format!("solid {name}\n");
+        for t in tris {
+            s += "  facet normal 0 0 0\n    outer loop\n";
+            for v in t {
+                s += &format!("      vertex {} {} {}\n", v[0], v[1], v[2]);
+            }
+            s += "    endloop\n  endfacet\n";
+        }
+        s += &format!("endsolid {name}\n");
+    }
+    s
+}
+
+#[test]
+fn ascii_stl_without_a_name_and_with_several_solids() {
+    let d = dir("stl-ascii");
+    let cube = cube_triangles();
+    // `solid` alone on its first line (MeshLab, many CAD exporters): ASCII, by its content.
+    let p = write(&d, "noname.stl", ascii_stl(&[("", cube.clone())]).as_bytes());
+    let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(parts.len(), 1);
+    assert_eq!(corners(&parts[0].mesh), cube);
+    // Two bodies: both read, each a part, in place (the second moved by 3 in x).
+    let moved: Vec<[[f32; 3]; 3]> = cube.iter().map(|t| t.map(|v| [v[0] + 3.0, v[1], v[2]])).collect();
+    let p = write(
+        &d,
+        "two.stl",
+        ascii_stl(&[("body1", cube.clone()), ("body2", moved.clone())]).as_bytes(),
+    );
+    let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(parts.len(), 2);
+    assert_eq!(corners(&parts[0].mesh), cube);
+    assert_eq!(corners(&parts[1].mesh), moved);
+    assert!(parts[1].name.ends_with(":body2"), "{}", parts[1].name);
+    let scene = load(&p).unwrap().scene;
+    assert_eq!(scene.triangle_count(), 2 * cube.len());
+    // A binary file whose header begins with "solid" stays binary.
+    let mut bin = binary_stl(&cube);
+    bin[..5].copy_from_slice(b"solid");
+    let p = write(&d, "solidheader.stl", &bin);
+    assert_eq!(corners(&load_model(&p, &mut Vec::new()).unwrap()[0].mesh), cube);
+    // What is not STL is refused at its line.
+    let p = write(
+        &d,
+        "bad.stl",
+        b"solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 zero\n",
+    );
+    let e = load_model(&p, &mut Vec::new()).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.stl: malformed STL: line 4: `zero` is not a number"),
+        "{e}"
+    );
+    let p = write(
+        &d,
+        "short.stl",
+        b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid x\n",
+    );
+    let e = load_model(&p, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("line 7: a facet has 3 vertices, got 2"), "{e}");
+    let _ = std::fs::remove_dir_all(d);
+}

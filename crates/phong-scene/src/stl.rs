@@ -1,0 +1,139 @@
+//! STL, binary and ASCII. The two are told apart by content, not by the first word: a binary
+//! file's size is 84 + 50 bytes a facet (its 80-byte header may begin with `solid`, as many
+//! exporters write), and an ASCII file is `solid [name]` then facets. Binary files are read by
+//! `stl_io`; ASCII ones here, every `solid ... endsolid` block a part (CAD tools write one a
+//! body), with a located error for what is not STL.
+
+use crate::Error;
+use crate::formats::{far_origin, model_error, part_name};
+use crate::obj::ObjPart;
+use glam::{DVec3, Vec3};
+use phong_core::Mesh;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// One `solid` block: its name (possibly empty) and its facets' corners.
+type Solid = (String, Vec<[Vec3; 3]>);
+
+/// The parts of the STL file `path` whose bytes are `bytes`.
+pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+    let fail = |m: String| model_error(path, format!("malformed STL: {m}"));
+    let binary = bytes.len() >= 84 && {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]);
+        84 + 50 * u64::from(n) == bytes.len() as u64
+    };
+    let text = (!binary).then(|| std::str::from_utf8(bytes).ok()).flatten();
+    let solids = match text {
+        Some(t) if t.trim_start().starts_with("solid") => ascii_solids(t).map_err(fail)?,
+        _ => {
+            let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| fail(e.to_string()))?;
+            let corners = mesh
+                .faces
+                .iter()
+                .map(|f| f.vertices.map(|i| Vec3::from_array(mesh.vertices[i].0)))
+                .collect();
+            vec![(String::new(), corners)]
+        }
+    };
+    let several = solids.len() > 1;
+    let indexed: Vec<_> = solids.iter().map(|(_, corners)| indexed(corners)).collect();
+    for (points, _) in &indexed {
+        if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(fail(format!("vertex {i} is not finite: {p}")));
+        }
+    }
+    // Every part is re-centred on one point, so that the parts keep their places.
+    let origin = far_origin(indexed.iter().flat_map(|(points, _)| points.iter().copied()));
+    let mut parts = Vec::new();
+    for (i, ((name, _), (points, triangles))) in solids.into_iter().zip(indexed).enumerate() {
+        if triangles.is_empty() {
+            continue;
+        }
+        let positions: Vec<Vec3> = points.iter().map(|p| (*p - origin).as_vec3()).collect();
+        let normals = vec![Vec3::ZERO; positions.len()];
+        let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
+        let base = part_name(path);
+        parts.push(ObjPart {
+            name: match (several, name.is_empty()) {
+                (false, _) => base,
+                (true, true) => format!("{base}#{}", i + 1),
+                (true, false) => format!("{base}:{name}"),
+            },
+            mesh,
+            material: None,
+            maps: phong_core::Maps::default(),
+            has_normals: false,
+            origin,
+        });
+    }
+    if parts.is_empty() {
+        return Err(fail("no facets: nothing to render".into()));
+    }
+    Ok(parts)
+}
+
+/// Corners with equal coordinates (bit for bit) as one vertex, in order of first use (as
+/// `stl_io` indexes a binary file).
+fn indexed(corners: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(corners.len());
+    let mut points = Vec::new();
+    let triangles = corners
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                *index.entry(v.to_array().map(f32::to_bits)).or_insert_with(|| {
+                    points.push(v.as_dvec3());
+                    (points.len() - 1) as u32
+                })
+            })
+        })
+        .collect();
+    (points, triangles)
+}
+
+/// The facets of each `solid ... endsolid` block of an ASCII STL (a block's name, possibly
+/// empty), or a message naming the line.
+fn ascii_solids(text: &str) -> Result<Vec<Solid>, String> {
+    let mut solids: Vec<Solid> = Vec::new();
+    let mut open = false;
+    let mut corners: Vec<Vec3> = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let at = |m: String| format!("line {}: {m}", n + 1);
+        let mut words = line.split_whitespace();
+        let Some(first) = words.next() else { continue };
+        match first {
+            "solid" if !open => {
+                open = true;
+                solids.push((words.collect::<Vec<_>>().join(" "), Vec::new()));
+            }
+            "endsolid" if open => open = false,
+            "facet" | "outer" | "endloop" if open => {}
+            "vertex" if open => {
+                let v: Vec<f32> = words
+                    .map(|w| w.parse::<f32>().map_err(|_| at(format!("`{w}` is not a number"))))
+                    .collect::<Result<_, _>>()?;
+                if v.len() != 3 {
+                    return Err(at(format!("a vertex has 3 coordinates, got {}", v.len())));
+                }
+                corners.push(Vec3::new(v[0], v[1], v[2]));
+            }
+            "endfacet" if open => {
+                if corners.len() != 3 {
+                    return Err(at(format!("a facet has 3 vertices, got {}", corners.len())));
+                }
+                let t = [corners[0], corners[1], corners[2]];
+                solids.last_mut().expect("inside a solid").1.push(t);
+                corners.clear();
+            }
+            w => {
+                let why = if open {
+                    "inside a solid"
+                } else {
+                    "outside a solid (`solid NAME` ... `endsolid`)"
+                };
+                return Err(at(format!("unexpected `{w}` {why}")));
+            }
+        }
+    }
+    Ok(solids)
+}
