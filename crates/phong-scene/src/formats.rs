@@ -122,6 +122,9 @@ pub fn load_model_full(
 ) -> Result<LoadedModel, Error> {
     let _budget = crate::texture_file::TextureBudget::start();
     let bytes = read_bounded(path, MAX_MODEL_BYTES, WHAT)?;
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(model_error(path, "an empty file: no model to render".into()));
+    }
     sources.push(path.to_path_buf());
     let format = model_format(path, &bytes)?;
     if format == ModelFormat::Obj {
@@ -403,7 +406,13 @@ fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
         );
     }
     if triangles.is_empty() {
-        return Err(fail("no faces: nothing to render (a point cloud?)".into()));
+        return Err(model_error(
+            path,
+            format!(
+                "no faces: a point cloud of {} points, nothing to render",
+                positions.len()
+            ),
+        ));
     }
     if !has_normals {
         normals = vec![Vec3::ZERO; positions.len()];

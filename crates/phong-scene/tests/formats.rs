@@ -332,3 +332,31 @@ fn ascii_stl_without_a_name_and_with_several_solids() {
     assert!(e.contains("line 7: a facet has 3 vertices, got 2"), "{e}");
     let _ = std::fs::remove_dir_all(d);
 }
+
+#[test]
+fn files_without_faces_say_what_they_are() {
+    let d = dir("nofaces");
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    let cases: [(&str, &[u8], &str); 5] = [
+        (
+            "cloud.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n",
+            "no faces: a point cloud of 4 points",
+        ),
+        (
+            "cloud.ply",
+            ply.as_bytes(),
+            "no faces: a point cloud of 3 points, nothing to render",
+        ),
+        ("empty.obj", b"", "an empty file"),
+        ("empty.stl", b"", "an empty file"),
+        ("blank.ply", b"\n  \n", "an empty file"),
+    ];
+    for (name, bytes, says) in cases {
+        let p = write(&d, name, bytes);
+        let e = load_model(&p, &mut Vec::new()).expect_err(name).to_string();
+        assert!(e.contains(says), "{name}: {e}");
+        assert!(!e.contains("malformed"), "{name}: {e}");
+    }
+    let _ = std::fs::remove_dir_all(d);
+}

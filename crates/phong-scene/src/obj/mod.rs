@@ -399,7 +399,11 @@ pub fn load_obj_text(
             0,
             None,
             format!(
-                "no faces (`f` records with 3 or more vertices): nothing to render{}",
+                "no faces{} (`f` records with 3 or more vertices): nothing to render{}",
+                match src.lines().filter(|l| l.trim_start().starts_with("v ")).count() {
+                    0 => String::new(),
+                    n => format!(": a point cloud of {n} points"),
+                },
                 prepared
                     .notes
                     .iter()
