@@ -697,6 +697,21 @@ fn vertex_colours_are_read() {
     let parts = load_model(&p, &mut w).unwrap();
     assert!(parts[0].mesh.colors().is_empty());
     assert!(w.iter().any(|w| w.contains("vertex colours")), "{w:?}");
+    // A colour that is no finite number: the colours are dropped with a warning, the
+    // positions kept (the model is drawn).
+    for bad in ["nan", "inf", "-inf"] {
+        let text = format!("v 0 0 0 1 0 0\nv 1 0 0 0 {bad} 0\nv 0 1 0 0 0 1\nf 1 2 3\n");
+        let p = write(&d, "nan.obj", text.as_bytes());
+        let mut w = Vec::new();
+        let parts = load_model(&p, &mut w).unwrap_or_else(|e| panic!("{bad}: {e}"));
+        assert!(parts[0].mesh.colors().is_empty(), "{bad}");
+        assert_eq!(parts[0].mesh.positions().len(), 3, "{bad}");
+        assert!(
+            w.iter()
+                .any(|w| w.contains("vertex colours are not used: 1 colour values are not finite")),
+            "{bad}: {w:?}"
+        );
+    }
     let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
 property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\n\
 end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 51\n3 0 1 2\n";

@@ -142,11 +142,12 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
     let mut vertices = lines(src)
         .map(|(_, l)| words(l))
         .filter(|w| w.first().is_some_and(|&(_, k)| k == "v"));
-    let keep_colours = vertices.all(|w| w.len() == 7);
+    let finite = |t: &str| strtod(t).is_some_and(|(x, _)| x.is_finite());
+    let keep_colours = vertices.all(|w| w.len() == 7 && w[4..7].iter().all(|(_, t)| finite(t)));
     let mut out = String::with_capacity(src.len() + 64);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let (mut short_faces, mut bad_refs, mut colours, mut lenient) = (0usize, 0usize, 0usize, None);
-    let (mut lines_, mut points) = (0usize, 0usize);
+    let (mut lines_, mut points, mut bad_colours) = (0usize, 0usize, 0usize);
     for (start, line) in lines(src) {
         let w = words(line);
         let Some(&(_, kw)) = w.first() else {
@@ -200,6 +201,12 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 // A `v`'s `w` or colour, and a `vt`'s `w`, are not used, but a broken one is
                 // a broken file.
                 for i in used + 1..w.len().min(8) {
+                    // A colour that is no finite number (`nan`): the colours are dropped, the
+                    // positions kept.
+                    if kw == "v" && i >= 4 && strtod(w[i].1).is_some_and(|(x, _)| !x.is_finite()) {
+                        bad_colours += 1;
+                        continue;
+                    }
                     number(i, &mut lenient)?;
                 }
                 if kw == "v" && w.len() > 6 && !keep_colours {
@@ -325,7 +332,11 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
             "{file}: {bad_refs} texture or normal indices refer to nothing: dropped from their faces"
         ));
     }
-    if colours > 0 {
+    if bad_colours > 0 {
+        notes.push(format!(
+            "{file}: vertex colours are not used: {bad_colours} colour values are not finite numbers"
+        ));
+    } else if colours > 0 {
         notes.push(format!(
             "{file}: vertex colours ({colours} vertices) are not used: not every vertex has `x y z r g b`"
         ));
