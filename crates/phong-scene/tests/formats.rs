@@ -360,3 +360,44 @@ fn files_without_faces_say_what_they_are() {
     }
     let _ = std::fs::remove_dir_all(d);
 }
+
+/// OBJ statements continued on the next line with `\` (Rhino writes them), and `usemtl` with
+/// no name (assimp's test files): read, with the same mesh as the statements on one line and
+/// the default material after the unnamed `usemtl`, with a warning.
+#[test]
+fn obj_continuation_lines_and_unnamed_usemtl() {
+    let d = dir("obj-variants");
+    let one = write(&d, "one.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n");
+    let cont = write(
+        &d,
+        "cont.obj",
+        b"v 0 0 \\\n 0\nv 1 0 0\r\nv 0 1 \\\r\n0\nv 1 1 0\nf 1 2 \\\n 4 \\\n 3\n",
+    );
+    let a = load_model(&one, &mut Vec::new()).expect("one line each");
+    let b = load_model(&cont, &mut Vec::new()).expect("continued lines");
+    assert_eq!(corners(&a[0].mesh), corners(&b[0].mesh));
+    assert_eq!(corners(&b[0].mesh).len(), 2);
+    // An error after continued lines keeps its line number.
+    let bad = write(&d, "bad.obj", b"v 0 0 \\\n 0\nv 1 0 0\nv 0 x 0\n");
+    let e = load_model(&bad, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("bad.obj:4:"), "{e}");
+    write(&d, "m.mtl", b"newmtl red\nKd 1 0 0\n");
+    let unnamed = write(
+        &d,
+        "unnamed.obj",
+        b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl red\nf 1 2 3\nusemtl\nf 2 4 3\n",
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&unnamed, &mut w).expect("read");
+    assert!(
+        w.iter().any(|w| w.contains("`usemtl` statements name no material")),
+        "{w:?}"
+    );
+    let red: Vec<_> = parts
+        .iter()
+        .filter(|p| p.material.is_some_and(|m| m.diffuse().to_array() == [1.0, 0.0, 0.0]))
+        .collect();
+    assert_eq!(red.len(), 1, "{:?}", parts.iter().map(|p| &p.name).collect::<Vec<_>>());
+    assert_eq!(parts.iter().map(|p| p.mesh.triangles().len()).sum::<usize>(), 2);
+    let _ = std::fs::remove_dir_all(d);
+}

@@ -41,6 +41,43 @@ impl Checker<'_> {
     }
 }
 
+/// The material name an unnamed `usemtl` is read as: no library defines it, so the faces after
+/// it take the default material.
+const NO_MATERIAL: &str = "phong:no-material";
+
+/// `src` with each line that ends in `\` joined to the next (the format allows it; Rhino
+/// writes it), the newlines it removes added after the joined line, so that every later line
+/// keeps its number.
+fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
+    if !src.contains("\\\n") && !src.contains("\\\r\n") {
+        return std::borrow::Cow::Borrowed(src);
+    }
+    let mut out = String::with_capacity(src.len());
+    let mut pending = 0usize;
+    let mut rest = src;
+    while let Some(i) = rest.find('\n') {
+        let (line, next) = (&rest[..i], &rest[i + 1..]);
+        let body = line.strip_suffix('\r').unwrap_or(line);
+        match body.strip_suffix('\\') {
+            Some(head) => {
+                out.push_str(head);
+                out.push(' ');
+                pending += 1;
+            }
+            None => {
+                out.push_str(line);
+                out.push('\n');
+                out.extend(std::iter::repeat_n('\n', pending));
+                pending = 0;
+            }
+        }
+        rest = next;
+    }
+    out.push_str(rest);
+    out.extend(std::iter::repeat_n('\n', pending));
+    std::borrow::Cow::Owned(out)
+}
+
 pub(super) fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
     let mut off = 0;
     src.split_inclusive('\n').map(move |l| {
@@ -112,6 +149,8 @@ pub(super) struct Prepared {
 /// A vertex index out of range, a malformed number or a non-finite coordinate is an error at
 /// its line and column.
 pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
+    let joined = join_continuations(src);
+    let src: &str = &joined;
     let c = Checker { path, src };
     fn words(line: &str) -> Vec<(usize, &str)> {
         let content = line.split('#').next().unwrap_or("");
@@ -147,7 +186,7 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
     let mut out = String::with_capacity(src.len() + 64);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let (mut short_faces, mut bad_refs, mut colours, mut lenient) = (0usize, 0usize, 0usize, None);
-    let (mut lines_, mut points, mut bad_colours) = (0usize, 0usize, 0usize);
+    let (mut lines_, mut points, mut bad_colours, mut unnamed_materials) = (0usize, 0usize, 0usize, 0usize);
     for (start, line) in lines(src) {
         let w = words(line);
         let Some(&(_, kw)) = w.first() else {
@@ -300,6 +339,14 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 }
                 out.push('\n');
             }
+            "usemtl" if w.len() == 1 => {
+                // No name (assimp's test files): the default material from here on, as a name
+                // that no library defines gives it.
+                unnamed_materials += 1;
+                out.push_str("usemtl ");
+                out.push_str(NO_MATERIAL);
+                out.push('\n');
+            }
             "l" | "p" => {
                 if kw == "l" {
                     lines_ += 1;
@@ -330,6 +377,11 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
     if bad_refs > 0 {
         notes.push(format!(
             "{file}: {bad_refs} texture or normal indices refer to nothing: dropped from their faces"
+        ));
+    }
+    if unnamed_materials > 0 {
+        notes.push(format!(
+            "{file}: {unnamed_materials} `usemtl` statements name no material: the default material there"
         ));
     }
     if bad_colours > 0 {
