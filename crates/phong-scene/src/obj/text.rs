@@ -239,10 +239,10 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 }
                 // A `v`'s `w` or colour, and a `vt`'s `w`, are not used, but a broken one is
                 // a broken file.
-                for i in used + 1..w.len().min(8) {
+                for (i, (_, t)) in w.iter().enumerate().take(8).skip(used + 1) {
                     // A colour that is no finite number (`nan`): the colours are dropped, the
                     // positions kept.
-                    if kw == "v" && i >= 4 && strtod(w[i].1).is_some_and(|(x, _)| !x.is_finite()) {
+                    if kw == "v" && i >= 4 && strtod(t).is_some_and(|(x, _)| !x.is_finite()) {
                         bad_colours += 1;
                         continue;
                     }
