@@ -242,7 +242,7 @@ pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
                 for (i, (_, t)) in w.iter().enumerate().take(8).skip(used + 1) {
                     // A colour that is no finite number (`nan`): the colours are dropped, the
                     // positions kept.
-                    if kw == "v" && i >= 4 && strtod(t).is_some_and(|(x, _)| !x.is_finite()) {
+                    if kw == "v" && w.len() == 7 && i >= 4 && strtod(t).is_some_and(|(x, _)| !x.is_finite()) {
                         bad_colours += 1;
                         continue;
                     }
