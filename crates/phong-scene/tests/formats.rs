@@ -399,5 +399,18 @@ fn obj_continuation_lines_and_unnamed_usemtl() {
         .collect();
     assert_eq!(red.len(), 1, "{:?}", parts.iter().map(|p| &p.name).collect::<Vec<_>>());
     assert_eq!(parts.iter().map(|p| p.mesh.triangles().len()).sum::<usize>(), 2);
+    // A name that no library defines: a warning naming it, the default material.
+    let undefined = write(
+        &d,
+        "undefined.obj",
+        b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl blue\nf 1 2 3\n",
+    );
+    let mut w = Vec::new();
+    let parts = load_model(&undefined, &mut w).expect("read");
+    assert!(
+        w.iter().any(|w| w.contains("no MTL library defines (\"blue\")")),
+        "{w:?}"
+    );
+    assert!(parts[0].material.is_none());
     let _ = std::fs::remove_dir_all(d);
 }

@@ -103,6 +103,29 @@ pub(crate) fn decode_text(path: &Path, mut bytes: Vec<u8>, warnings: &mut Vec<St
     }
 }
 
+/// A warning for each material that a `usemtl` names and no library defines (its faces take
+/// the default material), unless a library was missing (its own warning says so).
+fn undefined_materials(path: &Path, text: &str, defined: &[tobj::Material], warnings: &mut Vec<String>) {
+    if warnings.iter().any(|w| w.contains("material library")) {
+        return;
+    }
+    let mut named: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("usemtl "))
+        .map(str::trim)
+        .filter(|n| !n.is_empty() && *n != text::NO_MATERIAL && !defined.iter().any(|m| m.name == *n))
+        .collect();
+    named.sort_unstable();
+    named.dedup();
+    if !named.is_empty() {
+        let list = named.iter().map(|n| format!("{n:?}")).collect::<Vec<_>>().join(", ");
+        warnings.push(format!(
+            "{}: `usemtl` names materials that no MTL library defines ({list}): the default material there",
+            path.display()
+        ));
+    }
+}
+
 /// Loads an OBJ file and its MTL materials: one part per group and material.
 pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
     load_obj_sources(path, warnings, &mut Vec::new())
@@ -290,6 +313,7 @@ pub fn load_obj_text(
         )
     })?;
     let tobj_materials: Vec<tobj::Material> = materials.unwrap_or_default();
+    undefined_materials(path, &prepared.text, &tobj_materials, warnings);
     let materials: Vec<Material> = tobj_materials.iter().map(to_material).collect();
     // Each material's maps, its images read once for the whole file.
     let requests = map_requests.into_inner();

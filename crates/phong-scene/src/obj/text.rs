@@ -43,7 +43,7 @@ impl Checker<'_> {
 
 /// The material name an unnamed `usemtl` is read as: no library defines it, so the faces after
 /// it take the default material.
-const NO_MATERIAL: &str = "phong:no-material";
+pub(super) const NO_MATERIAL: &str = "phong:no-material";
 
 /// `src` with each line that ends in `\` joined to the next (the format allows it; Rhino
 /// writes it), the newlines it removes added after the joined line, so that every later line
