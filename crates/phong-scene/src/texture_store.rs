@@ -1,7 +1,7 @@
 //! Decoded textures kept on disk with their mipmaps, so that a large image is decoded once:
 //! the next load reads its levels back as they are held in memory (as a renderer's `.tx`
 //! files do, made on first use). Off unless [`set_texture_store`] names a folder; `phong`
-//! turns it on (README, "Textures").
+//! turns it on (docs/models.md, "The texture cache").
 //!
 //! A file is named by the hash (XXH3-128) of the image's bytes and whether it was decoded
 //! from sRGB, and holds its source's length and hash again: a changed image has another

@@ -1,4 +1,4 @@
-//! The routes: the page's assets and the JSON API (README's "The explorer" documents it).
+//! The routes: the page's assets and the JSON API (docs/explorer.md documents it).
 //! Every error is a 4xx (or a 503 for a full server) with `{"error": ..., "path": ...,
 //! "limit": ...}`; nothing a request sends makes a 500 or a panic.
 

@@ -1,4 +1,4 @@
-//! The TOML scene format (see README.md for every key), a module a section.
+//! The TOML scene format (docs/scenes.md lists every key), a module a section.
 //!
 //! serde with `deny_unknown_fields` rejects unknown keys and wrong types with the span toml
 //! gives (`raw`); values that need checking are read as `Spanned` so that a bad one is
