@@ -126,9 +126,9 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     Ok(loaded)
 }
 
-/// [`scene_for_model`] of a model already read from `path` (a model read once and viewed many
-/// times: `phong batch`, the Python module). `sources` is left empty and `warnings` holds the
-/// scene reader's only.
+/// The scene of a model alone (as `phong render MODEL` frames it) for a model already read
+/// from `path` (a model read once and viewed many times: `phong batch`, the Python module).
+/// `sources` is left empty and `warnings` holds the scene reader's only.
 pub fn scene_for_loaded(path: &Path, model: &LoadedModel, options: &ModelOptions) -> Result<Loaded, Error> {
     let name = path
         .file_name()
