@@ -459,3 +459,26 @@ fn a_materials_maps_decode_side_by_side_as_each_alone() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A value that is none of a key's forms is explained in the scene's words, not serde's.
+#[test]
+fn untagged_forms_are_explained_in_the_users_words() {
+    for (src, key, says) in [
+        (
+            "[[object]]\nshape = \"sphere\"\nmaterial = { diffuse = \"red\" }\n",
+            "`material`",
+            "must be a material's name or a table of its keys",
+        ),
+        (
+            "[[object]]\nshape = \"sphere\"\nscale = \"big\"\n",
+            "`scale`",
+            "must be a number (uniform) or [x, y, z]",
+        ),
+    ] {
+        let e = phong_scene::parse_scene(src, std::path::Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(key) && e.contains(says), "{e}");
+        assert!(!e.contains("untagged") && !e.contains("variant"), "{e}");
+    }
+}

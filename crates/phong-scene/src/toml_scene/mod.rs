@@ -63,7 +63,17 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
         let message = integer_message(e.message().trim())
             .replace("expected i64", "expected an integer")
             .replace("expected f32", "expected a number")
-            .replace("expected a sequence", "expected an array");
+            .replace("expected a sequence", "expected an array")
+            // serde's words for a value that is none of a key's forms, in the user's words.
+            .replace(
+                "data did not match any variant of untagged enum MaterialRef",
+                "must be a material's name or a table of its keys ({ diffuse = [r, g, b], shininess = s, ... }): \
+                 a key of the table is misspelt or holds a value of the wrong kind",
+            )
+            .replace(
+                "data did not match any variant of untagged enum Scale",
+                "must be a number (uniform) or [x, y, z]",
+            );
         // An error at a key itself ("duplicate key", also inside an inline table) names that
         // key; others the line's.
         let at_key = src
