@@ -249,17 +249,9 @@ fn check_out(out: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs `phong batch`.
-pub fn batch(a: BatchArgs) -> Result<()> {
-    let (index, count) = shard(&a)?;
-    if let Some(t) = a.threads
-        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
-    {
-        bail!(InputError(format!(
-            "--threads must be from 1 to {}, got {t}",
-            phong_core::limits::MAX_THREADS
-        )));
-    }
+/// This shard's jobs of the jobs file, each read or the outcome of its failure (every line is
+/// read: an output is checked against every shard's).
+fn read_jobs(a: &BatchArgs, index: usize, count: usize) -> Result<Vec<Result<Job, Outcome>>> {
     let file =
         std::fs::File::open(&a.jobs).map_err(|e| InputError(format!("cannot read {}: {e}", a.jobs.display())))?;
     if !file.metadata().is_ok_and(|m| m.is_file()) {
@@ -320,6 +312,22 @@ pub fn batch(a: BatchArgs) -> Result<()> {
             }
         }));
     }
+    Ok(jobs)
+}
+
+/// Runs `phong batch`.
+pub fn batch(a: BatchArgs) -> Result<()> {
+    let (index, count) = shard(&a)?;
+    if let Some(t) = a.threads
+        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
+    {
+        bail!(InputError(format!(
+            "--threads must be from 1 to {}, got {t}",
+            phong_core::limits::MAX_THREADS
+        )));
+    }
+    let jobs = read_jobs(&a, index, count)?;
+    let name = a.jobs.display().to_string();
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     // Each model file is read once: kept from its first job to its last.
     let models = Models::new();
