@@ -22,13 +22,6 @@ pub enum Source<'a> {
         /// Meshes by the name an object's `mesh` key gives (models held in memory).
         meshes: Option<&'a MeshLookup<'a>>,
     },
-    /// A model already read, framed as `phong render MODEL` frames it (`path` names it).
-    Model {
-        /// The file it stands for.
-        path: &'a Path,
-        /// The model.
-        model: &'a phong_scene::LoadedModel,
-    },
 }
 
 /// What the user sets over the scene (each `None` or empty keeps the scene's).
@@ -61,7 +54,6 @@ pub fn load(source: Source, settings: &Settings, models: &Models, size_names: &s
     let mut loaded = match source {
         Source::Path(path) if phong_scene::is_model_path(path) => load_model(path, settings, &view, models)?,
         Source::Path(path) => load_scene_file(path, settings, &view, models)?,
-        Source::Model { path, model } => framed(path, model, settings, &view)?,
         Source::Document { scene, anchor, meshes } => {
             let mut doc = scene.clone();
             merge_tables(&mut doc, &settings.tables).map_err(|e| json_error(anchor, e))?;
