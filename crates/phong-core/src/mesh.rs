@@ -456,86 +456,46 @@ impl Mesh {
             })
             .collect();
         let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
-        // The faces around each vertex, in face order: `around[v]` is
-        // `faces[start[v]..start[v + 1]]` (one allocation, not one per vertex).
-        let mut start = vec![0u32; w.positions.len() + 1];
-        for t in &w.triangles {
-            for &i in t {
-                start[i as usize + 1] += 1;
-            }
-        }
-        for v in 0..w.positions.len() {
-            start[v + 1] += start[v];
-        }
-        let mut faces = vec![0u32; w.triangles.len() * 3];
-        let mut fill = start.clone();
-        for (f, t) in w.triangles.iter().enumerate() {
-            for &i in t {
-                faces[fill[i as usize] as usize] = f as u32;
-                fill[i as usize] += 1;
-            }
-        }
-        let around = |v: usize| &faces[start[v] as usize..start[v + 1] as usize];
+        let around = Around::new(w.positions.len(), &w.triangles);
         let mut work = 0u64;
-        // At a vertex with many faces, faces of the same facet direction are one group (summed
-        // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
-        // of one triangle are one group); past MANY_GROUPS directions, the edge rule above.
-        // Vertices with few faces keep the plain loop, whose summation order the images were
-        // made with.
-        const MANY: usize = 32;
-        const MANY_GROUPS: usize = 64;
         let vertex_rule: Vec<Rule> = (0..w.positions.len())
             .map(|v| {
-                let fs = around(v);
-                if fs.len() <= MANY {
-                    return Rule::Plain;
-                }
-                let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
-                let mut g: Vec<(Vec3, Vec3)> = Vec::new();
-                for &f in fs {
-                    work += 1;
-                    let u = unit[f as usize];
-                    let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
-                        g.push((u, Vec3::ZERO));
-                        g.len() - 1
-                    });
-                    g[k].1 += facet[f as usize];
-                }
-                if g.len() <= MANY_GROUPS {
-                    Rule::Directions(g)
-                } else {
-                    Rule::Edges(edge_groups(
-                        v as u32,
-                        fs,
-                        &w.triangles,
-                        &facet,
-                        &unit,
-                        cos_crease,
-                        &mut work,
-                    ))
-                }
+                vertex_rule(
+                    around.of(v),
+                    v as u32,
+                    &w.triangles,
+                    &facet,
+                    &unit,
+                    crease_deg,
+                    &mut work,
+                )
             })
             .collect();
         let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
-        let mut positions = Vec::new();
-        let mut normals = Vec::new();
-        let mut uvs = Vec::new();
-        let mut uvs1 = Vec::new();
-        let mut colors = Vec::new();
-        type Key = (u32, [u32; 3], [[u32; 2]; 2], [u32; 3]);
-        let mut dedup: FxHashMap<Key, u32> = FxHashMap::default();
+        let mut out = CornerVertices::new(w.positions.len());
+        // Where corners carry nothing but their normal, a vertex of one normal is one vertex.
+        let plain = self.uvs.is_empty() && self.uvs1.is_empty() && self.colors.is_empty();
+        let mut one = vec![u32::MAX; if plain { w.positions.len() } else { 0 }];
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
             let own = unit[f];
             let mut corner = 0;
             let tri = t.map(|v| {
                 // A corner keeps its own texture coordinates: vertices split where they differ.
-                let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
-                let uv1 = self.uvs1.get(self.triangles[f][corner] as usize).copied();
-                let color = self.colors.get(self.triangles[f][corner] as usize).copied();
+                let k = self.triangles[f][corner] as usize;
                 corner += 1;
-                let n = match &vertex_rule[v as usize] {
-                    Rule::Plain => around(v as usize)
+                let rule = &vertex_rule[v as usize];
+                if let (true, Rule::Same(n)) = (plain, rule) {
+                    let i = &mut one[v as usize];
+                    if *i == u32::MAX {
+                        *i = out.vertex(v, w.positions[v as usize], *n, self, k, false);
+                    }
+                    return *i;
+                }
+                let n = match rule {
+                    Rule::Same(n) => *n,
+                    Rule::Plain => around
+                        .of(v as usize)
                         .iter()
                         .filter(|&&g| {
                             work += 1;
@@ -552,33 +512,184 @@ impl Mesh {
                     }),
                     Rule::Edges(groups) => groups[&(f as u32)],
                 };
-                let key = (
-                    v,
-                    n.to_array().map(f32::to_bits),
-                    [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
-                    color.unwrap_or_default().to_array().map(f32::to_bits),
-                );
-                *dedup.entry(key).or_insert_with(|| {
-                    positions.push(w.positions[v as usize]);
-                    normals.push(n);
-                    uvs.extend(uv);
-                    uvs1.extend(uv1);
-                    colors.extend(color);
-                    (positions.len() - 1) as u32
-                })
+                let many = matches!(rule, Rule::Directions(_) | Rule::Edges(_));
+                out.vertex(v, w.positions[v as usize], n, self, k, many)
             });
             triangles.push(tri);
         }
-        let mesh = Mesh {
-            positions,
-            normals,
+        (out.mesh(triangles), work)
+    }
+}
+
+/// The faces around each vertex, in face order: `of(v)` is `faces[start[v]..start[v + 1]]`
+/// (one allocation, not one per vertex).
+struct Around {
+    start: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Around {
+    fn new(vertices: usize, triangles: &[[u32; 3]]) -> Around {
+        let mut start = vec![0u32; vertices + 1];
+        for t in triangles {
+            for &i in t {
+                start[i as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            start[v + 1] += start[v];
+        }
+        let mut faces = vec![0u32; triangles.len() * 3];
+        let mut fill = start.clone();
+        for (f, t) in triangles.iter().enumerate() {
+            for &i in t {
+                faces[fill[i as usize] as usize] = f as u32;
+                fill[i as usize] += 1;
+            }
+        }
+        Around { start, faces }
+    }
+
+    fn of(&self, v: usize) -> &[u32] {
+        &self.faces[self.start[v] as usize..self.start[v + 1] as usize]
+    }
+}
+
+/// At a vertex with many faces, faces of the same facet direction are one group (summed
+/// once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
+/// of one triangle are one group); past MANY_GROUPS directions, the edge rule. Vertices with
+/// few faces keep the plain loop, whose summation order the images were made with, or, where
+/// every face lies within half the crease angle of their mean direction (so every pair is
+/// within the crease), that loop's result once for all the vertex's corners.
+fn vertex_rule(
+    fs: &[u32],
+    v: u32,
+    triangles: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    crease_deg: f32,
+    work: &mut u64,
+) -> Rule {
+    const MANY: usize = 32;
+    const MANY_GROUPS: usize = 64;
+    if fs.len() <= MANY {
+        // A margin of 0.02° over f32's rounding of the dot products (whose error in angle is
+        // under 0.001° for creases in [1°, 179°]), so the shortcut gives what the loop would.
+        if (1.0..=179.0).contains(&crease_deg) {
+            *work += 2 * fs.len() as u64;
+            let sum = fs.iter().fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize]);
+            let mean = sum.normalize_or_zero();
+            let cos_half = ((crease_deg - 0.02) * 0.5).to_radians().cos();
+            if mean != Vec3::ZERO && fs.iter().all(|&g| unit[g as usize].dot(mean) >= cos_half) {
+                return Rule::Same(mean);
+            }
+        }
+        return Rule::Plain;
+    }
+    let cos_crease = crease_deg.to_radians().cos();
+    let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+    for &f in fs {
+        *work += 1;
+        let u = unit[f as usize];
+        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+            g.push((u, Vec3::ZERO));
+            g.len() - 1
+        });
+        g[k].1 += facet[f as usize];
+    }
+    if g.len() <= MANY_GROUPS {
+        Rule::Directions(g)
+    } else {
+        Rule::Edges(edge_groups(v, fs, triangles, facet, unit, cos_crease, work))
+    }
+}
+
+/// The vertices of a mesh being split at its corners: one per position, normal, texture
+/// coordinates and colour, numbered in the order they are first met. A position's vertices
+/// are a chain searched in turn (a few at most where the position has few faces), those of a
+/// position with many faces a hash map.
+struct CornerVertices {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    uvs1: Vec<Vec2>,
+    colors: Vec<Color>,
+    keys: Vec<CornerKey>,
+    /// Per welded position, its first vertex (u32::MAX: none yet); per vertex, the next.
+    head: Vec<u32>,
+    next: Vec<u32>,
+    many: FxHashMap<(u32, CornerKey), u32>,
+}
+
+type CornerKey = ([u32; 3], [[u32; 2]; 2], [u32; 3]);
+
+impl CornerVertices {
+    fn new(welded: usize) -> CornerVertices {
+        CornerVertices {
+            positions: Vec::with_capacity(welded),
+            normals: Vec::with_capacity(welded),
+            uvs: Vec::new(),
+            uvs1: Vec::new(),
+            colors: Vec::new(),
+            keys: Vec::with_capacity(welded),
+            head: vec![u32::MAX; welded],
+            next: Vec::with_capacity(welded),
+            many: FxHashMap::default(),
+        }
+    }
+
+    /// The vertex at welded position `v` (at `p`) with normal `n` and the attributes of vertex
+    /// `k` of `source`.
+    fn vertex(&mut self, v: u32, p: Vec3, n: Vec3, source: &Mesh, k: usize, many: bool) -> u32 {
+        let uv = source.uvs.get(k).copied();
+        let uv1 = source.uvs1.get(k).copied();
+        let color = source.colors.get(k).copied();
+        let key: CornerKey = (
+            n.to_array().map(f32::to_bits),
+            [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
+            color.unwrap_or_default().to_array().map(f32::to_bits),
+        );
+        if many {
+            if let Some(&i) = self.many.get(&(v, key)) {
+                return i;
+            }
+        } else {
+            let mut i = self.head[v as usize];
+            while i != u32::MAX {
+                if self.keys[i as usize] == key {
+                    return i;
+                }
+                i = self.next[i as usize];
+            }
+        }
+        let i = self.positions.len() as u32;
+        self.positions.push(p);
+        self.normals.push(n);
+        self.uvs.extend(uv);
+        self.uvs1.extend(uv1);
+        self.colors.extend(color);
+        self.keys.push(key);
+        if many {
+            self.many.insert((v, key), i);
+            self.next.push(u32::MAX);
+        } else {
+            self.next.push(self.head[v as usize]);
+            self.head[v as usize] = i;
+        }
+        i
+    }
+
+    fn mesh(self, triangles: Vec<[u32; 3]>) -> Mesh {
+        Mesh {
+            positions: self.positions,
+            normals: self.normals,
             triangles,
-            uvs,
-            uvs1,
-            colors,
+            uvs: self.uvs,
+            uvs1: self.uvs1,
+            colors: self.colors,
             tangents: Vec::new(),
-        };
-        (mesh, work)
+        }
     }
 }
 
@@ -598,6 +709,8 @@ fn append_attribute<T: Clone>(mine: &mut Vec<T>, theirs: &[T], n_mine: usize, n_
 
 /// How a vertex's corners get their crease normals (see [`Mesh::with_crease_normals`]).
 enum Rule {
+    /// Every corner's normal is this one (its faces all lie within the crease of each other).
+    Same(Vec3),
     /// Every face around the vertex compared with the corner's own.
     Plain,
     /// The vertex's face directions, each with its facets' sum.
@@ -742,6 +855,150 @@ mod tests {
 mod crease_tests {
     use super::*;
 
+    impl Mesh {
+        /// The crease normals as first written (one hash lookup a corner): the fast version must
+        /// give these bits.
+        pub(super) fn reference_crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
+            let w = self.weld().0;
+            let cos_crease = crease_deg.to_radians().cos();
+            let facet: Vec<Vec3> = w
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| w.positions[i as usize]);
+                    (b - a).cross(c - a)
+                })
+                .collect();
+            let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+            // The faces around each vertex, in face order: `around[v]` is
+            // `faces[start[v]..start[v + 1]]` (one allocation, not one per vertex).
+            let mut start = vec![0u32; w.positions.len() + 1];
+            for t in &w.triangles {
+                for &i in t {
+                    start[i as usize + 1] += 1;
+                }
+            }
+            for v in 0..w.positions.len() {
+                start[v + 1] += start[v];
+            }
+            let mut faces = vec![0u32; w.triangles.len() * 3];
+            let mut fill = start.clone();
+            for (f, t) in w.triangles.iter().enumerate() {
+                for &i in t {
+                    faces[fill[i as usize] as usize] = f as u32;
+                    fill[i as usize] += 1;
+                }
+            }
+            let around = |v: usize| &faces[start[v] as usize..start[v + 1] as usize];
+            let mut work = 0u64;
+            // At a vertex with many faces, faces of the same facet direction are one group (summed
+            // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
+            // of one triangle are one group); past MANY_GROUPS directions, the edge rule above.
+            // Vertices with few faces keep the plain loop, whose summation order the images were
+            // made with.
+            const MANY: usize = 32;
+            const MANY_GROUPS: usize = 64;
+            let vertex_rule: Vec<Rule> = (0..w.positions.len())
+                .map(|v| {
+                    let fs = around(v);
+                    if fs.len() <= MANY {
+                        return Rule::Plain;
+                    }
+                    let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+                    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+                    for &f in fs {
+                        work += 1;
+                        let u = unit[f as usize];
+                        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+                            g.push((u, Vec3::ZERO));
+                            g.len() - 1
+                        });
+                        g[k].1 += facet[f as usize];
+                    }
+                    if g.len() <= MANY_GROUPS {
+                        Rule::Directions(g)
+                    } else {
+                        Rule::Edges(edge_groups(
+                            v as u32,
+                            fs,
+                            &w.triangles,
+                            &facet,
+                            &unit,
+                            cos_crease,
+                            &mut work,
+                        ))
+                    }
+                })
+                .collect();
+            let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
+            let mut positions = Vec::new();
+            let mut normals = Vec::new();
+            let mut uvs = Vec::new();
+            let mut uvs1 = Vec::new();
+            let mut colors = Vec::new();
+            type Key = (u32, [u32; 3], [[u32; 2]; 2], [u32; 3]);
+            let mut dedup: FxHashMap<Key, u32> = FxHashMap::default();
+            let mut triangles = Vec::with_capacity(w.triangles.len());
+            for (f, t) in w.triangles.iter().enumerate() {
+                let own = unit[f];
+                let mut corner = 0;
+                let tri = t.map(|v| {
+                    // A corner keeps its own texture coordinates: vertices split where they differ.
+                    let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
+                    let uv1 = self.uvs1.get(self.triangles[f][corner] as usize).copied();
+                    let color = self.colors.get(self.triangles[f][corner] as usize).copied();
+                    corner += 1;
+                    let n = match &vertex_rule[v as usize] {
+                        Rule::Plain => around(v as usize)
+                            .iter()
+                            .filter(|&&g| {
+                                work += 1;
+                                unit[g as usize].dot(own) >= cos_crease
+                            })
+                            .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                            .normalize_or_zero(),
+                        Rule::Directions(g) => {
+                            *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
+                                work += g.len() as u64;
+                                g.iter()
+                                    .filter(|(u, _)| u.dot(own) >= cos_crease)
+                                    .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
+                                    .normalize_or_zero()
+                            })
+                        }
+                        Rule::Edges(groups) => groups[&(f as u32)],
+                        Rule::Same(n) => *n,
+                    };
+                    let key = (
+                        v,
+                        n.to_array().map(f32::to_bits),
+                        [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
+                        color.unwrap_or_default().to_array().map(f32::to_bits),
+                    );
+                    *dedup.entry(key).or_insert_with(|| {
+                        positions.push(w.positions[v as usize]);
+                        normals.push(n);
+                        uvs.extend(uv);
+                        uvs1.extend(uv1);
+                        colors.extend(color);
+                        (positions.len() - 1) as u32
+                    })
+                });
+                triangles.push(tri);
+            }
+            let mesh = Mesh {
+                positions,
+                normals,
+                triangles,
+                uvs,
+                uvs1,
+                colors,
+                tangents: Vec::new(),
+            };
+            (mesh, work)
+        }
+    }
+
     /// A fan of 100 000 faces around one apex, every one in its own direction (a cone's tip):
     /// the work grows linearly with the faces (counted, not timed); neighbours meet at a soft
     /// edge, so the apex has one normal, the normalised sum of every facet (here +z).
@@ -812,6 +1069,89 @@ mod crease_tests {
                 .normalize();
             let got = m.normals()[t[0] as usize];
             assert!((got - want).length() < 1e-5, "face {f}: {got} vs {want}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod crease_equivalence {
+    use super::*;
+    use crate::primitives;
+    use proptest::prelude::*;
+
+    /// A height field of `n`×`n` cells with heights `h` (steps and slopes: creases of every
+    /// angle), texture coordinates that jump on one row (seams) and, optionally, colours.
+    fn field(n: usize, h: &[f32], seam: bool, colored: bool) -> Mesh {
+        let mut p = Vec::new();
+        let mut uv = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                p.push(Vec3::new(x as f32, y as f32, h[(y * (n + 1) + x) % h.len()]));
+                let v = if seam && y == n / 2 { 0.9 } else { y as f32 / n as f32 };
+                uv.push(Vec2::new(x as f32 / n as f32, v));
+            }
+        }
+        let mut t = Vec::new();
+        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+        for y in 0..n {
+            for x in 0..n {
+                t.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                t.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        // A degenerate face and a repeated one.
+        t.push([at(0, 0), at(0, 0), at(1, 1)]);
+        t.push(t[0]);
+        let colors = p
+            .iter()
+            .map(|q| Color::new(q.x / n as f32, q.y / n as f32, 0.5))
+            .collect();
+        let m = Mesh::from_triangles(p, t).expect("mesh").with_uvs(uv).expect("uvs");
+        if colored {
+            m.with_colors(colors).expect("colours")
+        } else {
+            m
+        }
+    }
+
+    fn same_bits(a: &Mesh, b: &Mesh) {
+        let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(a.triangles, b.triangles);
+        assert_eq!(bits(&a.positions), bits(&b.positions));
+        assert_eq!(bits(&a.normals), bits(&b.normals));
+        assert_eq!(a.uvs, b.uvs);
+        assert_eq!(a.colors, b.colors);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        /// The shortcut (one normal a vertex where its faces are all within half the crease of
+        /// their mean) gives the plain loop's bits, vertex order and splits.
+        #[test]
+        fn fast_crease_normals_are_the_plain_loops(
+            n in 1usize..9,
+            h in proptest::collection::vec(prop_oneof![-3.0f32..3.0, Just(0.0f32), Just(1.0f32)], 1..40),
+            crease in prop_oneof![0.0f32..180.0, Just(1.0f32), Just(30.0f32), Just(45.0f32), Just(90.0f32), Just(179.0f32), Just(180.0f32)],
+            seam in any::<bool>(),
+            colored in any::<bool>(),
+        ) {
+            let m = field(n, &h, seam, colored);
+            same_bits(&m.crease_normals(crease).0, &m.reference_crease_normals(crease).0);
+        }
+    }
+
+    #[test]
+    fn fast_crease_normals_on_the_shapes() {
+        for mesh in [
+            primitives::sphere(24),
+            primitives::cube(),
+            primitives::teapot(8),
+            primitives::cone(16),
+            primitives::torus(16, 1.0, 0.3),
+        ] {
+            for crease in [1.0, 10.0, 30.0, 60.0, 89.0, 90.0, 91.0, 120.0, 179.0, 180.0] {
+                same_bits(&mesh.crease_normals(crease).0, &mesh.reference_crease_normals(crease).0);
+            }
         }
     }
 }

@@ -102,6 +102,7 @@ pub fn load_viewed(
         sources,
         notes: Vec::new(),
         textures: Default::default(),
+        times: Default::default(),
     };
     match source {
         Source::Path(path) if phong_scene::is_model_path(path) => {

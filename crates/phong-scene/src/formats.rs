@@ -1,15 +1,12 @@
-//! Model files by format: OBJ with its MTL libraries (`obj.rs`), PLY (ply-rs) and STL
-//! (stl_io). The format is told by the content where the content tells it (PLY's `ply` line,
+//! Model files by format: OBJ with its MTL libraries (`obj/`), PLY (`ply.rs`), STL (`stl.rs`)
+//! and glTF (`gltf_model.rs`). The format is told by the content where the content tells it (PLY's `ply` line,
 //! glTF's magic, a binary STL's size, an ASCII STL's `solid`), else by the extension; anything
 //! else is an error naming the formats phong reads.
 
 use crate::obj::{decode_text, obj_from_text};
 use crate::{Error, ObjPart, read_bounded};
 use glam::{DVec3, Vec3};
-use phong_core::Mesh;
 use phong_core::limits::MAX_MODEL_BYTES;
-use ply_rs::parser::Parser;
-use ply_rs::ply::{Property, PropertyAccess};
 use std::path::{Path, PathBuf};
 
 const WHAT: &str = "model (MAX_MODEL_BYTES)";
@@ -128,8 +125,13 @@ pub fn load_model_full(
     sources.push(path.to_path_buf());
     let format = model_format(path, &bytes)?;
     if format == ModelFormat::Obj {
-        let text = decode_text(path, bytes, warnings);
-        return Ok(LoadedModel::new(obj_from_text(path, &text, warnings, sources)?, format));
+        return crate::timing::timed(
+            |t| &mut t.parse,
+            || {
+                let text = decode_text(path, bytes, warnings);
+                Ok(LoadedModel::new(obj_from_text(path, &text, warnings, sources)?, format))
+            },
+        );
     }
     // A glTF's external buffers, beside it (each added to `sources`).
     let dir = path.parent().unwrap_or(Path::new(""));
@@ -143,7 +145,10 @@ pub fn load_model_full(
             other => other.to_string(),
         })
     };
-    let model = read_bytes(path, &bytes, format, &resource, warnings);
+    let model = crate::timing::timed(
+        |t| &mut t.parse,
+        || read_bytes(path, &bytes, format, &resource, warnings),
+    );
     warnings.extend(moved.into_inner());
     sources.extend(read.into_inner());
     model
@@ -159,7 +164,7 @@ fn read_bytes(
     warnings: &mut Vec<String>,
 ) -> Result<LoadedModel, Error> {
     match format {
-        ModelFormat::Ply => Ok(LoadedModel::new(read_ply(path, bytes)?, format)),
+        ModelFormat::Ply => Ok(LoadedModel::new(crate::ply::read_ply(path, bytes)?, format)),
         ModelFormat::Stl => Ok(LoadedModel::new(crate::stl::read_stl(path, bytes)?, format)),
         ModelFormat::Gltf => {
             let m = crate::gltf_model::read_gltf(path, bytes, resource, warnings)?;
@@ -225,213 +230,6 @@ pub(crate) fn model_error(path: &Path, message: String) -> Error {
     }
 }
 
-/// A PLY vertex: position and, where the file has all three, a normal and a colour (`red`,
-/// `green`, `blue`, or `r`, `g`, `b`: bytes as 0–255, floats as 0–1, as scanners write them).
-#[derive(Default)]
-struct PlyVertex {
-    p: [Option<f64>; 3],
-    n: [Option<f64>; 3],
-    c: [Option<f64>; 3],
-}
-
-/// A PLY colour channel in [0, 1]: integers of 8 bits over 255, of 16 over 65535, floats as
-/// they are (clamped).
-fn channel(p: &Property) -> Option<f64> {
-    let v = match *p {
-        Property::UChar(v) => f64::from(v) / 255.0,
-        Property::Char(v) => f64::from(v) / 127.0,
-        Property::UShort(v) => f64::from(v) / 65535.0,
-        Property::Float(v) => f64::from(v),
-        Property::Double(v) => v,
-        _ => return None,
-    };
-    v.is_finite().then(|| v.clamp(0.0, 1.0))
-}
-
-fn scalar(p: &Property) -> Option<f64> {
-    Some(match *p {
-        Property::Char(v) => f64::from(v),
-        Property::UChar(v) => f64::from(v),
-        Property::Short(v) => f64::from(v),
-        Property::UShort(v) => f64::from(v),
-        Property::Int(v) => f64::from(v),
-        Property::UInt(v) => f64::from(v),
-        Property::Float(v) => f64::from(v),
-        Property::Double(v) => v,
-        _ => return None,
-    })
-}
-
-impl PropertyAccess for PlyVertex {
-    fn new() -> Self {
-        PlyVertex::default()
-    }
-    fn set_property(&mut self, name: String, property: Property) {
-        let slot = match name.as_str() {
-            "x" => &mut self.p[0],
-            "y" => &mut self.p[1],
-            "z" => &mut self.p[2],
-            "nx" => &mut self.n[0],
-            "ny" => &mut self.n[1],
-            "nz" => &mut self.n[2],
-            "red" | "r" | "diffuse_red" => return self.c[0] = channel(&property),
-            "green" | "g" | "diffuse_green" => return self.c[1] = channel(&property),
-            "blue" | "b" | "diffuse_blue" => return self.c[2] = channel(&property),
-            _ => return,
-        };
-        *slot = scalar(&property);
-    }
-}
-
-/// A PLY face: its vertex indices (`vertex_indices` or `vertex_index`).
-#[derive(Default)]
-struct PlyFace(Option<Vec<i64>>);
-
-impl PropertyAccess for PlyFace {
-    fn new() -> Self {
-        PlyFace::default()
-    }
-    fn set_property(&mut self, name: String, property: Property) {
-        if name != "vertex_indices" && name != "vertex_index" {
-            return;
-        }
-        self.0 = match property {
-            Property::ListChar(v) => Some(v.into_iter().map(i64::from).collect()),
-            Property::ListUChar(v) => Some(v.into_iter().map(i64::from).collect()),
-            Property::ListShort(v) => Some(v.into_iter().map(i64::from).collect()),
-            Property::ListUShort(v) => Some(v.into_iter().map(i64::from).collect()),
-            Property::ListInt(v) => Some(v.into_iter().map(i64::from).collect()),
-            Property::ListUInt(v) => Some(v.into_iter().map(i64::from).collect()),
-            _ => None,
-        };
-    }
-}
-
-/// What ply-rs's header grammar panics on instead of refusing: a number in a header line past
-/// `u64` (its `uint` rule unwraps the parse). The header is its lines up to the one that is
-/// `end_header` (as ply-rs reads them: a line merely containing the word goes on).
-fn check_ply_header(bytes: &[u8]) -> Result<(), String> {
-    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line = String::from_utf8_lossy(line);
-        if line.trim() == "end_header" {
-            break;
-        }
-        for run in line.split(|c: char| !c.is_ascii_digit()).filter(|r| !r.is_empty()) {
-            if run.parse::<u64>().is_err() {
-                return Err(format!("header line {}: the number {run} is too large", i + 1));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// A PLY file's `vertex` and `face` elements as one part (polygons as fans; other elements
-/// skipped).
-fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
-    let fail = |m: String| model_error(path, format!("malformed PLY: {m}"));
-    check_ply_header(bytes).map_err(fail)?;
-    let mut reader = std::io::BufReader::new(bytes);
-    let header = Parser::<PlyVertex>::new()
-        .read_header(&mut reader)
-        .map_err(|e| fail(e.to_string()))?;
-    let (mut vertices, mut faces) = (Vec::new(), Vec::new());
-    for (name, element) in &header.elements {
-        match name.as_str() {
-            "vertex" => {
-                vertices = Parser::<PlyVertex>::new()
-                    .read_payload_for_element(&mut reader, element, &header)
-                    .map_err(|e| fail(format!("element vertex: {e}")))?;
-            }
-            "face" => {
-                faces = Parser::<PlyFace>::new()
-                    .read_payload_for_element(&mut reader, element, &header)
-                    .map_err(|e| fail(format!("element face: {e}")))?;
-            }
-            other => {
-                // Read past it (edges, materials, a scanner's extras).
-                Parser::<ply_rs::ply::DefaultElement>::new()
-                    .read_payload_for_element(&mut reader, element, &header)
-                    .map_err(|e| fail(format!("element {other}: {e}")))?;
-            }
-        }
-    }
-    let mut points = Vec::with_capacity(vertices.len());
-    let mut normals = Vec::with_capacity(vertices.len());
-    let mut has_normals = !vertices.is_empty();
-    // Colours where every vertex has them.
-    let colors: Vec<phong_core::Color> = vertices
-        .iter()
-        .map(|v| match v.c {
-            [Some(r), Some(g), Some(b)] => Some(phong_core::Color::new(r as f32, g as f32, b as f32)),
-            _ => None,
-        })
-        .collect::<Option<Vec<_>>>()
-        .unwrap_or_default();
-    for (i, v) in vertices.iter().enumerate() {
-        let [Some(x), Some(y), Some(z)] = v.p else {
-            return Err(fail(format!("vertex {i} has no x, y and z")));
-        };
-        let p = DVec3::new(x, y, z);
-        if !p.as_vec3().is_finite() {
-            return Err(fail(format!("vertex {i} is not finite in f32: {p}")));
-        }
-        points.push(p);
-        match v.n {
-            [Some(x), Some(y), Some(z)] => normals.push(Vec3::new(x as f32, y as f32, z as f32).normalize_or_zero()),
-            _ => {
-                has_normals = false;
-                normals.push(Vec3::ZERO);
-            }
-        }
-    }
-    let (positions, origin) = recentred(&points);
-    let n = positions.len() as i64;
-    let mut triangles = Vec::new();
-    let mut corners = Vec::new();
-    for (k, f) in faces.iter().enumerate() {
-        let idx =
-            f.0.as_deref()
-                .ok_or_else(|| fail(format!("face {k} has no vertex_indices")))?;
-        if let Some(bad) = idx.iter().find(|&&i| i < 0 || i >= n) {
-            return Err(fail(format!(
-                "face {k}: vertex index {bad} is out of range ({n} vertices)"
-            )));
-        }
-        corners.clear();
-        corners.extend(idx.iter().map(|&i| positions[i as usize]));
-        triangles.extend(
-            crate::polygon::triangulate(&corners)
-                .into_iter()
-                .map(|t| t.map(|k| idx[k as usize] as u32)),
-        );
-    }
-    if triangles.is_empty() {
-        return Err(model_error(
-            path,
-            format!(
-                "no faces: a point cloud of {} points, nothing to render",
-                positions.len()
-            ),
-        ));
-    }
-    if !has_normals {
-        normals = vec![Vec3::ZERO; positions.len()];
-    }
-    let mesh = Mesh::new(positions, normals, triangles)
-        .and_then(|m| m.with_colors(colors))
-        .map_err(|e| fail(e.to_string()))?;
-    // With colours, a white material: they are the ambient and diffuse colours.
-    let material = (!mesh.colors().is_empty()).then(vertex_color_material);
-    Ok(vec![ObjPart {
-        name: part_name(path),
-        mesh,
-        material,
-        maps: phong_core::Maps::default(),
-        has_normals,
-        origin,
-    }])
-}
-
 /// The material of a part whose vertex colours stand for its ambient and diffuse colours
 /// (OpenGL's `GL_COLOR_MATERIAL` with `GL_AMBIENT_AND_DIFFUSE`): ambient and diffuse white
 /// (the colour multiplies them), the rest OpenGL's default.
@@ -441,9 +239,6 @@ pub(crate) fn vertex_color_material() -> phong_core::Material {
         .expect("valid colours")
 }
 
-/// An STL file (ASCII or binary) as one part, its vertices shared where they are equal
-/// (stl_io's indexing); the facets' normals are not used (the scene's `normals` choice makes
-/// them).
 /// Where a model with vertices `points` is re-centred: the centre of its bounding box where
 /// that lies far from the origin for its size (more than 4 times its largest side: f32 would
 /// lose its detail there), else the origin (a model near the origin keeps its coordinates

@@ -14,12 +14,14 @@ mod json_scene;
 mod model;
 mod obj;
 mod overrides;
+mod ply;
 mod png_out;
 mod polygon;
 mod read;
 mod stl;
 mod texture_file;
 mod texture_store;
+mod timing;
 mod toml_scene;
 
 pub use error::Error;
@@ -36,6 +38,7 @@ pub use png_out::{encode_png, encode_png8, encode_rgba8, is_complete_png, write_
 pub use read::{read_bounded, read_text};
 pub use texture_file::{ReadFile, TextureStats, decode as decode_texture, last_store_error};
 pub use texture_store::{TextureStore, set_texture_store, texture_store};
+pub use timing::{LoadTimes, take_times};
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_from,
     parse_scene_with,
@@ -58,6 +61,8 @@ pub struct Loaded {
     pub notes: Vec<String>,
     /// The texture images read, and what they cost (`-v`).
     pub textures: TextureStats,
+    /// Where the load's time went (`-v`).
+    pub times: LoadTimes,
 }
 
 /// Loads a scene file (`.toml`) or a model (`.obj`, `.ply`, `.stl`, framed by a default camera
@@ -82,8 +87,10 @@ pub fn is_model_path(path: &Path) -> bool {
 pub fn load_with(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     let _budget = texture_file::TextureBudget::start();
     texture_file::take_stats();
+    timing::take_times();
     let mut loaded = load_without_stats(path, options)?;
     loaded.textures = texture_file::take_stats();
+    loaded.times = timing::take_times();
     Ok(loaded)
 }
 

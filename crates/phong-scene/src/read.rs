@@ -9,6 +9,10 @@ use std::path::{Path, PathBuf};
 /// The bytes of `path`, a regular file of at most `limit` bytes (`what` names the kind and its
 /// limit's constant in messages).
 pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Error> {
+    crate::timing::timed(|t| &mut t.read, || read_bounded_untimed(path, limit, what))
+}
+
+fn read_bounded_untimed(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Error> {
     let fail = |m: String| Error::Read {
         path: path.to_path_buf(),
         source: std::io::Error::other(m),

@@ -1,7 +1,7 @@
 //! STL, binary and ASCII. The two are told apart by content, not by the first word: a binary
 //! file's size is 84 + 50 bytes a facet (its 80-byte header may begin with `solid`, as many
-//! exporters write), and an ASCII file is `solid [name]` then facets. Binary files are read by
-//! `stl_io`; ASCII ones here, every `solid ... endsolid` block a part (CAD tools write one a
+//! exporters write), and an ASCII file is `solid [name]` then facets. Binary files are read as
+//! arrays of facets; ASCII ones line by line, every `solid ... endsolid` block a part (CAD tools write one a
 //! body), with a located error for what is not STL.
 
 use crate::Error;
@@ -9,7 +9,7 @@ use crate::formats::{far_origin, model_error, part_name};
 use crate::obj::ObjPart;
 use glam::{DVec3, Vec3};
 use phong_core::Mesh;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// One `solid` block: its name (possibly empty) and its facets' corners.
@@ -25,15 +25,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error>
     let text = (!binary).then(|| std::str::from_utf8(bytes).ok()).flatten();
     let solids = match text {
         Some(t) if t.trim_start().starts_with("solid") => ascii_solids(t).map_err(fail)?,
-        _ => {
-            let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| fail(e.to_string()))?;
-            let corners = mesh
-                .faces
-                .iter()
-                .map(|f| f.vertices.map(|i| Vec3::from_array(mesh.vertices[i].0)))
-                .collect();
-            vec![(String::new(), corners)]
-        }
+        _ => vec![(String::new(), binary_facets(bytes).map_err(fail)?)],
     };
     let several = solids.len() > 1;
     let indexed: Vec<_> = solids.iter().map(|(_, corners)| indexed(corners)).collect();
@@ -72,11 +64,36 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error>
     Ok(parts)
 }
 
-/// Corners with equal coordinates (bit for bit) as one vertex, in order of first use (as
-/// `stl_io` indexes a binary file).
+/// The facets of a binary STL: after an 80-byte header and a count, 50 bytes a facet (a
+/// normal, three corners as little-endian f32, two bytes of attributes). Bytes after the last
+/// facet are ignored, as other readers do.
+fn binary_facets(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, String> {
+    let Some(count) = bytes.get(80..84) else {
+        return Err(format!(
+            "{} bytes: neither a binary STL (an 84-byte header, then 50 bytes a facet) nor an ASCII one",
+            bytes.len()
+        ));
+    };
+    let n = u32::from_le_bytes(count.try_into().expect("4 bytes")) as usize;
+    let body = &bytes[84..];
+    if body.len() / 50 < n {
+        return Err(format!(
+            "the header counts {n} facets, the file holds {} (50 bytes a facet); an ASCII STL begins with `solid`",
+            body.len() / 50
+        ));
+    }
+    let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    Ok(body
+        .chunks_exact(50)
+        .take(n)
+        .map(|b| [12, 24, 36].map(|o| Vec3::new(f(&b[o..]), f(&b[o + 4..]), f(&b[o + 8..]))))
+        .collect())
+}
+
+/// Corners with equal coordinates (bit for bit) as one vertex, in order of first use.
 fn indexed(corners: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(corners.len());
-    let mut points = Vec::new();
+    let mut index: FxHashMap<[u32; 3], u32> = FxHashMap::with_capacity_and_hasher(corners.len(), Default::default());
+    let mut points = Vec::with_capacity(corners.len() / 2);
     let triangles = corners
         .iter()
         .map(|t| {

@@ -219,7 +219,7 @@ fn broken_ply_and_stl_are_errors() {
         (
             "nan.ply",
             good.replace("1 1 1 255", "nan 1 1 255").into_bytes(),
-            "Line 6",
+            "element vertex row 6 (line 23): `nan` is not a finite number",
         ),
         ("nan-binary.ply", nan_binary(), "vertex 0 is not finite"),
         (
@@ -412,5 +412,89 @@ fn obj_continuation_lines_and_unnamed_usemtl() {
         "{w:?}"
     );
     assert!(parts[0].material.is_none());
+    let _ = std::fs::remove_dir_all(d);
+}
+
+/// PLY's variants as exporters write them: every scalar type and its other names, doubles
+/// for positions, 16-bit colours, an element with lists before the vertices, a face element
+/// with other properties around its index list, `\r\n` lines, and a list of shorts: all the
+/// cube, the same corners in the same order; 16-bit colours over 65535.
+#[test]
+fn ply_variants_read_alike() {
+    let d = dir("ply-variants");
+    let want = cube_triangles();
+    let mut b = String::from(
+        "ply\r\nformat binary_little_endian 1.0\r\nobj_info made by hand\r\nelement material 2\r\n\
+         property list uint8 float32 values\r\nelement vertex 8\r\nproperty float64 x\r\nproperty double y\r\n\
+         property float64 z\r\nproperty ushort red\r\nproperty uint16 green\r\nproperty ushort blue\r\n\
+         property int8 extra\r\nelement face 6\r\nproperty uchar flags\r\nproperty list uchar short vertex_indices\r\n\
+         property float quality\r\nend_header\r\n",
+    )
+    .into_bytes();
+    for k in 0..2u8 {
+        b.push(k + 1);
+        for _ in 0..=k {
+            b.extend(1.5f32.to_le_bytes());
+        }
+    }
+    for v in CUBE_V {
+        for c in v {
+            b.extend(f64::from(c).to_le_bytes());
+        }
+        for c in [65535u16, 0, 13107] {
+            b.extend(c.to_le_bytes());
+        }
+        b.push(7);
+    }
+    for f in CUBE_F {
+        b.push(0);
+        b.push(4);
+        for i in f {
+            b.extend((i as i16).to_le_bytes());
+        }
+        b.extend(0.5f32.to_le_bytes());
+    }
+    let p = write(&d, "variants.ply", &b);
+    let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(corners(&parts[0].mesh), want);
+    assert!(!parts[0].has_normals);
+    assert!(parts[0].mesh.colors().iter().all(|c| c.to_array() == [1.0, 0.0, 0.2]));
+    // Cut inside the faces: an error at the element and row, never a panic.
+    let cut = &b[..b.len() - 10];
+    let e = load_model(&write(&d, "cut.ply", cut), &mut Vec::new())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("element face row 5") && e.contains("the file ends inside it"),
+        "{e}"
+    );
+    // Counts past what the file holds are refused before anything is allocated, also for an
+    // element of no properties (nothing to read, so nothing to loop over).
+    let header = |body: &str| format!("ply\nformat ascii 1.0\n{body}end_header\n");
+    for (text, says) in [
+        (
+            header("element vertex 99999999999\nproperty float x\n"),
+            "element vertex claims 99999999999 rows",
+        ),
+        (header("element nothing 18446744073709551615\n"), "no faces"),
+        (
+            header("element vertex 18446744073709551615\n"),
+            "vertex 0 has no x, y and z",
+        ),
+        (
+            header("element vertex 1\nproperty half x\n"),
+            "header line 4: unknown type `half`",
+        ),
+        ("ply\nelement vertex 1\nend_header\n".to_string(), "no `format` line"),
+        (
+            header("element face 1\nproperty list float int vertex_indices\n"),
+            "count must be of an integer type",
+        ),
+    ] {
+        let e = load_model(&write(&d, "bad.ply", text.as_bytes()), &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{text}: {e}");
+    }
     let _ = std::fs::remove_dir_all(d);
 }

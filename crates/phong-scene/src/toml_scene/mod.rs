@@ -101,6 +101,7 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
         sources: ctx.sources,
         notes: Vec::new(),
         textures: Default::default(),
+        times: Default::default(),
     })
 }
 

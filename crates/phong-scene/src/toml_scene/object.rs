@@ -74,12 +74,15 @@ pub(super) fn object(
             Some(n) => ctx.name(n, "normals", allowed)?,
             None => default,
         };
-        Ok(match choice {
-            "flat" => mesh.with_flat_normals(),
-            "smooth" => mesh.with_smooth_normals(),
-            "angle" => mesh.with_crease_normals(crease),
-            _ => mesh,
-        })
+        Ok(crate::timing::timed(
+            |t| &mut t.normals,
+            || match choice {
+                "flat" => mesh.with_flat_normals(),
+                "smooth" => mesh.with_smooth_normals(),
+                "angle" => mesh.with_crease_normals(crease),
+                _ => mesh,
+            },
+        ))
     };
     match (&o.shape, &o.mesh) {
         (Some(_), Some(m)) | (None, Some(m)) if o.shape.is_some() => {
@@ -240,12 +243,15 @@ pub(super) fn object(
                     Some(a) => a,
                     None => "file",
                 };
-                let mesh = match choice {
-                    "flat" => p.mesh.with_flat_normals(),
-                    "smooth" => p.mesh.with_smooth_normals(),
-                    "angle" => p.mesh.with_crease_normals(crease),
-                    _ => p.mesh,
-                };
+                let mesh = crate::timing::timed(
+                    |t| &mut t.normals,
+                    || match choice {
+                        "flat" => p.mesh.with_flat_normals(),
+                        "smooth" => p.mesh.with_smooth_normals(),
+                        "angle" => p.mesh.with_crease_normals(crease),
+                        _ => p.mesh,
+                    },
+                );
                 // The scene's material replaces the file's, maps and all.
                 let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
                 let maps = if !maps.is_empty() && !mesh.has_uvs() {
