@@ -9,6 +9,7 @@ mod materials;
 mod render;
 mod report;
 mod serve;
+mod shader;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -59,6 +60,8 @@ enum Command {
     Serve(serve::ServeArgs),
     /// Fit a material to a target image of a scene, or to a BRDF.
     Fit(fit::FitArgs),
+    /// Write the scene's illumination model as shaders: GLSL 1.20, 3.30 or ES 3.00, or a WebGL2 page.
+    Shader(shader::ShaderArgs),
     /// List the built-in materials, or show one.
     Materials {
         /// A material name (case, spaces, '-' and '_' ignored).
@@ -103,6 +106,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench::bench(args),
         Command::Serve(args) => serve::serve(args),
         Command::Fit(args) => fit::fit(args),
+        Command::Shader(args) => shader::shader(args),
         Command::Materials { name } => materials::materials(name.as_deref()),
     }
 }

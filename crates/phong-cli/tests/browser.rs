@@ -80,6 +80,25 @@ async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<S
 
 async fn open_sized(name: &'static str, query: &str, server_args: &[&str], window: (u32, u32)) -> Result<Session> {
     let (server, url) = start_server(server_args);
+    let (client, driver, profile) = browser(window).await?;
+    client.goto(&format!("{url}{query}")).await?;
+    let s = Session {
+        client,
+        url,
+        name,
+        _server: server,
+        _driver: driver,
+        _profile: profile,
+    };
+    s.idle().await?;
+    s.js("window.phong.keepPng = true; window.phong.rerender(); return true;")
+        .await?;
+    s.idle().await?;
+    Ok(s)
+}
+
+/// A headless chromium under chromedriver, its window `window` pixels.
+async fn browser(window: (u32, u32)) -> Result<(Client, Proc, tempfile::TempDir)> {
     let port = free_port();
     let driver = Proc(
         Command::new(CHROMEDRIVER)
@@ -108,20 +127,7 @@ async fn open_sized(name: &'static str, query: &str, server_args: &[&str], windo
         .connect(&format!("http://127.0.0.1:{port}"))
         .await
         .map_err(|e| anyhow!("WebDriver session: {e}"))?;
-    client.goto(&format!("{url}{query}")).await?;
-    let s = Session {
-        client,
-        url,
-        name,
-        _server: server,
-        _driver: driver,
-        _profile: profile,
-    };
-    s.idle().await?;
-    s.js("window.phong.keepPng = true; window.phong.rerender(); return true;")
-        .await?;
-    s.idle().await?;
-    Ok(s)
+    Ok((client, driver, profile))
 }
 
 impl Session {
@@ -1152,5 +1158,112 @@ fn bench_slider_latency() {
             Ok(())
         })
         .await;
+    });
+}
+
+/// Scenes over the model's options, each drawn by `phong shader --target html` in chromium's
+/// WebGL2 and by `phong render` at one sample: the canvas's pixels within 2/255 of phong's on
+/// at least 99.5% of the pixels (where they differ: triangle edges, which WebGL's rasteriser
+/// and phong's decide by their own rules).
+#[test]
+fn exported_html_draws_phongs_pixels() {
+    if !browser_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lights = [
+        "[[light]]\ntype = \"directional\"\ndirection = [-1.0, -1.0, -1.5]\n",
+        "[[light]]\ntype = \"point\"\nposition = [2.0, 2.0, 3.0]\nattenuation = [1.0, 0.05, 0.01]\n\
+         [[light]]\ntype = \"directional\"\ndirection = [1.0, 0.2, -1.0]\ncolor = [0.3, 0.3, 0.5]\n",
+        "[[light]]\ntype = \"spot\"\nposition = [0.0, 3.0, 3.0]\ndirection = [0.0, -1.0, -1.0]\ncutoff = 30.0\nexponent = 4.0\n",
+    ];
+    let cameras = [
+        "[camera]\nposition = [0.5, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 45.0\n",
+        "[camera]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 10.0]\nheight = 3.2\n",
+    ];
+    let shadings = [
+        "model = \"phong\"",
+        "model = \"blinn-phong\"\ninterpolation = \"gouraud\"",
+        "model = \"lambert\"",
+        "model = \"phong-lyon\"",
+        "model = \"blinn-phong\"\nnormalization = \"blinn-phong\"",
+        "model = \"phong\"\noutput = \"specular\"",
+        "model = \"opengl\"\ntwo_sided = true",
+    ];
+    let mut scenes = Vec::new();
+    for (k, shading) in shadings.iter().enumerate() {
+        let light = lights[k % lights.len()];
+        let camera = cameras[k % cameras.len()];
+        let encoding = if k % 2 == 0 { "linear" } else { "srgb" };
+        let text = format!(
+            "[image]\nwidth = 160\nheight = 120\nbackground = [0.05, 0.05, 0.07]\nencoding = \"{encoding}\"\n\n{camera}\n\
+             [shading]\n{shading}\nambient = [0.2, 0.2, 0.2]\n\n{light}\n\
+             [[object]]\nshape = \"sphere\"\nmaterial = {{ paint = [0.2, 0.35, 0.7], shininess = 30.0 }}\nposition = [-0.6, 0.0, 0.0]\nscale = 0.8\n\n\
+             [[object]]\nshape = \"torus\"\nmaterial = \"gold\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n"
+        );
+        let path = dir.path().join(format!("scene{k}.toml"));
+        std::fs::write(&path, text).unwrap();
+        scenes.push(path);
+    }
+    run(async move {
+        let (client, _driver, _profile) = browser((400, 400)).await.expect("browser");
+        for scene in &scenes {
+            let html = scene.with_extension("html");
+            let png = scene.with_extension("png");
+            let phong = |args: &[&str]| {
+                let out = Command::new(env!("CARGO_BIN_EXE_phong"))
+                    .args(args)
+                    .output()
+                    .expect("phong runs");
+                assert!(
+                    out.status.success(),
+                    "{args:?}: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+            };
+            let (s, h, p) = (scene.to_str().unwrap(), html.to_str().unwrap(), png.to_str().unwrap());
+            phong(&["shader", s, "--target", "html", "-o", h]);
+            phong(&["render", s, "-o", p, "--antialias", "1"]);
+            client.goto(&format!("file://{h}")).await.expect("page");
+            let got = client
+                .execute(
+                    "if (window.phongError) return 'error: ' + window.phongError; \
+                     return document.getElementById('phong').toDataURL('image/png');",
+                    vec![],
+                )
+                .await
+                .expect("canvas");
+            let url = got.as_str().expect("a string").to_string();
+            assert!(url.starts_with("data:image/png;base64,"), "{}: {url}", scene.display());
+            let bytes = base64::engine::general_purpose::STANDARD
+                .decode(&url["data:image/png;base64,".len()..])
+                .unwrap();
+            let (w, hh, web, wc) = decode(&bytes).unwrap();
+            let (pw, ph, ours, oc) = decode(&std::fs::read(&png).unwrap()).unwrap();
+            assert_eq!((w, hh), (pw, ph), "{}", scene.display());
+            let (mut off, mut worst, mut at) = (0usize, 0u8, (0, 0));
+            for i in 0..(w * hh) as usize {
+                let d = (0..3)
+                    .map(|c| web[i * wc + c].abs_diff(ours[i * oc + c]))
+                    .max()
+                    .unwrap();
+                if d > 2 {
+                    off += 1;
+                }
+                if d > worst {
+                    worst = d;
+                    at = (i as u32 % w, i as u32 / w);
+                }
+            }
+            let share = off as f64 / f64::from(w * hh);
+            assert!(
+                share <= 0.005,
+                "{}: {:.2}% of pixels differ by more than 2/255 (worst {worst} at {at:?})",
+                scene.display(),
+                share * 100.0
+            );
+            eprintln!("{}: {off} pixels past 2/255, worst {worst} at {at:?}", scene.display());
+        }
+        client.close().await.expect("close");
     });
 }

@@ -646,3 +646,53 @@ fn a_large_texture_is_read_back_from_the_texture_cache() {
         .unwrap();
     assert_eq!(from_cache(&o), 1, "{}", stderr(&o));
 }
+
+/// `phong shader`: the GLSL targets write the pair and its uniforms (the JSON's values are the
+/// scene's: the sphere's shininess, the light's direction); what a shader cannot express is
+/// exit 2 naming what, and no file is written.
+#[test]
+fn shader_exports_glsl_and_refuses_what_it_cannot_express() {
+    let stem = tmp("s");
+    let s = stem.to_str().unwrap();
+    let o = phong(&["shader", "examples/scenes/shininess.toml", "--target", "glsl", "-o", s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let vert = std::fs::read_to_string(stem.with_extension("vert")).unwrap();
+    let frag = std::fs::read_to_string(stem.with_extension("frag")).unwrap();
+    assert!(
+        vert.starts_with("#version 120\n") && vert.contains("attribute vec3 normal;"),
+        "{vert}"
+    );
+    assert!(frag.contains("vec3 R = 2.0 * dot(L, N) * N - L;"), "{frag}");
+    assert!(frag.contains("gl_FragColor") && !frag.contains("out vec4"), "{frag}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(stem.with_extension("json")).unwrap()).unwrap();
+    let shininess: Vec<f64> = json["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o["uniforms"]["uShininess"].as_f64().unwrap())
+        .collect();
+    assert_eq!(shininess, [1.0, 10.0, 100.0, 1000.0]);
+    // Directional: the direction to the light, -direction normalised.
+    let l = &json["scene"]["uLightPosition"][0];
+    let n = (1.0f64 + 1.0 + 2.25).sqrt();
+    for (k, want) in [1.0 / n, 1.0 / n, 1.5 / n].into_iter().enumerate() {
+        assert!((l[k].as_f64().unwrap() - want).abs() < 1e-6, "{l}");
+    }
+    let o = phong(&["shader", "examples/scenes/shininess.toml", "--target", "glsl330"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("#version 330 core") && text.contains("out vec4 fragColor;"),
+        "{text}"
+    );
+    for (scene, says) in [
+        ("examples/scenes/textures.toml", "texture maps"),
+        ("examples/scenes/gouraud_vs_phong.toml", "shaded differently"),
+    ] {
+        let page = tmp("p.html");
+        let o = phong(&["shader", scene, "--target", "html", "-o", page.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{scene}");
+        assert!(stderr(&o).contains(says), "{scene}: {}", stderr(&o));
+        assert!(!page.exists());
+    }
+}

@@ -1,0 +1,80 @@
+//! `phong shader`: the scene's illumination model as shaders (phong-shader).
+
+use crate::args::{RunArgs, ShadingArgs};
+use crate::{InputError, refuse_overwriting};
+use anyhow::{Result, bail};
+use phong_shader::{Version, html, program};
+use std::path::PathBuf;
+
+/// What `phong shader` writes.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Target {
+    /// A vertex/fragment pair in GLSL 1.20 (the course's form), with its uniforms as JSON.
+    Glsl,
+    /// The pair in GLSL 3.30 core.
+    Glsl330,
+    /// The pair in GLSL ES 3.00 (WebGL2).
+    Glsl300es,
+    /// One standalone WebGL2 page drawing the scene with the shaders.
+    Html,
+}
+
+#[derive(clap::Args)]
+pub struct ShaderArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// What to write.
+    #[arg(long, value_enum, default_value = "glsl")]
+    pub target: Target,
+    /// Output: the page for `html`; for the GLSL targets a stem, written as STEM.vert,
+    /// STEM.frag and STEM.json (the uniforms' values). Default: standard output.
+    #[arg(short = 'o', long = "out")]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub shading: ShadingArgs,
+}
+
+/// Writes the shaders of `a.run.input`'s scene.
+pub fn shader(a: ShaderArgs) -> Result<()> {
+    let job = a.run.resolve(Some(&a.shading))?;
+    let unsupported = |e: phong_shader::Unsupported| InputError(format!("{}: cannot export: {e}", job.input.display()));
+    let files: Vec<(Option<PathBuf>, String)> = match a.target {
+        Target::Html => vec![(a.output.clone(), html(&job.scene).map_err(unsupported)?)],
+        t => {
+            let version = match t {
+                Target::Glsl => Version::Legacy120,
+                Target::Glsl330 => Version::Core330,
+                _ => Version::Es300,
+            };
+            let p = program(&job.scene, version).map_err(unsupported)?;
+            let json = serde_json::to_string_pretty(&p.uniforms)? + "\n";
+            match &a.output {
+                None => vec![(
+                    None,
+                    format!(
+                        "// ---- vertex shader ----\n{}\n// ---- fragment shader ----\n{}\n// ---- uniforms (JSON) ----\n{json}",
+                        p.vertex, p.fragment
+                    ),
+                )],
+                Some(stem) => ["vert", "frag", "json"]
+                    .into_iter()
+                    .zip([p.vertex, p.fragment, json])
+                    .map(|(ext, text)| (Some(stem.with_extension(ext)), text))
+                    .collect(),
+            }
+        }
+    };
+    for (path, text) in files {
+        match path {
+            None => print!("{text}"),
+            Some(p) => {
+                if p.as_os_str().is_empty() {
+                    bail!(InputError("an empty output path".into()));
+                }
+                refuse_overwriting(&p, &job.sources)?;
+                phong_scene::write_file(&p, text.as_bytes())?;
+            }
+        }
+    }
+    Ok(())
+}

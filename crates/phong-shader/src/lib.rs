@@ -1,0 +1,437 @@
+//! # phong-shader
+//!
+//! A scene's illumination model as shaders: a vertex/fragment pair in GLSL 1.20 (the form the
+//! course's notes use), GLSL 3.30 core and GLSL ES 3.00, and a standalone WebGL2 page that
+//! draws the scene's meshes with them. The shaders compute [`phong_core::shade`] term for term
+//! (the equation is in their comments); the scene's model, options, light count and kinds are
+//! compiled in, the colours, positions and matrices are uniforms whose values come as JSON.
+//!
+//! What a shader cannot express exactly is refused ([`Unsupported`]) instead of drawn
+//! differently: texture maps, blending, flat interpolation (phong lights a flat triangle at its
+//! centroid, GL at a provoking vertex), and objects of different shading options in one scene.
+
+use base64::Engine;
+use glam::Vec3;
+use phong_core::{
+    Encoding, Interpolation, Light, LyonLambda, Normalization, Object, Output, Scene, ShadingSettings, SpecularModel,
+    Viewer,
+};
+use serde_json::{Value, json};
+use std::fmt::Write;
+
+mod page;
+pub use page::html;
+
+/// Why a scene cannot be exported exactly.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Unsupported(pub String);
+
+/// The GLSL dialect.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Version {
+    /// GLSL 1.20 (`attribute`, `varying`, `gl_FragColor`): the course's form.
+    Legacy120,
+    /// GLSL 3.30 core.
+    Core330,
+    /// GLSL ES 3.00 (WebGL2).
+    Es300,
+}
+
+/// A vertex/fragment pair and the values of its uniforms.
+#[derive(Clone, Debug)]
+pub struct Program {
+    /// The vertex shader.
+    pub vertex: String,
+    /// The fragment shader.
+    pub fragment: String,
+    /// `{"scene": {uniform: value}, "objects": [{"name", "uniforms": {...}}]}`.
+    pub uniforms: Value,
+}
+
+/// The shading every object of `scene` shares, or why there is none.
+fn shared_shading(scene: &Scene) -> Result<ShadingSettings, Unsupported> {
+    let first = scene
+        .objects
+        .first()
+        .ok_or_else(|| Unsupported("the scene has no objects".into()))?;
+    for o in &scene.objects {
+        if o.shading != first.shading {
+            return Err(Unsupported(format!(
+                "objects `{}` and `{}` are shaded differently (model, interpolation, viewer or output): \
+                 a program has one; export a scene whose objects share them",
+                first.name, o.name
+            )));
+        }
+        if !o.maps.is_empty() {
+            return Err(Unsupported(format!(
+                "object `{}` has texture maps: the shader export draws untextured materials only",
+                o.name
+            )));
+        }
+        if o.blends() {
+            return Err(Unsupported(format!(
+                "object `{}` is transparent (blended): the shader export draws opaque objects only",
+                o.name
+            )));
+        }
+    }
+    if matches!(first.shading.output, Output::Normal | Output::Depth) {
+        return Err(Unsupported(format!(
+            "output {:?}: the shader export draws the lit colour and its terms (color, ambient, diffuse, specular)",
+            first.shading.output
+        )));
+    }
+    if first.shading.interpolation == Interpolation::Flat {
+        return Err(Unsupported(
+            "flat interpolation: phong lights a flat triangle at its centroid, GL at one of its \
+             vertices; use `interpolation = \"phong\"` or `\"gouraud\"`"
+                .into(),
+        ));
+    }
+    Ok(first.shading)
+}
+
+fn v3(v: Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn rgb(c: phong_core::Color) -> Value {
+    json!([c.r, c.g, c.b])
+}
+
+/// The uniforms of the scene (camera, global ambient, lights).
+fn scene_uniforms(scene: &Scene) -> Value {
+    let aspect = scene.image.width as f32 / scene.image.height as f32;
+    let m = scene.camera.clip_from_world(aspect).to_cols_array();
+    let lights = scene.lighting.lights();
+    let each = |f: &dyn Fn(&Light) -> Value| Value::Array(lights.iter().map(f).collect());
+    json!({
+        "uClipFromWorld": m,
+        "uEye": v3(scene.camera.eye()),
+        "uToViewer": v3((scene.camera.eye() - scene.camera.target()).normalize_or_zero()),
+        "uGlobalAmbient": rgb(scene.lighting.ambient()),
+        "uLightPosition": each(&|l| v3(l.position().or_else(|| l.to_light()).unwrap_or(Vec3::ZERO))),
+        "uLightAttenuation": each(&|l| json!(l.attenuation().unwrap_or_default().coefficients())),
+        "uLightAmbient": each(&|l| rgb(l.color().ambient())),
+        "uLightDiffuse": each(&|l| rgb(l.color().diffuse())),
+        "uLightSpecular": each(&|l| rgb(l.color().specular())),
+        "uSpotDirection": each(&|l| v3(l.spot_cone().map_or(Vec3::ZERO, |c| c.0))),
+        "uSpotCosCutoff": each(&|l| json!(l.spot_cone().map_or(-2.0, |c| c.2))),
+        "uSpotExponent": each(&|l| json!(l.spot_cone().map_or(0.0, |c| c.3))),
+    })
+}
+
+/// The uniforms of one object's material (`k_d`, `k_s` from the normalisation).
+fn material_uniforms(o: &Object) -> Value {
+    let m = &o.material;
+    let s = m.shininess();
+    let (kd, ks) = o.shading.options.normalization.factors(s);
+    json!({
+        "uEmission": rgb(m.emission()),
+        "uAmbient": rgb(m.ambient()),
+        "uDiffuse": rgb(m.diffuse()),
+        "uSpecular": rgb(m.specular()),
+        "uShininess": s,
+        "uKd": kd,
+        "uKs": ks,
+    })
+}
+
+/// The exact shaders for `scene` in `version`, or why it cannot be exported.
+pub fn program(scene: &Scene, version: Version) -> Result<Program, Unsupported> {
+    let shading = shared_shading(scene)?;
+    let lighting = lighting_glsl(scene, &shading);
+    let encoding = scene.image.encoding;
+    let (vertex, fragment) = match shading.interpolation {
+        Interpolation::Gouraud => gouraud(&lighting, &shading, encoding),
+        _ => per_fragment(&lighting, &shading, encoding),
+    };
+    let uniforms = json!({
+        "scene": scene_uniforms(scene),
+        "objects": scene.objects.iter().map(|o| json!({"name": o.name, "uniforms": material_uniforms(o)})).collect::<Vec<_>>(),
+    });
+    Ok(Program {
+        vertex: dialect(&vertex, version, true),
+        fragment: dialect(&fragment, version, false),
+        uniforms,
+    })
+}
+
+/// The source, written as GLSL 3.30 with `#version` left out, in `version`'s words.
+fn dialect(src: &str, version: Version, vertex: bool) -> String {
+    match version {
+        Version::Core330 => format!("#version 330 core\n{src}"),
+        Version::Es300 => format!("#version 300 es\nprecision highp float;\n{src}"),
+        Version::Legacy120 => {
+            let mut out = String::from("#version 120\n");
+            for line in src.lines() {
+                let l = if vertex {
+                    line.replacen("in ", "attribute ", usize::from(line.starts_with("in ")))
+                        .replacen("out ", "varying ", usize::from(line.starts_with("out ")))
+                } else if line.starts_with("out vec4 fragColor") {
+                    continue;
+                } else {
+                    line.replacen("in ", "varying ", usize::from(line.starts_with("in ")))
+                        .replace("fragColor", "gl_FragColor")
+                };
+                out.push_str(&l);
+                out.push('\n');
+            }
+            out
+        }
+    }
+}
+
+/// The header comment: the equation the shaders compute, in the seed's words.
+fn equation(shading: &ShadingSettings) -> String {
+    let o = &shading.options;
+    let spec = match o.specular {
+        SpecularModel::None => "0 (Lambert: no highlight)".to_string(),
+        SpecularModel::Phong => "((R.V)+)^s, R = 2(N.L)N - L (Phong 1973)".to_string(),
+        SpecularModel::BlinnPhong => "((N.H)+)^s, H = normalize(L + V) (Blinn 1977, OpenGL's)".to_string(),
+        SpecularModel::Lyon { squarings, .. } => {
+            format!("(1 - (s/g) lambda)+^g, g = 2^{squarings}, lambda = 1 - R.V, only where R.V > 0 (Lyon 1993)")
+        }
+    };
+    format!(
+        "// Generated by `phong shader`: the Phong illumination model of this scene, exactly as\n\
+         // phong computes it (phong-core's `shade`). In the course's words:\n\
+         //   colour = ambient + diffuse + specular\n\
+         //   ambient  = e_m + a_m*a_g + sum_lights att*spot * a_m*a_l\n\
+         //   diffuse  = sum_lights att*spot * k_d (N.L)+ d_m*d_l\n\
+         //   specular = sum_lights att*spot * k_s f spec s_m*s_l\n\
+         // with (x)+ = max(x, 0), spec = {spec},\n\
+         // f = {gate}, k_d = uKd, k_s = uKs{norm}; att = 1/(k0 + k1 d + k2 d^2) for point and spot\n\
+         // lights, spot = (-L.S)^exponent inside the cone. N, L, V are unit vectors in world space;\n\
+         // V points to the {viewer}. The colour is {clamp}.\n",
+        gate = if o.gate_specular {
+            "1 where N.L > 0, else 0"
+        } else {
+            "1"
+        },
+        norm = if o.normalization == Normalization::None {
+            " (1: not normalised)"
+        } else {
+            " (energy normalisation; the specular term also times (N.L)+)"
+        },
+        viewer = match shading.viewer {
+            Viewer::Local => "eye (local viewer)",
+            Viewer::Infinite => "camera along its axis (infinite viewer)",
+        },
+        clamp = if o.clamp { "clamped to [0, 1]" } else { "not clamped" },
+    )
+}
+
+/// The uniform declarations and the `light(P, N, out ambient, out diffuse, out specular)`
+/// function: every light's code, its kind compiled in.
+fn lighting_glsl(scene: &Scene, shading: &ShadingSettings) -> String {
+    let o = &shading.options;
+    let lights = scene.lighting.lights();
+    let n = lights.len();
+    let mut s = equation(shading);
+    s += "uniform vec3 uEmission, uAmbient, uDiffuse, uSpecular;\n\
+          uniform float uShininess, uKd, uKs;\n\
+          uniform vec3 uEye, uToViewer, uGlobalAmbient;\n";
+    if n > 0 {
+        let _ = write!(
+            s,
+            "uniform vec3 uLightPosition[{n}], uLightAttenuation[{n}], uLightAmbient[{n}], uLightDiffuse[{n}], uLightSpecular[{n}], uSpotDirection[{n}];\n\
+             uniform float uSpotCosCutoff[{n}], uSpotExponent[{n}];\n"
+        );
+    }
+    s += "\n// (x+)^s with 0^s = 0, x taken as at most 1 against rounding.\n\
+          float powPositive(float x, float s) { return x > 0.0 ? pow(min(x, 1.0), s) : 0.0; }\n\n";
+    let spec = match o.specular {
+        SpecularModel::None => "    float spec = 0.0;\n".to_string(),
+        SpecularModel::Phong => "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float spec = powPositive(dot(R, V), uShininess);\n".to_string(),
+        SpecularModel::BlinnPhong => "    vec3 LV = L + V;\n    float spec = dot(LV, LV) > 0.0 ? powPositive(dot(N, normalize(LV)), uShininess) : 0.0;\n".to_string(),
+        SpecularModel::Lyon { squarings, lambda } => {
+            let lam = match lambda {
+                LyonLambda::Dot => "1.0 - rv",
+                LyonLambda::Difference => "0.5 * dot(R - V, R - V)",
+            };
+            let k = squarings.min(16);
+            format!(
+                "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float rv = dot(R, V);\n    float spec = 0.0;\n    if (rv > 0.0) {{\n        float g = {g:.1};\n        spec = max(1.0 - (uShininess / g) * max({lam}, 0.0), 0.0);\n        for (int k = 0; k < {k}; k++) spec *= spec;\n    }}\n",
+                g = f64::from(1u32 << k)
+            )
+        }
+    };
+    let _ = write!(
+        s,
+        "// One light's share: att*spot, the direction to it, and the three terms.\n\
+         void addLight(vec3 L, float att, vec3 N, vec3 V, vec3 la, vec3 ld, vec3 ls, inout vec3 a, inout vec3 d, inout vec3 sp) {{\n\
+         \x20   if (!(att > 0.0)) return;\n\
+         \x20   a += uAmbient * la * att;\n\
+         \x20   if (dot(L, L) == 0.0 || dot(N, N) == 0.0) return;\n\
+         \x20   float nl = dot(N, L);\n\
+         \x20   if (nl > 0.0) d += uDiffuse * ld * (att * uKd * nl);\n\
+         \x20   {gate}\n\
+         \x20   if (dot(V, V) == 0.0) return;\n\
+         {spec}{norm}\
+         \x20   if (spec > 0.0) sp += uSpecular * ls * (att * uKs * spec);\n\
+         }}\n\n",
+        gate = if o.gate_specular { "else return;" } else { "" },
+        norm = if o.normalization == Normalization::None {
+            ""
+        } else {
+            "    spec *= max(nl, 0.0);\n"
+        },
+    );
+    s += "// The terms at point P with normal Nraw (any length), world space.\n\
+          void lightPoint(vec3 P, vec3 Nraw, out vec3 a, out vec3 d, out vec3 sp) {\n";
+    s += match shading.viewer {
+        Viewer::Local => "    vec3 V = uEye - P;\n",
+        Viewer::Infinite => "    vec3 V = uToViewer;\n",
+    };
+    s += "    V = dot(V, V) > 0.0 ? normalize(V) : vec3(0.0);\n\
+          \x20   vec3 N = dot(Nraw, Nraw) > 0.0 ? normalize(Nraw) : vec3(0.0);\n\
+          \x20   a = uEmission + uAmbient * uGlobalAmbient;\n\
+          \x20   d = vec3(0.0);\n\
+          \x20   sp = vec3(0.0);\n";
+    for (i, l) in lights.iter().enumerate() {
+        match l {
+            Light::Directional(_) => {
+                let _ = writeln!(
+                    s,
+                    "    // light {i}: directional\n    addLight(uLightPosition[{i}], 1.0, N, V, uLightAmbient[{i}], uLightDiffuse[{i}], uLightSpecular[{i}], a, d, sp);"
+                );
+            }
+            _ => {
+                let spot = if l.spot_cone().is_some_and(|c| c.1 != 180.0) {
+                    format!(
+                        "        if (dist > 0.0) {{\n            float c = dot(-L, uSpotDirection[{i}]);\n            att *= c >= uSpotCosCutoff[{i}] ? pow(max(c, 0.0), uSpotExponent[{i}]) : 0.0;\n        }}\n"
+                    )
+                } else {
+                    String::new()
+                };
+                let _ = write!(
+                    s,
+                    "    {{ // light {i}: {kind}\n\
+                     \x20       vec3 toLight = uLightPosition[{i}] - P;\n\
+                     \x20       float dist = length(toLight);\n\
+                     \x20       vec3 L = dist > 0.0 ? toLight / dist : vec3(0.0);\n\
+                     \x20       vec3 k = uLightAttenuation[{i}];\n\
+                     \x20       float att = 1.0 / (k.x + dist * (k.y + dist * k.z));\n\
+                     {spot}\
+                     \x20       addLight(L, att, N, V, uLightAmbient[{i}], uLightDiffuse[{i}], uLightSpecular[{i}], a, d, sp);\n\
+                     \x20   }}\n",
+                    kind = if spot.is_empty() { "point" } else { "spot" },
+                );
+            }
+        }
+    }
+    s += "}\n\n";
+    let _ = write!(
+        s,
+        "// The 8-bit value the image stores, as a colour in [0, 1].\n\
+         vec3 encode(vec3 c) {{\n    c = clamp(c, 0.0, 1.0);\n{}}}\n\n",
+        match scene.image.encoding {
+            Encoding::Linear => "    return c;\n",
+            Encoding::Srgb =>
+                "    return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, 12.92 * c, vec3(lessThanEqual(c, vec3(0.0031308))));\n",
+        }
+    );
+    let term = match shading.output {
+        Output::Color => {
+            if o.clamp {
+                "clamp(a + d + sp, 0.0, 1.0)"
+            } else {
+                "a + d + sp"
+            }
+        }
+        Output::Ambient => "a",
+        Output::Diffuse => "d",
+        Output::Specular => "sp",
+        Output::Normal | Output::Depth => unreachable!("refused by shared_shading"),
+    };
+    let _ = write!(
+        s,
+        "// What the image shows: {:?}.\nvec3 shadePoint(vec3 P, vec3 N) {{\n    vec3 a, d, sp;\n    lightPoint(P, N, a, d, sp);\n    return {term};\n}}\n",
+        shading.output
+    );
+    s
+}
+
+/// Per-fragment (Phong) interpolation: world position and unnormalised normal interpolated,
+/// lit per pixel; a back face of a two-sided object is lit with its normal flipped.
+fn per_fragment(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (String, String) {
+    let vertex = "// Phong interpolation: the position and normal (world space) go to the fragment shader.\n\
+                  uniform mat4 uClipFromWorld;\n\
+                  in vec3 position;\n\
+                  in vec3 normal;\n\
+                  out vec3 vPosition;\n\
+                  out vec3 vNormal;\n\
+                  void main() {\n\
+                  \x20   vPosition = position;\n\
+                  \x20   vNormal = normal;\n\
+                  \x20   gl_Position = uClipFromWorld * vec4(position, 1.0);\n\
+                  }\n"
+    .to_string();
+    let flip = if shading.options.two_sided {
+        "    vec3 N = gl_FrontFacing ? vNormal : -vNormal;\n"
+    } else {
+        "    vec3 N = vNormal;\n"
+    };
+    let fragment = format!(
+        "{lighting}\nin vec3 vPosition;\nin vec3 vNormal;\nout vec4 fragColor;\nvoid main() {{\n{flip}    fragColor = vec4(encode(shadePoint(vPosition, N)), 1.0);\n}}\n"
+    );
+    (vertex, fragment)
+}
+
+/// Per-vertex (Gouraud) interpolation: lit at the vertices, colours interpolated (both sides'
+/// where lighting is two-sided, chosen per fragment by facing, as OpenGL does).
+fn gouraud(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (String, String) {
+    let two = shading.options.two_sided;
+    let vertex = format!(
+        "{lighting}\n// Gouraud interpolation: the colour is computed here and interpolated.\n\
+         uniform mat4 uClipFromWorld;\nin vec3 position;\nin vec3 normal;\nout vec3 vFront;\n{}\
+         void main() {{\n    vFront = shadePoint(position, normal);\n{}    gl_Position = uClipFromWorld * vec4(position, 1.0);\n}}\n",
+        if two { "out vec3 vBack;\n" } else { "" },
+        if two {
+            "    vBack = shadePoint(position, -normal);\n"
+        } else {
+            ""
+        },
+    );
+    let fragment = format!(
+        "// Gouraud interpolation: the vertices' colours, interpolated.\n\
+         in vec3 vFront;\n{}out vec4 fragColor;\n\
+         vec3 encode(vec3 c) {{\n    c = clamp(c, 0.0, 1.0);\n{}}}\n\
+         void main() {{\n    fragColor = vec4(encode({}), 1.0);\n}}\n",
+        if two { "in vec3 vBack;\n" } else { "" },
+        match lighting.contains("lessThanEqual(c, vec3(0.0031308))") {
+            false => "    return c;\n",
+            true =>
+                "    return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, 12.92 * c, vec3(lessThanEqual(c, vec3(0.0031308))));\n",
+        },
+        if two {
+            "gl_FrontFacing ? vFront : vBack"
+        } else {
+            "vFront"
+        },
+    );
+    (vertex, fragment)
+}
+
+/// A mesh's arrays as base64 of little-endian values (positions and normals f32 × 3, indices
+/// u32 × 3).
+pub(crate) fn mesh_data(o: &Object) -> Value {
+    let b64 = |bytes: Vec<u8>| base64::engine::general_purpose::STANDARD.encode(bytes);
+    let f = |v: &[Vec3]| b64(v.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect());
+    let i: Vec<u8> = o
+        .mesh
+        .triangles()
+        .iter()
+        .flatten()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    json!({
+        "positions": f(o.mesh.positions()),
+        "normals": f(o.mesh.normals()),
+        "indices": b64(i),
+        "count": o.mesh.triangles().len() * 3,
+        "cull": !o.shading.options.two_sided,
+    })
+}
