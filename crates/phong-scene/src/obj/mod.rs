@@ -1,9 +1,8 @@
-//! Wavefront OBJ and MTL import, with tobj.
+//! Wavefront OBJ and MTL import.
 //!
-//! tobj parses; before it, a line-by-line check of the OBJ (vertex records,
-//! face indices) and of each MTL (colours, `Ns`, `d`, `illum`) finds
-//! malformed input and reports its file, line and column, which tobj's
-//! errors do not carry.
+//! The OBJ is read by phong in one pass (`read.rs`), every malformed record reported at its
+//! file, line and column, its groups given as tobj's single-index meshes; each MTL is checked
+//! line by line (colours, `Ns`, `d`, `illum`) and parsed by tobj.
 //!
 //! MTL mapping: `Ka`, `Kd`, `Ks`, `Ke` → ambient, diffuse, specular,
 //! emission; `Ns` → shininess (the exponent itself, 0..1000); `d` → alpha;
@@ -14,9 +13,10 @@
 //! `-s`, `-clamp` and `-imfchan` options: see `texture_file.rs`.
 
 //!
-//! The preparation of the OBJ's text is in `text.rs`, the MTL libraries in `mtl.rs`.
+//! The OBJ reader is `read.rs` (with `text.rs`), the MTL libraries `mtl.rs`.
 
 mod mtl;
+mod read;
 mod text;
 
 use crate::Error;
@@ -27,7 +27,7 @@ use phong_core::{Color, Maps, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
-use text::{lines, prepare_obj};
+use text::lines;
 
 /// One group of an OBJ file with one material.
 #[derive(Debug, Clone)]
@@ -105,12 +105,12 @@ pub(crate) fn decode_text(path: &Path, mut bytes: Vec<u8>, warnings: &mut Vec<St
 
 /// A warning for each material that a `usemtl` names and no library defines (its faces take
 /// the default material), unless a library was missing (its own warning says so).
-fn undefined_materials(path: &Path, text: &str, defined: &[tobj::Material], warnings: &mut Vec<String>) {
+fn undefined_materials(path: &Path, used: &[String], defined: &[tobj::Material], warnings: &mut Vec<String>) {
     if warnings.iter().any(|w| w.contains("material library")) {
         return;
     }
-    let mut named: Vec<&str> = text
-        .lines()
+    let mut named: Vec<&str> = used
+        .iter()
         .filter_map(|l| l.strip_prefix("usemtl "))
         .map(str::trim)
         .filter(|n| !n.is_empty() && *n != text::NO_MATERIAL && !defined.iter().any(|m| m.name == *n))
@@ -204,19 +204,13 @@ pub fn load_obj_text(
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ObjPart>, Error> {
     let _budget = crate::texture_file::TextureBudget::start();
-    let prepared = prepare_obj(path, src)?;
-    warnings.extend(prepared.notes.iter().cloned());
+    let joined = text::join_continuations(src);
+    let src: &str = &joined;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: std::cell::RefCell<Option<Error>> = Default::default();
     let mtl_warnings: std::cell::RefCell<Vec<String>> = Default::default();
     let map_requests: std::cell::RefCell<Vec<(String, MapRequest)>> = Default::default();
-    let opts = tobj::LoadOptions {
-        triangulate: false,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let loaded = tobj::load_obj_buf(&mut BufReader::new(prepared.text.as_bytes()), &opts, |mtl: &Path| {
+    let load_mtl = |mtl: &Path| {
         // Located at the `mtllib` statement (its line, not a comment's).
         let name = mtl.to_string_lossy();
         let at = lines(src)
@@ -284,36 +278,17 @@ pub fn load_obj_text(
             return Err(tobj::LoadError::OpenFileFailed);
         }
         tobj::load_mtl_buf(&mut BufReader::new(text.as_bytes()))
-    });
+    };
+    let prepared = read::read_obj(path, src, &mut |p| load_mtl(p));
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);
     }
+    let prepared = prepared?;
+    warnings.extend(prepared.notes.iter().cloned());
     warnings.extend(mtl_warnings.into_inner());
-    let (models, materials) = loaded.map_err(|e| {
-        // tobj names no line: point at the first statement of the kind it could not read.
-        let kw = match e {
-            tobj::LoadError::PositionParseError
-            | tobj::LoadError::ScalingByZeroError
-            | tobj::LoadError::ColorParseError => "v",
-            tobj::LoadError::NormalParseError => "vn",
-            tobj::LoadError::TexcoordParseError => "vt",
-            tobj::LoadError::MaterialParseError => "usemtl",
-            tobj::LoadError::InvalidObjectName => "o",
-            _ => "f",
-        };
-        let at = lines(src)
-            .find(|(_, l)| l.split_whitespace().next() == Some(kw))
-            .map_or(0, |(start, _)| start);
-        Error::at(
-            path,
-            src,
-            at,
-            Some(kw),
-            format!("malformed OBJ: {e} (tobj does not say where; the first `{kw}` statement is shown)"),
-        )
-    })?;
+    let (models, materials) = (prepared.models, prepared.materials);
     let tobj_materials: Vec<tobj::Material> = materials.unwrap_or_default();
-    undefined_materials(path, &prepared.text, &tobj_materials, warnings);
+    undefined_materials(path, &prepared.used, &tobj_materials, warnings);
     let materials: Vec<Material> = tobj_materials.iter().map(to_material).collect();
     // Each material's maps, its images read once for the whole file.
     let requests = map_requests.into_inner();

@@ -1,8 +1,9 @@
-//! The OBJ text prepared for tobj, line for line: checked (every error at its line and
-//! column, which tobj's errors lack), numbers read as `strtod` reads them, positions re-centred
-//! in f64, and what tobj reads differently from the format rewritten.
+//! What the OBJ reader shares: lines, continuation lines, numbers as `strtod` reads them,
+//! located errors; and, for the tests, the reader as first written (the text checked and
+//! rewritten line for line for tobj to parse), which `read.rs` must agree with.
 
 use crate::Error;
+#[cfg(test)]
 use glam::DVec3;
 use std::path::Path;
 
@@ -48,7 +49,7 @@ pub(super) const NO_MATERIAL: &str = "phong:no-material";
 /// `src` with each line that ends in `\` joined to the next (the format allows it; Rhino
 /// writes it), the newlines it removes added after the joined line, so that every later line
 /// keeps its number.
-fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
+pub(super) fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
     if !src.contains("\\\n") && !src.contains("\\\r\n") {
         return std::borrow::Cow::Borrowed(src);
     }
@@ -90,7 +91,7 @@ pub(super) fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
 /// A number as C's `strtod` reads it, which is how other loaders read OBJ numbers: Rust's
 /// grammar (`1.e-3`, `.8e-001`, `1e+02`), else the longest prefix that is a decimal number
 /// (`3.1+e2` is 3.1). The second value is true when characters were left over.
-fn strtod(s: &str) -> Option<(f64, bool)> {
+pub(super) fn strtod(s: &str) -> Option<(f64, bool)> {
     if let Ok(x) = s.parse::<f64>() {
         return Some((x, false));
     }
@@ -123,7 +124,9 @@ fn strtod(s: &str) -> Option<(f64, bool)> {
     s[..i].parse().ok().map(|x| (x, true))
 }
 
-/// An OBJ's text prepared for tobj, with what the preparation found.
+/// An OBJ's text prepared for tobj, with what the preparation found (the reader as first
+/// written, kept as the tests' second implementation of `read.rs`).
+#[cfg(test)]
 pub(super) struct Prepared {
     /// The text tobj reads, line for line the file's (so that locations stay right).
     pub text: String,
@@ -148,6 +151,7 @@ pub(super) struct Prepared {
 ///
 /// A vertex index out of range, a malformed number or a non-finite coordinate is an error at
 /// its line and column.
+#[cfg(test)]
 pub(super) fn prepare_obj(path: &Path, src: &str) -> Result<Prepared, Error> {
     let joined = join_continuations(src);
     let src: &str = &joined;
