@@ -371,8 +371,9 @@ impl Mesh {
 
     /// [`Mesh::welded`] and, per vertex of `self`, its vertex in the welded mesh.
     fn weld(&self) -> (Mesh, Vec<u32>) {
-        let mut map: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-        let mut positions = Vec::new();
+        let mut map: FxHashMap<[u32; 3], u32> =
+            FxHashMap::with_capacity_and_hasher(self.positions.len(), Default::default());
+        let mut positions = Vec::with_capacity(self.positions.len());
         let remap: Vec<u32> = self
             .positions
             .iter()
@@ -447,29 +448,26 @@ impl Mesh {
     fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
         let w = self.weld().0;
         let cos_crease = crease_deg.to_radians().cos();
-        let facet: Vec<Vec3> = w
+        let (facet, unit): (Vec<Vec3>, Vec<Vec3>) = w
             .triangles
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| w.positions[i as usize]);
-                (b - a).cross(c - a)
+                let f = (b - a).cross(c - a);
+                (f, f.normalize_or_zero())
             })
-            .collect();
-        let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+            .unzip();
         let around = Around::new(w.positions.len(), &w.triangles);
         let mut work = 0u64;
+        // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
+        // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
+        // what the loop would.
+        let cos_half = (1.0..=179.0)
+            .contains(&crease_deg)
+            .then(|| ((crease_deg - 0.02) * 0.5).to_radians().cos());
+        let cosines = (cos_crease, cos_half);
         let vertex_rule: Vec<Rule> = (0..w.positions.len())
-            .map(|v| {
-                vertex_rule(
-                    around.of(v),
-                    v as u32,
-                    &w.triangles,
-                    &facet,
-                    &unit,
-                    crease_deg,
-                    &mut work,
-                )
-            })
+            .map(|v| vertex_rule(around.of(v), v as u32, &w.triangles, &facet, &unit, cosines, &mut work))
             .collect();
         let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
         let mut out = CornerVertices::new(w.positions.len());
@@ -478,6 +476,14 @@ impl Mesh {
         let mut one = vec![u32::MAX; if plain { w.positions.len() } else { 0 }];
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
+            if plain {
+                // The common case first: every corner's vertex already made.
+                let ids = t.map(|v| one[v as usize]);
+                if !ids.contains(&u32::MAX) {
+                    triangles.push(ids);
+                    continue;
+                }
+            }
             let own = unit[f];
             let mut corner = 0;
             let tri = t.map(|v| {
@@ -567,26 +573,22 @@ fn vertex_rule(
     triangles: &[[u32; 3]],
     facet: &[Vec3],
     unit: &[Vec3],
-    crease_deg: f32,
+    (cos_crease, cos_half): (f32, Option<f32>),
     work: &mut u64,
 ) -> Rule {
     const MANY: usize = 32;
     const MANY_GROUPS: usize = 64;
     if fs.len() <= MANY {
-        // A margin of 0.02° over f32's rounding of the dot products (whose error in angle is
-        // under 0.001° for creases in [1°, 179°]), so the shortcut gives what the loop would.
-        if (1.0..=179.0).contains(&crease_deg) {
+        if let Some(cos_half) = cos_half {
             *work += 2 * fs.len() as u64;
             let sum = fs.iter().fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize]);
             let mean = sum.normalize_or_zero();
-            let cos_half = ((crease_deg - 0.02) * 0.5).to_radians().cos();
             if mean != Vec3::ZERO && fs.iter().all(|&g| unit[g as usize].dot(mean) >= cos_half) {
                 return Rule::Same(mean);
             }
         }
         return Rule::Plain;
     }
-    let cos_crease = crease_deg.to_radians().cos();
     let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
     let mut g: Vec<(Vec3, Vec3)> = Vec::new();
     for &f in fs {

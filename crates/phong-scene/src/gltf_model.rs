@@ -220,10 +220,20 @@ pub fn read_gltf(
                     .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
             }
             let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let positions: Vec<[f32; 3]> = reader
-                .read_positions()
-                .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?
-                .collect();
+            let packed_positions = prim
+                .get(&::gltf::Semantic::Positions)
+                .and_then(|a| packed(&a, &buffers))
+                .filter(|(_, t)| *t == ::gltf::accessor::DataType::F32);
+            let positions: Vec<[f32; 3]> = match packed_positions {
+                Some((bytes, _)) => bytes
+                    .chunks_exact(12)
+                    .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
+                    .collect(),
+                None => reader
+                    .read_positions()
+                    .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?
+                    .collect(),
+            };
             if let Some((i, p)) = positions
                 .iter()
                 .enumerate()
@@ -248,9 +258,17 @@ pub fn read_gltf(
                 }
                 None => Vec::new(),
             };
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n as u32).collect(),
+            let indices: Vec<u32> = match (prim.indices().and_then(|a| packed(&a, &buffers)), reader.read_indices()) {
+                (Some((b, ::gltf::accessor::DataType::U32)), _) => b
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect(),
+                (Some((b, ::gltf::accessor::DataType::U16)), _) => b
+                    .chunks_exact(2)
+                    .map(|c| u32::from(u16::from_le_bytes([c[0], c[1]])))
+                    .collect(),
+                (_, Some(i)) => i.into_u32().collect(),
+                (_, None) => (0..n as u32).collect(),
             };
             if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
                 return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
@@ -635,6 +653,24 @@ fn phong_material(m: &::gltf::Material) -> Material {
 
 /// Checks an accessor before the reader trusts it: its type, a float component type where
 /// `float`, at least one element, and every element inside its buffer view and buffer.
+/// An accessor's elements as one run of bytes, and their component type, where they are
+/// tightly packed (no stride between them, nothing sparse) and lie inside their buffer: read
+/// as a slice rather than element by element.
+fn packed<'b>(a: &::gltf::Accessor, buffers: &'b [Vec<u8>]) -> Option<(&'b [u8], ::gltf::accessor::DataType)> {
+    let view = a.view()?;
+    let size = a.size();
+    if a.sparse().is_some() || a.normalized() || view.stride().is_some_and(|s| s != size) {
+        return None;
+    }
+    let start = view.offset().checked_add(a.offset())?;
+    let end = start.checked_add(a.count().checked_mul(size)?)?;
+    if a.offset().checked_add(a.count().checked_mul(size)?)? > view.length() {
+        return None;
+    }
+    let bytes = buffers.get(view.buffer().index())?.get(start..end)?;
+    Some((bytes, a.data_type()))
+}
+
 fn check_accessor(
     a: &::gltf::Accessor,
     buffers: &[Vec<u8>],

@@ -576,7 +576,8 @@ fn closedness(parts: &[ObjPart]) -> Closed {
     if count > MAX_CLOSED_CHECK {
         return Closed::Unchecked;
     }
-    let mut ids: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    let mut ids: FxHashMap<[u32; 3], u32> =
+        FxHashMap::with_capacity_and_hasher(parts.iter().map(|p| p.mesh.positions().len()).sum(), Default::default());
     // Each face's edges (x, y) as (higher id, +1 or -1), kept under the lower id; a closed,
     // consistent model has two faces on every edge, wound opposite ways. Lists under each id
     // (counted first, then filled), not a hash map of edges: linear, and a few times faster.
@@ -619,7 +620,9 @@ fn closedness(parts: &[ObjPart]) -> Closed {
     let (mut open_edges, mut inconsistent) = (0, 0);
     for w in start.windows(2) {
         let list = &mut under[w[0] as usize..w[1] as usize];
-        list.sort_unstable_by_key(|e| e.0);
+        if list.len() > 1 {
+            list.sort_unstable_by_key(|e| e.0);
+        }
         for run in list.chunk_by(|x, y| x.0 == y.0) {
             if run.len() != 2 {
                 open_edges += 1;
