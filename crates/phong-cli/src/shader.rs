@@ -3,7 +3,7 @@
 use crate::args::{RunArgs, ShadingArgs};
 use crate::{InputError, refuse_overwriting};
 use anyhow::{Result, bail};
-use phong_shader::{Version, html, program};
+use phong_shader::{Version, html, program, program_of};
 use std::path::PathBuf;
 
 /// What `phong shader` writes.
@@ -30,6 +30,10 @@ pub struct ShaderArgs {
     /// STEM.frag and STEM.json (the uniforms' values). Default: standard output.
     #[arg(short = 'o', long = "out")]
     pub output: Option<PathBuf>,
+    /// For the GLSL targets, the object whose shaders to write (its name or index) where the
+    /// scene's objects are shaded differently.
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub object: Option<String>,
     #[command(flatten)]
     pub shading: ShadingArgs,
 }
@@ -46,7 +50,27 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
                 Target::Glsl330 => Version::Core330,
                 _ => Version::Es300,
             };
-            let p = program(&job.scene, version).map_err(unsupported)?;
+            let p = match &a.object {
+                None => program(&job.scene, version),
+                Some(o) => {
+                    let objects = &job.scene.objects;
+                    let index = o
+                        .parse::<usize>()
+                        .ok()
+                        .filter(|&i| i < objects.len())
+                        .or_else(|| objects.iter().position(|x| x.name == *o))
+                        .ok_or_else(|| {
+                            let names: Vec<_> = objects.iter().map(|x| format!("`{}`", x.name)).collect();
+                            InputError(format!(
+                                "--object {o}: no such object (the scene's: {}, or an index below {})",
+                                names.join(", "),
+                                objects.len()
+                            ))
+                        })?;
+                    program_of(&job.scene, index, version)
+                }
+            }
+            .map_err(unsupported)?;
             let json = serde_json::to_string_pretty(&p.uniforms)? + "\n";
             match &a.output {
                 None => vec![(

@@ -1189,6 +1189,7 @@ fn exported_html_draws_phongs_pixels() {
         "model = \"blinn-phong\"\nnormalization = \"blinn-phong\"",
         "model = \"phong\"\noutput = \"specular\"",
         "model = \"opengl\"\ntwo_sided = true",
+        "model = \"blinn-phong\"\ninterpolation = \"flat\"\ntwo_sided = true",
     ];
     let mut scenes = Vec::new();
     for (k, shading) in shadings.iter().enumerate() {
@@ -1199,17 +1200,29 @@ fn exported_html_draws_phongs_pixels() {
             "[image]\nwidth = 160\nheight = 120\nbackground = [0.05, 0.05, 0.07]\nencoding = \"{encoding}\"\n\n{camera}\n\
              [shading]\n{shading}\nambient = [0.2, 0.2, 0.2]\n\n{light}\n\
              [[object]]\nshape = \"sphere\"\nmaterial = {{ paint = [0.2, 0.35, 0.7], shininess = 30.0 }}\nposition = [-0.6, 0.0, 0.0]\nscale = 0.8\n\n\
-             [[object]]\nshape = \"torus\"\nmaterial = \"gold\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n"
+             [[object]]\nshape = \"torus\"\nmaterial = \"gold\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n\n\
+             [[label]]\ntext = \"k = {k}\"\nposition = [0.0, -1.0, 1.0]\n"
         );
         let path = dir.path().join(format!("scene{k}.toml"));
         std::fs::write(&path, text).unwrap();
         scenes.push(path);
     }
+    // Every example scene the export can draw (all but the textured one): objects shaded
+    // differently each drawn with its own program, flat objects, labels.
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    for e in std::fs::read_dir(&examples).unwrap().flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "toml") && !p.ends_with("textures.toml") {
+            scenes.push(p);
+        }
+    }
+    let out = dir.path().to_path_buf();
     run(async move {
         let (client, _driver, _profile) = browser((400, 400)).await.expect("browser");
         for scene in &scenes {
-            let html = scene.with_extension("html");
-            let png = scene.with_extension("png");
+            let stem = scene.file_stem().unwrap().to_string_lossy().into_owned();
+            let html = out.join(format!("{stem}.html"));
+            let png = out.join(format!("{stem}.png"));
             let phong = |args: &[&str]| {
                 let out = Command::new(env!("CARGO_BIN_EXE_phong"))
                     .args(args)

@@ -685,14 +685,52 @@ fn shader_exports_glsl_and_refuses_what_it_cannot_express() {
         text.contains("#version 330 core") && text.contains("out vec4 fragColor;"),
         "{text}"
     );
-    for (scene, says) in [
-        ("examples/scenes/textures.toml", "texture maps"),
-        ("examples/scenes/gouraud_vs_phong.toml", "shaded differently"),
+    for (scene, target, says) in [
+        ("examples/scenes/textures.toml", "html", "texture maps"),
+        ("examples/scenes/gouraud_vs_phong.toml", "glsl", "shaded differently"),
+        (
+            "examples/scenes/gouraud_vs_phong.toml",
+            "glsl --object nothing",
+            "--object nothing: no such object",
+        ),
     ] {
-        let page = tmp("p.html");
-        let o = phong(&["shader", scene, "--target", "html", "-o", page.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(2), "{scene}");
+        let page = tmp("p.out");
+        let mut args = vec!["shader", scene, "--target"];
+        args.extend(target.split(' '));
+        args.extend(["-o", page.to_str().unwrap()]);
+        let o = phong(&args);
+        assert_eq!(o.status.code(), Some(2), "{scene} {target}");
         assert!(stderr(&o).contains(says), "{scene}: {}", stderr(&o));
-        assert!(!page.exists());
+        assert!(!page.exists() && !page.with_extension("vert").exists());
     }
+    // A scene of objects shaded differently: the page draws each with its own program; the
+    // GLSL pair is one object's (flat: lit at the triangle's centroid).
+    let page = tmp("g.html");
+    let o = phong(&[
+        "shader",
+        "examples/scenes/gouraud_vs_phong.toml",
+        "--target",
+        "html",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let html = std::fs::read_to_string(&*page).unwrap();
+    assert!(
+        html.contains("triangleCentroid") && html.contains("vFront"),
+        "flat and Gouraud programs"
+    );
+    let o = phong(&[
+        "shader",
+        "examples/scenes/gouraud_vs_phong.toml",
+        "--target",
+        "glsl330",
+        "--object",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).matches("#version 330 core").count(),
+        2
+    );
 }

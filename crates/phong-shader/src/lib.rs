@@ -7,8 +7,9 @@
 //! compiled in, the colours, positions and matrices are uniforms whose values come as JSON.
 //!
 //! What a shader cannot express exactly is refused ([`Unsupported`]) instead of drawn
-//! differently: texture maps, blending, flat interpolation (phong lights a flat triangle at its
-//! centroid, GL at a provoking vertex), and objects of different shading options in one scene.
+//! differently: texture maps, blending, the normal and depth outputs; a GLSL pair has one
+//! shading, so a scene whose objects are shaded differently is exported one object at a time
+//! (the page draws each with its own program).
 
 use base64::Engine;
 use glam::Vec3;
@@ -49,6 +50,29 @@ pub struct Program {
     pub uniforms: Value,
 }
 
+/// Why object `o` cannot be drawn by an exported shader, if it cannot.
+fn check_object(o: &Object) -> Result<(), Unsupported> {
+    if !o.maps.is_empty() {
+        return Err(Unsupported(format!(
+            "object `{}` has texture maps: the shader export draws untextured materials only",
+            o.name
+        )));
+    }
+    if o.blends() {
+        return Err(Unsupported(format!(
+            "object `{}` is transparent (blended): the shader export draws opaque objects only",
+            o.name
+        )));
+    }
+    if matches!(o.shading.output, Output::Normal | Output::Depth) {
+        return Err(Unsupported(format!(
+            "object `{}`: output {:?}: the shader export draws the lit colour and its terms (color, ambient, diffuse, specular)",
+            o.name, o.shading.output
+        )));
+    }
+    Ok(())
+}
+
 /// The shading every object of `scene` shares, or why there is none.
 fn shared_shading(scene: &Scene) -> Result<ShadingSettings, Unsupported> {
     let first = scene
@@ -56,38 +80,14 @@ fn shared_shading(scene: &Scene) -> Result<ShadingSettings, Unsupported> {
         .first()
         .ok_or_else(|| Unsupported("the scene has no objects".into()))?;
     for o in &scene.objects {
+        check_object(o)?;
         if o.shading != first.shading {
             return Err(Unsupported(format!(
                 "objects `{}` and `{}` are shaded differently (model, interpolation, viewer or output): \
-                 a program has one; export a scene whose objects share them",
+                 a program has one; choose one with --object (the html target draws each with its own)",
                 first.name, o.name
             )));
         }
-        if !o.maps.is_empty() {
-            return Err(Unsupported(format!(
-                "object `{}` has texture maps: the shader export draws untextured materials only",
-                o.name
-            )));
-        }
-        if o.blends() {
-            return Err(Unsupported(format!(
-                "object `{}` is transparent (blended): the shader export draws opaque objects only",
-                o.name
-            )));
-        }
-    }
-    if matches!(first.shading.output, Output::Normal | Output::Depth) {
-        return Err(Unsupported(format!(
-            "output {:?}: the shader export draws the lit colour and its terms (color, ambient, diffuse, specular)",
-            first.shading.output
-        )));
-    }
-    if first.shading.interpolation == Interpolation::Flat {
-        return Err(Unsupported(
-            "flat interpolation: phong lights a flat triangle at its centroid, GL at one of its \
-             vertices; use `interpolation = \"phong\"` or `\"gouraud\"`"
-                .into(),
-        ));
     }
     Ok(first.shading)
 }
@@ -101,7 +101,7 @@ fn rgb(c: phong_core::Color) -> Value {
 }
 
 /// The uniforms of the scene (camera, global ambient, lights).
-fn scene_uniforms(scene: &Scene) -> Value {
+pub(crate) fn scene_uniforms(scene: &Scene) -> Value {
     let aspect = scene.image.width as f32 / scene.image.height as f32;
     let m = scene.camera.clip_from_world(aspect).to_cols_array();
     let lights = scene.lighting.lights();
@@ -138,24 +138,45 @@ fn material_uniforms(o: &Object) -> Value {
     })
 }
 
-/// The exact shaders for `scene` in `version`, or why it cannot be exported.
+/// The exact shaders for `scene` in `version` (its objects all shaded alike), or why it
+/// cannot be exported.
 pub fn program(scene: &Scene, version: Version) -> Result<Program, Unsupported> {
     let shading = shared_shading(scene)?;
-    let lighting = lighting_glsl(scene, &shading);
-    let encoding = scene.image.encoding;
+    Ok(program_for(
+        scene,
+        &shading,
+        &scene.objects.iter().collect::<Vec<_>>(),
+        version,
+    ))
+}
+
+/// The shaders of object `index` of `scene` (by its shading), with its uniforms only.
+pub fn program_of(scene: &Scene, index: usize, version: Version) -> Result<Program, Unsupported> {
+    let o = scene
+        .objects
+        .get(index)
+        .ok_or_else(|| Unsupported(format!("the scene has no object {index}")))?;
+    check_object(o)?;
+    Ok(program_for(scene, &o.shading, &[o], version))
+}
+
+/// The program of `shading` for `objects` (which are shaded so).
+fn program_for(scene: &Scene, shading: &ShadingSettings, objects: &[&Object], version: Version) -> Program {
+    let lighting = lighting_glsl(scene, shading);
     let (vertex, fragment) = match shading.interpolation {
-        Interpolation::Gouraud => gouraud(&lighting, &shading, encoding),
-        _ => per_fragment(&lighting, &shading, encoding),
+        Interpolation::Gouraud => gouraud(&lighting, shading, false),
+        Interpolation::Flat => gouraud(&lighting, shading, true),
+        Interpolation::Phong => per_fragment(&lighting, shading),
     };
     let uniforms = json!({
         "scene": scene_uniforms(scene),
-        "objects": scene.objects.iter().map(|o| json!({"name": o.name, "uniforms": material_uniforms(o)})).collect::<Vec<_>>(),
+        "objects": objects.iter().map(|o| json!({"name": o.name, "uniforms": material_uniforms(o)})).collect::<Vec<_>>(),
     });
-    Ok(Program {
+    Program {
         vertex: dialect(&vertex, version, true),
         fragment: dialect(&fragment, version, false),
         uniforms,
-    })
+    }
 }
 
 /// The source, written as GLSL 3.30 with `#version` left out, in `version`'s words.
@@ -166,6 +187,8 @@ fn dialect(src: &str, version: Version, vertex: bool) -> String {
         Version::Legacy120 => {
             let mut out = String::from("#version 120\n");
             for line in src.lines() {
+                let line = line.replace("flat out ", "out ").replace("flat in ", "in ");
+                let line = line.as_str();
                 let l = if vertex {
                     line.replacen("in ", "attribute ", usize::from(line.starts_with("in ")))
                         .replacen("out ", "varying ", usize::from(line.starts_with("out ")))
@@ -356,7 +379,7 @@ fn lighting_glsl(scene: &Scene, shading: &ShadingSettings) -> String {
 
 /// Per-fragment (Phong) interpolation: world position and unnormalised normal interpolated,
 /// lit per pixel; a back face of a two-sided object is lit with its normal flipped.
-fn per_fragment(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (String, String) {
+fn per_fragment(lighting: &str, shading: &ShadingSettings) -> (String, String) {
     let vertex = "// Phong interpolation: the position and normal (world space) go to the fragment shader.\n\
                   uniform mat4 uClipFromWorld;\n\
                   in vec3 position;\n\
@@ -381,26 +404,51 @@ fn per_fragment(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (Stri
 }
 
 /// Per-vertex (Gouraud) interpolation: lit at the vertices, colours interpolated (both sides'
-/// where lighting is two-sided, chosen per fragment by facing, as OpenGL does).
-fn gouraud(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (String, String) {
+/// where lighting is two-sided, chosen per fragment by facing, as OpenGL does). Flat: each
+/// triangle lit once at its centroid with its facet normal, as phong lights it: the mesh is
+/// drawn with its vertices unshared, each carrying its triangle's `triangleCentroid` and facet
+/// `normal`, and the colours are `flat`.
+fn gouraud(lighting: &str, shading: &ShadingSettings, flat: bool) -> (String, String) {
     let two = shading.options.two_sided;
+    let q = if flat { "flat " } else { "" };
+    let (what, at) = if flat {
+        (
+            "// Flat interpolation: each triangle lit at its centroid with its facet normal (every\n\
+             // vertex of a triangle carries both), one colour for the triangle.\n",
+            "triangleCentroid",
+        )
+    } else {
+        (
+            "// Gouraud interpolation: the colour is computed here and interpolated.\n",
+            "position",
+        )
+    };
     let vertex = format!(
-        "{lighting}\n// Gouraud interpolation: the colour is computed here and interpolated.\n\
-         uniform mat4 uClipFromWorld;\nin vec3 position;\nin vec3 normal;\nout vec3 vFront;\n{}\
-         void main() {{\n    vFront = shadePoint(position, normal);\n{}    gl_Position = uClipFromWorld * vec4(position, 1.0);\n}}\n",
-        if two { "out vec3 vBack;\n" } else { "" },
+        "{lighting}\n{what}uniform mat4 uClipFromWorld;\nin vec3 position;\nin vec3 normal;\n{}{q}out vec3 vFront;\n{}\
+         void main() {{\n    vFront = shadePoint({at}, normal);\n{}    gl_Position = uClipFromWorld * vec4(position, 1.0);\n}}\n",
+        if flat { "in vec3 triangleCentroid;\n" } else { "" },
         if two {
-            "    vBack = shadePoint(position, -normal);\n"
+            format!("{q}out vec3 vBack;\n")
         } else {
-            ""
+            String::new()
+        },
+        if two {
+            format!("    vBack = shadePoint({at}, -normal);\n")
+        } else {
+            String::new()
         },
     );
     let fragment = format!(
-        "// Gouraud interpolation: the vertices' colours, interpolated.\n\
-         in vec3 vFront;\n{}out vec4 fragColor;\n\
+        "// The vertices' colours{}.\n\
+         {q}in vec3 vFront;\n{}out vec4 fragColor;\n\
          vec3 encode(vec3 c) {{\n    c = clamp(c, 0.0, 1.0);\n{}}}\n\
          void main() {{\n    fragColor = vec4(encode({}), 1.0);\n}}\n",
-        if two { "in vec3 vBack;\n" } else { "" },
+        if flat { ", one a triangle" } else { ", interpolated" },
+        if two {
+            format!("{q}in vec3 vBack;\n")
+        } else {
+            String::new()
+        },
         match lighting.contains("lessThanEqual(c, vec3(0.0031308))") {
             false => "    return c;\n",
             true =>
@@ -415,23 +463,43 @@ fn gouraud(lighting: &str, shading: &ShadingSettings, _: Encoding) -> (String, S
     (vertex, fragment)
 }
 
-/// A mesh's arrays as base64 of little-endian values (positions and normals f32 × 3, indices
-/// u32 × 3).
-pub(crate) fn mesh_data(o: &Object) -> Value {
+/// A mesh's arrays as base64 of little-endian values (positions, normals and, for flat
+/// objects, centroids as f32 × 3; indices u32 × 3); a flat object's vertices unshared, each
+/// with its triangle's facet normal and centroid.
+pub(crate) fn mesh_data(o: &Object, program: usize) -> Value {
     let b64 = |bytes: Vec<u8>| base64::engine::general_purpose::STANDARD.encode(bytes);
     let f = |v: &[Vec3]| b64(v.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect());
-    let i: Vec<u8> = o
-        .mesh
-        .triangles()
-        .iter()
-        .flatten()
-        .flat_map(|i| i.to_le_bytes())
-        .collect();
+    let m = &o.mesh;
+    let flat = o.shading.interpolation == Interpolation::Flat;
+    let (positions, normals, centroids, indices): (Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<u32>) = if flat {
+        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for t in 0..m.triangles().len() {
+            let [a, b, c] = m.corners(t);
+            let n = phong_core::mesh::facet_normal(a, b, c);
+            let centroid = (a + b + c) / 3.0;
+            for p in [a, b, c] {
+                out.3.push(out.0.len() as u32);
+                out.0.push(p);
+                out.1.push(n);
+                out.2.push(centroid);
+            }
+        }
+        out
+    } else {
+        (
+            m.positions().to_vec(),
+            m.normals().to_vec(),
+            Vec::new(),
+            m.triangles().iter().flatten().copied().collect(),
+        )
+    };
     json!({
-        "positions": f(o.mesh.positions()),
-        "normals": f(o.mesh.normals()),
-        "indices": b64(i),
-        "count": o.mesh.triangles().len() * 3,
+        "program": program,
+        "positions": f(&positions),
+        "normals": f(&normals),
+        "centroids": f(&centroids),
+        "indices": b64(indices.iter().flat_map(|i| i.to_le_bytes()).collect()),
+        "count": indices.len(),
         "cull": !o.shading.options.two_sided,
     })
 }

@@ -1,7 +1,7 @@
 //! The standalone WebGL2 page: the scene's meshes embedded, drawn with the exported GLSL ES
 //! 3.00 shaders and the scene's camera at the scene's image size. No network, no library.
 
-use crate::{Unsupported, Version, mesh_data, program};
+use crate::{Unsupported, Version, mesh_data, program_of};
 use phong_core::Scene;
 use serde_json::json;
 
@@ -9,25 +9,51 @@ use serde_json::json;
 /// The canvas is `#phong`; `window.phongDone` is set once it is drawn (or `window.phongError`
 /// with the reason).
 pub fn html(scene: &Scene) -> Result<String, Unsupported> {
-    let p = program(scene, Version::Es300)?;
+    if scene.objects.is_empty() {
+        return Err(Unsupported("the scene has no objects".into()));
+    }
+    // One program per distinct shading, in the objects' order; each object's index in it.
+    let mut shadings: Vec<phong_core::ShadingSettings> = Vec::new();
+    let mut meshes = Vec::new();
+    let mut materials = Vec::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let k = match shadings.iter().position(|s| *s == o.shading) {
+            Some(k) => k,
+            None => {
+                shadings.push(o.shading);
+                shadings.len() - 1
+            }
+        };
+        let p = program_of(scene, i, Version::Es300)?;
+        materials.push(p.uniforms["objects"][0]["uniforms"].clone());
+        meshes.push(mesh_data(o, k));
+    }
+    let programs: Vec<_> = shadings
+        .iter()
+        .map(|s| {
+            let first = scene
+                .objects
+                .iter()
+                .position(|o| o.shading == *s)
+                .expect("an object has it");
+            let p = program_of(scene, first, Version::Es300).expect("checked above");
+            json!({"vertex": p.vertex, "fragment": p.fragment})
+        })
+        .collect();
     let bg = scene.image.background;
     let encode = |c: f32| f64::from(scene.image.encoding.encode(c)) / 255.0;
     let data = json!({
         "width": scene.image.width,
         "height": scene.image.height,
         "background": [encode(bg[0]), encode(bg[1]), encode(bg[2]), 1.0],
-        "vertex": p.vertex,
-        "fragment": p.fragment,
-        "uniforms": p.uniforms,
-        "meshes": scene.objects.iter().map(mesh_data).collect::<Vec<_>>(),
+        "programs": programs,
+        "scene": crate::scene_uniforms(scene),
+        "materials": materials,
+        "meshes": meshes,
+        "labels": label_runs(scene),
     });
     // `</` cannot close the script from inside a JSON string.
     let data = data.to_string().replace("</", "<\\/");
-    let labels = if scene.labels.is_empty() {
-        ""
-    } else {
-        "<p>The scene's labels are not drawn here.</p>"
-    };
     Ok(format!(
         r#"<!doctype html>
 <html lang="en">
@@ -42,9 +68,7 @@ pre {{ background: #111; padding: 1em; overflow: auto; max-height: 30em; }}
 </head>
 <body>
 <canvas id="phong"></canvas>
-{labels}
-<details><summary>Vertex shader</summary><pre id="vs"></pre></details>
-<details><summary>Fragment shader</summary><pre id="fs"></pre></details>
+<div id="shaders"></div>
 <script>
 const scene = {data};
 function bytes(b64) {{
@@ -59,8 +83,6 @@ function run() {{
   // One CSS pixel an image pixel, whatever the screen's density.
   canvas.style.width = scene.width / devicePixelRatio + "px";
   canvas.style.height = scene.height / devicePixelRatio + "px";
-  document.getElementById("vs").textContent = scene.vertex;
-  document.getElementById("fs").textContent = scene.fragment;
   const gl = canvas.getContext("webgl2", {{ antialias: false, preserveDrawingBuffer: true }});
   if (!gl) throw new Error("this browser has no WebGL2");
   const compile = (type, src) => {{
@@ -70,34 +92,48 @@ function run() {{
     if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
     return s;
   }};
-  const prog = gl.createProgram();
-  gl.attachShader(prog, compile(gl.VERTEX_SHADER, scene.vertex));
-  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, scene.fragment));
-  gl.bindAttribLocation(prog, 0, "position");
-  gl.bindAttribLocation(prog, 1, "normal");
-  gl.linkProgram(prog);
-  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
-  gl.useProgram(prog);
+  const programs = scene.programs.map((p, i) => {{
+    for (const [what, src] of [["Vertex", p.vertex], ["Fragment", p.fragment]]) {{
+      const d = document.createElement("details");
+      d.innerHTML = "<summary></summary><pre></pre>";
+      d.firstChild.textContent = what + " shader" + (scene.programs.length > 1 ? " " + (i + 1) : "");
+      d.lastChild.textContent = src;
+      document.getElementById("shaders").append(d);
+    }}
+    const prog = gl.createProgram();
+    gl.attachShader(prog, compile(gl.VERTEX_SHADER, p.vertex));
+    gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, p.fragment));
+    gl.bindAttribLocation(prog, 0, "position");
+    gl.bindAttribLocation(prog, 1, "normal");
+    gl.bindAttribLocation(prog, 2, "triangleCentroid");
+    gl.linkProgram(prog);
+    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+    return prog;
+  }});
   const floats = ["uShininess", "uKd", "uKs", "uSpotCosCutoff", "uSpotExponent"];
-  const set = (name, v) => {{
+  const set = (prog, name, v) => {{
     const at = gl.getUniformLocation(prog, name);
     if (at === null) return;
     const arr = Array.isArray(v) ? v.flat() : [v];
+    if (arr.length === 0) return;
     if (name === "uClipFromWorld") gl.uniformMatrix4fv(at, false, arr);
     else if (floats.includes(name)) gl.uniform1fv(at, arr);
     else gl.uniform3fv(at, arr);
   }};
-  for (const [k, v] of Object.entries(scene.uniforms.scene)) if (!(Array.isArray(v) && v.length === 0)) set(k, v);
   gl.viewport(0, 0, scene.width, scene.height);
   gl.clearColor(...scene.background);
   gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
   gl.enable(gl.DEPTH_TEST);
   gl.depthFunc(gl.LESS);
   scene.meshes.forEach((m, i) => {{
-    for (const [k, v] of Object.entries(scene.uniforms.objects[i].uniforms)) set(k, v);
+    const prog = programs[m.program];
+    gl.useProgram(prog);
+    for (const [k, v] of Object.entries(scene.scene)) set(prog, k, v);
+    for (const [k, v] of Object.entries(scene.materials[i])) set(prog, k, v);
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
-    [m.positions, m.normals].forEach((b, loc) => {{
+    [m.positions, m.normals, m.centroids].forEach((b, loc) => {{
+      if (b.length === 0) return;
       const buf = gl.createBuffer();
       gl.bindBuffer(gl.ARRAY_BUFFER, buf);
       gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(bytes(b)), gl.STATIC_DRAW);
@@ -110,6 +146,15 @@ function run() {{
     if (m.cull) gl.enable(gl.CULL_FACE); else gl.disable(gl.CULL_FACE);
     gl.drawElements(gl.TRIANGLES, m.count, gl.UNSIGNED_INT, 0);
   }});
+  // The labels: runs of pixels of one colour, each cleared in place (the image's rows from
+  // the top, GL's from the bottom).
+  gl.enable(gl.SCISSOR_TEST);
+  for (const [x, y, n, r, g, b] of scene.labels) {{
+    gl.scissor(x, scene.height - 1 - y, n, 1);
+    gl.clearColor(r / 255, g / 255, b / 255, 1);
+    gl.clear(gl.COLOR_BUFFER_BIT);
+  }}
+  gl.disable(gl.SCISSOR_TEST);
   gl.finish();
 }}
 try {{ run(); window.phongDone = true; }} catch (e) {{ window.phongError = String(e); document.body.append(String(e)); }}
@@ -118,4 +163,33 @@ try {{ run(); window.phongDone = true; }} catch (e) {{ window.phongError = Strin
 </html>
 "#
     ))
+}
+
+/// The scene's labels as phong draws them over its image: runs `[x, y, length, r, g, b]` of
+/// pixels of one colour (8-bit, in the image's encoding), rows from the top.
+fn label_runs(scene: &Scene) -> Vec<[u32; 6]> {
+    let (w, h) = (scene.image.width, scene.image.height);
+    if scene.labels.is_empty() {
+        return Vec::new();
+    }
+    let Ok(mut img) = phong_core::Image::new(w, h, [0.0; 4]) else {
+        return Vec::new();
+    };
+    phong_core::text::draw_labels(&mut img, &scene.camera, &scene.labels);
+    let enc = |c: f32| u32::from(scene.image.encoding.encode(c));
+    let mut runs: Vec<[u32; 6]> = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let p = img.get(x, y);
+            if p[3] == 0.0 {
+                continue;
+            }
+            let c = [enc(p[0]), enc(p[1]), enc(p[2])];
+            match runs.last_mut() {
+                Some(r) if r[1] == y && r[0] + r[2] == x && r[3..] == c => r[2] += 1,
+                _ => runs.push([x, y, 1, c[0], c[1], c[2]]),
+            }
+        }
+    }
+    runs
 }
