@@ -1280,3 +1280,65 @@ fn exported_html_draws_phongs_pixels() {
         client.close().await.expect("close");
     });
 }
+
+/// The explorer's Shader view: the selected object's GLSL (1.20 by default, then ES 3.00), and
+/// the page the export writes, run in the browser's WebGL2 beside phong's image at the size
+/// the view shows it: at most 0.5% of the pixels differ by more than 2/255, for the default
+/// scene and with every model of the Model menu.
+#[test]
+fn shader_view_runs_the_exported_glsl_beside_phong() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("shader", "", &[]).await.expect("the page opens");
+        s.step("open Shader", async {
+            s.client
+                .find(Locator::XPath("//button[normalize-space(.)='Shader']"))
+                .await?
+                .click()
+                .await?;
+            s.idle().await
+        })
+        .await;
+        for model in ["blinn-phong", "phong", "lambert", "phong-lyon", "opengl"] {
+            s.step(&format!("model {model}: WebGL2 within 2/255 of phong"), async {
+                s.control("Model").await?.select_by_value(model).await?;
+                s.idle().await?;
+                let d = s.js("return window.phong.shaderDifference;").await?;
+                let (w, h, off) = (d["width"].as_u64().unwrap_or(0), d["height"].as_u64().unwrap_or(0), d["off"].as_u64().unwrap_or(u64::MAX));
+                ensure!(w >= 200 && h >= 100, "the images are {w}x{h}");
+                ensure!(off * 200 <= w * h, "{off} of {} pixels differ by more than 2/255", w * h);
+                // Drawn at the size shown (device pixels), not stretched.
+                let shown = s
+                    .js("const i = document.getElementById('shader-phong'); return [i.naturalWidth, Math.round(i.clientWidth * devicePixelRatio)];")
+                    .await?;
+                let (natural, css) = (shown[0].as_i64().unwrap_or(0), shown[1].as_i64().unwrap_or(0));
+                ensure!((natural - css).abs() <= 2, "phong's image is {natural} pixels wide, shown at {css}");
+                let vertex = s.js("return document.getElementById('shader-vertex').textContent;").await?;
+                ensure!(vertex.as_str().is_some_and(|v| v.starts_with("#version 120")), "{vertex}");
+                Ok(())
+            })
+            .await;
+        }
+        s.step("GLSL ES 3.00", async {
+            s.client
+                .find(Locator::Id("shader-target"))
+                .await?
+                .select_by_value("glsl300es")
+                .await?;
+            s.idle().await?;
+            let fragment = s
+                .js("return document.getElementById('shader-fragment').textContent;")
+                .await?;
+            ensure!(
+                fragment
+                    .as_str()
+                    .is_some_and(|f| f.starts_with("#version 300 es") && f.contains("shadePoint")),
+                "{fragment}"
+            );
+            Ok(())
+        })
+        .await;
+    });
+}

@@ -77,6 +77,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/render", post(render))
         .route("/api/probe", post(probe_pixel))
         .route("/api/toml", post(to_toml))
+        .route("/api/shader", post(shader))
         .route("/api/fit", post(fit))
         .route("/api/models", get(list_models))
         .route("/api/models/{name}", put(upload).delete(delete_model))
@@ -593,6 +594,69 @@ async fn to_toml(body: Body) -> Result<Response, ApiError> {
         t.text
     );
     Ok(([(header::CONTENT_TYPE, "application/toml; charset=utf-8")], text).into_response())
+}
+
+/// `POST /api/shader?target=glsl|glsl330|glsl300es|html[&object=INDEX]`: the scene's model as
+/// shaders (phong-shader): for the GLSL targets `{"vertex", "fragment", "uniforms"}` (the
+/// object's program where `object` is given, else the scene's, whose objects must share one),
+/// for `html` the standalone WebGL2 page. What a shader cannot express is a 422 saying what.
+async fn shader(
+    State(state): State<Arc<AppState>>,
+    ConnectInfo(peer): ConnectInfo<SocketAddr>,
+    Query(q): Query<HashMap<String, String>>,
+    headers: HeaderMap,
+    body: Body,
+) -> Result<Response, ApiError> {
+    use phong_shader::Version;
+    let target = q.get("target").map_or("glsl300es", String::as_str);
+    let version = match target {
+        "glsl" => Some(Version::Legacy120),
+        "glsl330" => Some(Version::Core330),
+        "glsl300es" => Some(Version::Es300),
+        "html" => None,
+        other => {
+            return Err(ApiError::at(
+                "target",
+                format!("`target` is \"glsl\", \"glsl330\", \"glsl300es\" or \"html\", got \"{other}\""),
+            ));
+        }
+    };
+    let object = match q.get("object") {
+        None => None,
+        Some(o) => Some(
+            o.parse::<usize>()
+                .map_err(|_| ApiError::at("object", format!("`object` is an object's index, got \"{o}\"")))?,
+        ),
+    };
+    let client = client_id(&headers, peer);
+    let bytes = read_body(body, SERVE_MAX_BODY, "SERVE_MAX_BODY").await?;
+    let value = parse_json(&bytes)?;
+    touch(&state, &client);
+    let c = client.clone();
+    run_job(&state, &client, move |st| {
+        let scene = scene_from_json(st, &c, &value)?;
+        let refuse = |e: phong_shader::Unsupported| ApiError::new(StatusCode::UNPROCESSABLE_ENTITY, e.to_string());
+        Ok(match version {
+            None => {
+                let page = phong_shader::html(&scene).map_err(refuse)?;
+                ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], page).into_response()
+            }
+            Some(v) => {
+                let p = match object {
+                    Some(i) => phong_shader::program_of(&scene, i, v),
+                    None => phong_shader::program(&scene, v),
+                }
+                .map_err(refuse)?;
+                axum::Json(serde_json::json!({
+                    "vertex": p.vertex,
+                    "fragment": p.fragment,
+                    "uniforms": p.uniforms,
+                }))
+                .into_response()
+            }
+        })
+    })
+    .await
 }
 
 /// `GET /api/lobe?shininess=S[&incidence=DEG][&squarings=N]`: the specular factor against the

@@ -802,3 +802,53 @@ async fn uploaded_textures_are_used() {
     let c = (16 * 32 + 16) * 3;
     assert_eq!(&px[c..c + 3], &[0, 255, 0]);
 }
+
+/// `POST /api/shader`: the scene's GLSL with its uniforms (the material's values), the page,
+/// one object's program of a scene shaded two ways; bad targets and objects are 400s naming
+/// the key, what a shader cannot express a 422 saying what.
+#[tokio::test]
+async fn shader_export_over_the_api() {
+    let st = state();
+    let r = call(&st, "POST", "/api/shader?target=glsl", "a", small_scene().to_string()).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", String::from_utf8_lossy(&r.body));
+    let j = r.json();
+    assert!(j["vertex"].as_str().is_some_and(|v| v.starts_with("#version 120")));
+    assert!(j["fragment"].as_str().is_some_and(|f| f.contains("gl_FragColor")));
+    // Ruby's shininess, from the built-in table (0.6 × 128 in OpenGL's units).
+    let s = j["uniforms"]["objects"][0]["uniforms"]["uShininess"].as_f64().unwrap();
+    assert!((s - 76.8).abs() < 1e-3, "{s}");
+    let page = call(&st, "POST", "/api/shader?target=html", "a", small_scene().to_string()).await;
+    assert_eq!(page.status, StatusCode::OK);
+    assert!(page.kind.starts_with("text/html"));
+    let mut two = small_scene();
+    two["object"] = json!([{"shape": "sphere"}, {"shape": "cube", "interpolation": "flat"}]);
+    let r = call(&st, "POST", "/api/shader?target=glsl300es", "a", two.to_string()).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.json()["error"].as_str().unwrap().contains("shaded differently"));
+    let r = call(
+        &st,
+        "POST",
+        "/api/shader?target=glsl300es&object=1",
+        "a",
+        two.to_string(),
+    )
+    .await;
+    assert_eq!(r.status, StatusCode::OK);
+    assert!(r.json()["vertex"].as_str().unwrap().contains("triangleCentroid"));
+    for (uri, path) in [
+        ("/api/shader?target=hlsl", "target"),
+        ("/api/shader?target=glsl&object=x", "object"),
+    ] {
+        let r = call(&st, "POST", uri, "a", small_scene().to_string()).await;
+        assert_eq!(refused(&r), (400, path.to_string(), String::new()), "{uri}");
+    }
+    let r = call(
+        &st,
+        "POST",
+        "/api/shader?target=glsl&object=7",
+        "a",
+        small_scene().to_string(),
+    )
+    .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+}

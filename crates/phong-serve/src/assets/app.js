@@ -189,6 +189,7 @@ function changed(preview) {
   } else if (S.view === 'terms') renderTerms();
   else if (S.view === 'compare') renderCompare();
   else if (S.view === 'lobe') renderLobe();
+  else if (S.view === 'shader') renderShader();
 }
 
 function requestFrame(preview, t0) {
@@ -746,7 +747,7 @@ function bindControls() {
     S.scene.light.pop();
     buildLights(); drawMarkers(); changed(false);
   });
-  for (const v of ['render', 'terms', 'compare', 'lobe', 'fit']) {
+  for (const v of ['render', 'terms', 'compare', 'lobe', 'fit', 'shader']) {
     on(`view-${v}`, 'click', () => setView(v));
   }
   on('fit-target', 'change', (e) => { S.fitTarget = e.target.files[0] || null; $('fit-result').textContent = S.fitTarget ? `target: ${S.fitTarget.name}` : ''; });
@@ -758,6 +759,17 @@ function bindControls() {
     setView('render');
   });
   on('compare-with', 'change', (e) => { S.compare = e.target.value; changed(false); });
+  on('shader-target', 'change', () => changed(false));
+  for (const k of ['vertex', 'fragment']) {
+    on(`copy-${k}`, 'click', async () => {
+      const text = $(`shader-${k}`).textContent;
+      try { await navigator.clipboard.writeText(text); } catch {
+        const r = document.createRange(); r.selectNodeContents($(`shader-${k}`));
+        const sel = getSelection(); sel.removeAllRanges(); sel.addRange(r); document.execCommand('copy');
+      }
+      $('status').textContent = `${k} shader copied`;
+    });
+  }
   on('compare-split', 'input', (e) => { S.split = Number(e.target.value); drawCompare(); saveUrl(); });
   on('compare-difference', 'change', (e) => { S.difference = e.target.checked; renderCompare(); saveUrl(); });
   on('download-toml', 'click', downloadToml);
@@ -862,11 +874,77 @@ function buildLights() {
 
 function setView(v) {
   S.view = v;
-  for (const k of ['render', 'terms', 'compare', 'lobe', 'fit']) {
+  for (const k of ['render', 'terms', 'compare', 'lobe', 'fit', 'shader']) {
     $(`${k}-view`).hidden = k !== v;
     $(`view-${k}`).setAttribute('aria-pressed', String(k === v));
   }
   changed(false);
+}
+
+// ---------- the shader view ----------
+// The images at the width they are shown at, in device pixels, at the frame's aspect.
+function shaderSize() {
+  const [fw, fh] = frameSize();
+  const w = Math.max(32, Math.round($('shader-phong').parentElement.clientWidth * devicePixelRatio));
+  return [w, Math.max(18, Math.round(w * fh / fw))];
+}
+
+// The pixels of an image source (img or canvas) as RGBA bytes at w x h.
+function pixelsOf(source, w, h) {
+  const c = document.createElement('canvas');
+  c.width = w; c.height = h;
+  const g = c.getContext('2d');
+  g.drawImage(source, 0, 0);
+  return g.getImageData(0, 0, w, h).data;
+}
+
+async function renderShader() {
+  const g = generation;
+  const [w, h] = shaderSize();
+  const s = sceneFor(false, (s) => { s.image.width = w; s.image.height = h; s.image.antialias = 1; });
+  $('shader-view').style.setProperty('--aspect', `${w} / ${h}`);
+  hooks.active++;
+  try {
+    const target = $('shader-target').value;
+    const code = await (await post(`/api/shader?target=${target}&object=${S.sel}`, s)).json();
+    if (g !== generation) return;
+    $('shader-vertex').textContent = code.vertex;
+    $('shader-fragment').textContent = code.fragment;
+    const page = await (await post('/api/shader?target=html', s)).text();
+    const png = await (await post('/api/render', s)).blob();
+    if (g !== generation) return;
+    const img = $('shader-phong');
+    img.src = URL.createObjectURL(png);
+    await img.decode();
+    const frame = $('shader-webgl');
+    await new Promise((done) => { frame.onload = done; frame.srcdoc = page; });
+    const win = frame.contentWindow;
+    if (win.phongError) throw { error: `WebGL2: ${win.phongError}` };
+    const ours = pixelsOf(img, w, h);
+    const theirs = pixelsOf(win.document.getElementById('phong'), w, h);
+    const diff = $('shader-diff');
+    diff.width = w; diff.height = h;
+    const out = new ImageData(w, h);
+    let off = 0;
+    for (let i = 0; i < w * h; i++) {
+      let worst = 0;
+      for (let k = 0; k < 3; k++) {
+        const d = Math.abs(ours[4 * i + k] - theirs[4 * i + k]);
+        worst = Math.max(worst, d);
+        out.data[4 * i + k] = Math.min(255, d * 8);
+      }
+      out.data[4 * i + 3] = 255;
+      if (worst > 2) off++;
+    }
+    diff.getContext('2d').putImageData(out, 0, 0);
+    window.phong.shaderDifference = { width: w, height: h, off };
+    $('shader-summary').textContent = `${off} of ${w * h} pixels differ by more than 2/255 (triangle edges: each rasteriser's own rule)`;
+    clearErrors();
+  } catch (e) {
+    showError(e.error ? e : { error: String(e) });
+  } finally {
+    hooks.active--;
+  }
 }
 
 // ---------- the fit ----------
