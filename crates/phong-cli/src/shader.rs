@@ -3,7 +3,7 @@
 use crate::args::{RunArgs, ShadingArgs};
 use crate::{InputError, refuse_overwriting};
 use anyhow::{Result, bail};
-use phong_shader::{Version, html, program, program_of};
+use phong_shader::{Version, html, program, program_of, threejs};
 use std::path::PathBuf;
 
 /// What `phong shader` writes.
@@ -17,6 +17,9 @@ pub enum Target {
     Glsl300es,
     /// One standalone WebGL2 page drawing the scene with the shaders.
     Html,
+    /// A three.js module (`phong-material.js`: `phongMaterial(THREE, i)`) and an example page
+    /// (`index.html`), written into the folder `-o` names.
+    Threejs,
 }
 
 #[derive(clap::Args)]
@@ -26,8 +29,9 @@ pub struct ShaderArgs {
     /// What to write.
     #[arg(long, value_enum, default_value = "glsl")]
     pub target: Target,
-    /// Output: the page for `html`; for the GLSL targets a stem, written as STEM.vert,
-    /// STEM.frag and STEM.json (the uniforms' values). Default: standard output.
+    /// Output: the page for `html`; the folder for `threejs`; for the GLSL targets a stem,
+    /// written as STEM.vert, STEM.frag and STEM.json (the uniforms' values). Default:
+    /// standard output.
     #[arg(short = 'o', long = "out")]
     pub output: Option<PathBuf>,
     /// For the GLSL targets, the object whose shaders to write (its name or index) where the
@@ -44,6 +48,20 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
     let unsupported = |e: phong_shader::Unsupported| InputError(format!("{}: cannot export: {e}", job.input.display()));
     let files: Vec<(Option<PathBuf>, String)> = match a.target {
         Target::Html => vec![(a.output.clone(), html(&job.scene).map_err(unsupported)?)],
+        Target::Threejs => {
+            let Some(dir) = &a.output else {
+                bail!(InputError(
+                    "--target threejs writes a folder: name it with -o DIR".into()
+                ));
+            };
+            let (module, page) = threejs(&job.scene).map_err(unsupported)?;
+            std::fs::create_dir_all(dir)
+                .map_err(|e| InputError(format!("cannot create the folder {}: {e}", dir.display())))?;
+            vec![
+                (Some(dir.join("phong-material.js")), module),
+                (Some(dir.join("index.html")), page),
+            ]
+        }
         t => {
             let version = match t {
                 Target::Glsl => Version::Legacy120,

@@ -1342,3 +1342,165 @@ fn shader_view_runs_the_exported_glsl_beside_phong() {
         .await;
     });
 }
+
+/// three.js, vendored from the npm registry into the target folder (once), for the threejs
+/// target's example page; `None` (skipped) where npm is missing, a failure under
+/// PHONG_REQUIRE_BROWSER=1.
+fn vendored_three() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("three");
+    let build = dir.join("package/build");
+    if build.join("three.module.js").exists() {
+        return Some(build);
+    }
+    std::fs::create_dir_all(&dir).ok()?;
+    let packed = Command::new("npm")
+        .args(["pack", "three", "--silent"])
+        .current_dir(&dir)
+        .output();
+    let name = match packed {
+        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).trim().to_string(),
+        other => {
+            if std::env::var("PHONG_REQUIRE_BROWSER").is_ok_and(|v| v == "1") {
+                panic!("PHONG_REQUIRE_BROWSER=1 but `npm pack three` failed: {other:?}");
+            }
+            eprintln!("skipped: `npm pack three` failed (apt-get install npm)");
+            return None;
+        }
+    };
+    let ok = Command::new("tar")
+        .args(["xzf", &name])
+        .current_dir(&dir)
+        .status()
+        .is_ok_and(|s| s.success());
+    (ok && build.join("three.module.js").exists()).then_some(build)
+}
+
+/// `phong shader --target threejs`: the example page, with three.js from the npm registry
+/// beside it and served over HTTP as a user would, draws phong's pixels: at most 0.5% of them
+/// past 2/255, for each interpolation and light kind, both viewers.
+#[test]
+fn exported_threejs_material_draws_phongs_pixels() {
+    if !browser_available() {
+        return;
+    }
+    let Some(three) = vendored_three() else { return };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenes = [
+        (
+            "phong",
+            "[[light]]\ntype = \"point\"\nposition = [2.0, 2.0, 3.0]\nattenuation = [1.0, 0.05, 0.01]\n",
+            "fov = 45.0",
+        ),
+        (
+            "gouraud",
+            "[[light]]\ntype = \"spot\"\nposition = [0.0, 3.0, 3.0]\ndirection = [0.0, -1.0, -1.0]\ncutoff = 30.0\nexponent = 4.0\n",
+            "fov = 45.0",
+        ),
+        (
+            "flat",
+            "[[light]]\ntype = \"directional\"\ndirection = [-1.0, -1.0, -1.5]\n",
+            "projection = \"orthographic\"\nheight = 3.2",
+        ),
+    ];
+    let mut pages = Vec::new();
+    for (interp, light, camera) in scenes {
+        let text = format!(
+            "[image]\nwidth = 200\nheight = 150\nbackground = [0.05, 0.05, 0.07]\n\n\
+             [camera]\nposition = [0.5, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n{camera}\n\n\
+             [shading]\nmodel = \"phong\"\ninterpolation = \"{interp}\"\n\n{light}\n\
+             [[object]]\nshape = \"sphere\"\nmaterial = \"gold\"\nposition = [-0.6, 0.0, 0.0]\nscale = 0.8\n\n\
+             [[object]]\nshape = \"torus\"\nmaterial = \"jade\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n"
+        );
+        let scene = dir.path().join(format!("{interp}.toml"));
+        std::fs::write(&scene, text).unwrap();
+        let site = dir.path().join(interp);
+        let png = dir.path().join(format!("{interp}.png"));
+        for args in [
+            vec![
+                "shader",
+                scene.to_str().unwrap(),
+                "--target",
+                "threejs",
+                "-o",
+                site.to_str().unwrap(),
+            ],
+            vec![
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                png.to_str().unwrap(),
+                "--antialias",
+                "1",
+            ],
+        ] {
+            let o = Command::new(env!("CARGO_BIN_EXE_phong")).args(&args).output().unwrap();
+            assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        }
+        for f in ["three.module.js", "three.core.js"] {
+            if three.join(f).exists() {
+                std::fs::copy(three.join(f), site.join(f)).unwrap();
+            }
+        }
+        pages.push((interp, png));
+    }
+    let port = free_port();
+    let _server = Proc(
+        Command::new("python3")
+            .args(["-m", "http.server", &port.to_string(), "--bind", "127.0.0.1"])
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("python3 -m http.server"),
+    );
+    let t0 = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(t0.elapsed() < Duration::from_secs(20), "the HTTP server did not listen");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    run(async move {
+        let (client, _driver, _profile) = browser((400, 400)).await.expect("browser");
+        for (interp, png) in &pages {
+            client
+                .goto(&format!("http://127.0.0.1:{port}/{interp}/"))
+                .await
+                .expect("page");
+            let t0 = Instant::now();
+            let url = loop {
+                let v = client
+                    .execute(
+                        "if (window.phongError) return 'error: ' + window.phongError; \
+                         return window.phongDone ? document.getElementById('phong').toDataURL('image/png') : null;",
+                        vec![],
+                    )
+                    .await
+                    .expect("script");
+                if let Some(s) = v.as_str() {
+                    break s.to_string();
+                }
+                assert!(
+                    t0.elapsed() < Duration::from_secs(30),
+                    "{interp}: the page did not draw"
+                );
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            };
+            assert!(url.starts_with("data:image/png;base64,"), "{interp}: {url}");
+            let bytes = base64::engine::general_purpose::STANDARD
+                .decode(&url["data:image/png;base64,".len()..])
+                .unwrap();
+            let (w, h, web, wc) = decode(&bytes).unwrap();
+            let (pw, ph, ours, oc) = decode(&std::fs::read(png).unwrap()).unwrap();
+            assert_eq!((w, h), (pw, ph), "{interp}");
+            let off = (0..(w * h) as usize)
+                .filter(|&i| (0..3).any(|c| web[i * wc + c].abs_diff(ours[i * oc + c]) > 2))
+                .count();
+            eprintln!("three.js {interp}: {off} pixels past 2/255");
+            assert!(
+                off * 200 <= (w * h) as usize,
+                "three.js {interp}: {off} of {} pixels past 2/255",
+                w * h
+            );
+        }
+        client.close().await.expect("close");
+    });
+}

@@ -21,7 +21,9 @@ use serde_json::{Value, json};
 use std::fmt::Write;
 
 mod page;
+mod three;
 pub use page::html;
+pub use three::threejs;
 
 /// Why a scene cannot be exported exactly.
 #[derive(Debug, thiserror::Error)]
