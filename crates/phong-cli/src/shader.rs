@@ -17,6 +17,8 @@ pub enum Target {
     Glsl300es,
     /// One standalone WebGL2 page drawing the scene with the shaders.
     Html,
+    /// A BRDF Explorer analytic file (`.brdf`) of one object's material under its model.
+    Brdf,
     /// A three.js module (`phong-material.js`: `phongMaterial(THREE, i)`) and an example page
     /// (`index.html`), written into the folder `-o` names.
     Threejs,
@@ -34,8 +36,8 @@ pub struct ShaderArgs {
     /// standard output.
     #[arg(short = 'o', long = "out")]
     pub output: Option<PathBuf>,
-    /// For the GLSL targets, the object whose shaders to write (its name or index) where the
-    /// scene's objects are shaded differently.
+    /// The object whose shaders to write (its name or index): for the GLSL targets where the
+    /// scene's objects are shaded differently, and for `brdf` (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]
     pub object: Option<String>,
     #[command(flatten)]
@@ -48,6 +50,13 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
     let unsupported = |e: phong_shader::Unsupported| InputError(format!("{}: cannot export: {e}", job.input.display()));
     let files: Vec<(Option<PathBuf>, String)> = match a.target {
         Target::Html => vec![(a.output.clone(), html(&job.scene).map_err(unsupported)?)],
+        Target::Brdf => {
+            let index = object_index(&job.scene, a.object.as_deref().unwrap_or("0"))?;
+            vec![(
+                a.output.clone(),
+                phong_shader::brdf(&job.scene, index).map_err(unsupported)?,
+            )]
+        }
         Target::Threejs => {
             let Some(dir) = &a.output else {
                 bail!(InputError(
@@ -71,20 +80,7 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
             let p = match &a.object {
                 None => program(&job.scene, version),
                 Some(o) => {
-                    let objects = &job.scene.objects;
-                    let index = o
-                        .parse::<usize>()
-                        .ok()
-                        .filter(|&i| i < objects.len())
-                        .or_else(|| objects.iter().position(|x| x.name == *o))
-                        .ok_or_else(|| {
-                            let names: Vec<_> = objects.iter().map(|x| format!("`{}`", x.name)).collect();
-                            InputError(format!(
-                                "--object {o}: no such object (the scene's: {}, or an index below {})",
-                                names.join(", "),
-                                objects.len()
-                            ))
-                        })?;
+                    let index = object_index(&job.scene, o)?;
                     program_of(&job.scene, index, version)
                 }
             }
@@ -119,4 +115,22 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The index of the object `o` names (its index or its name).
+fn object_index(scene: &phong_core::Scene, o: &str) -> Result<usize> {
+    let objects = &scene.objects;
+    o.parse::<usize>()
+        .ok()
+        .filter(|&i| i < objects.len())
+        .or_else(|| objects.iter().position(|x| x.name == *o))
+        .ok_or_else(|| {
+            let names: Vec<_> = objects.iter().map(|x| format!("`{}`", x.name)).collect();
+            InputError(format!(
+                "--object {o}: no such object (the scene's: {}, or an index below {})",
+                names.join(", "),
+                objects.len()
+            ))
+            .into()
+        })
 }

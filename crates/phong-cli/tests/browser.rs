@@ -1504,3 +1504,180 @@ fn exported_threejs_material_draws_phongs_pixels() {
         client.close().await.expect("close");
     });
 }
+
+/// `phong shader --target brdf`: the `.brdf` file's shader, compiled in the browser's WebGL2
+/// with its parameters as BRDF Explorer declares them (uniforms of their names), evaluated on
+/// a 32×32 grid of light and view directions (given as the vertex attributes of one point a
+/// pixel, passed on as `flat` varyings, so that both sides evaluate the same vectors; the
+/// result's exact float bits read back through an integer target), equals phong-core's
+/// `shade` for the material: `(diffuse + specular) / (N·L)` under a white light, within 1e-4
+/// (relative above 1), for each model and normalisation.
+#[test]
+fn brdf_file_evaluates_to_shade_in_webgl() {
+    if !browser_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cases = [
+        ("phong", "none", "gold"),
+        ("blinn-phong", "none", "ruby"),
+        ("lambert", "none", "jade"),
+        ("phong-lyon", "none", "chrome"),
+        ("blinn-phong", "blinn-phong-exact", "pewter"),
+        ("phong", "phong", "emerald"),
+    ];
+    let mut files = Vec::new();
+    for (k, (model, norm, material)) in cases.iter().enumerate() {
+        let toml = dir.path().join(format!("b{k}.toml"));
+        std::fs::write(
+            &toml,
+            format!(
+                "[shading]\nmodel = \"{model}\"\nnormalization = \"{norm}\"\n[[light]]\ntype = \"directional\"\n\
+                 direction = [0, 0, -1]\n[[object]]\nshape = \"sphere\"\nmaterial = \"{material}\"\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join(format!("b{k}.brdf"));
+        let o = Command::new(env!("CARGO_BIN_EXE_phong"))
+            .args([
+                "shader",
+                toml.to_str().unwrap(),
+                "--target",
+                "brdf",
+                "-o",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let scene = phong_scene::load(&toml).expect("the scene").scene;
+        files.push((std::fs::read_to_string(&out).unwrap(), scene.objects[0].clone()));
+    }
+    const N: u32 = 32;
+    let directions = |x: u32, y: u32| {
+        let tl = (x as f32 + 0.5) / N as f32 * 1.4835298;
+        let tv = (y as f32 + 0.5) / N as f32 * 1.4835298;
+        let pv = ((x * 7 + y * 3) % N) as f32 / N as f32 * std::f32::consts::TAU;
+        (
+            Vec3::new(tl.sin(), 0.0, tl.cos()),
+            Vec3::new(tv.sin() * pv.cos(), tv.sin() * pv.sin(), tv.cos()),
+        )
+    };
+    let page = dir.path().join("brdf.html");
+    std::fs::write(&page, "<!doctype html><canvas id=c width=32 height=32></canvas>").unwrap();
+    run(async move {
+        let (client, _driver, _profile) = browser((400, 400)).await.expect("browser");
+        client.goto(&format!("file://{}", page.display())).await.expect("page");
+        for (text, object) in &files {
+            let block = |name: &str| {
+                let start = text.find(&format!("::begin {name}\n")).unwrap() + 8 + name.len();
+                text[start..text.find(&format!("::end {name}")).unwrap()].to_string()
+            };
+            // Parameters as BRDF Explorer declares them: `uniform` of the type, set to the
+            // default.
+            let mut decls = String::new();
+            let mut sets = String::new();
+            for l in block("parameters").lines().filter(|l| !l.trim().is_empty()) {
+                let w: Vec<&str> = l.split_whitespace().collect();
+                match w[0] {
+                    "color" => {
+                        decls += &format!("uniform vec3 {};\n", w[1]);
+                        sets += &format!(
+                            "gl.uniform3f(gl.getUniformLocation(p, '{}'), {}, {}, {});",
+                            w[1], w[2], w[3], w[4]
+                        );
+                    }
+                    "float" => {
+                        decls += &format!("uniform float {};\n", w[1]);
+                        sets += &format!("gl.uniform1f(gl.getUniformLocation(p, '{}'), {});", w[1], w[4]);
+                    }
+                    other => panic!("parameter type {other}"),
+                }
+            }
+            let fragment = format!(
+                "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\n{decls}\
+                 flat in vec3 vL, vV;\nout uvec4 o;\n{}\n\
+                 void main() {{\n  vec3 L = vL, V = vV;\n\
+                 vec3 f = BRDF(L, V, vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0));\n\
+                 o = uvec4(floatBitsToUint(f.r), floatBitsToUint(f.g), floatBitsToUint(f.b), 0u);\n}}\n",
+                block("shader")
+            );
+            let script = format!(
+                "const gl = document.getElementById('c').getContext('webgl2');\n\
+                 const sh = (t, s) => {{ const x = gl.createShader(t); gl.shaderSource(x, s); gl.compileShader(x);\n\
+                   if (!gl.getShaderParameter(x, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(x)); return x; }};\n\
+                 const p = gl.createProgram();\n\
+                 gl.attachShader(p, sh(gl.VERTEX_SHADER, '#version 300 es\\nin vec3 aL, aV;\\nflat out vec3 vL, vV;\\nvoid main() {{ int x = gl_VertexID % 32, y = gl_VertexID / 32; vL = aL; vV = aV; gl_PointSize = 1.0; gl_Position = vec4((float(x) + 0.5) / 16.0 - 1.0, (float(y) + 0.5) / 16.0 - 1.0, 0.0, 1.0); }}'));\n\
+                 gl.attachShader(p, sh(gl.FRAGMENT_SHADER, arguments[0]));\n\
+                 gl.linkProgram(p); gl.useProgram(p); {sets}\n\
+                 [arguments[1], arguments[2]].forEach((d, k) => {{ const loc = gl.getAttribLocation(p, k ? 'aV' : 'aL');\n\
+                   gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer()); gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(d), gl.STATIC_DRAW);\n\
+                   gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0); }});\n\
+                 const rb = gl.createRenderbuffer(); gl.bindRenderbuffer(gl.RENDERBUFFER, rb);\n\
+                 gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA32UI, 32, 32);\n\
+                 const fb = gl.createFramebuffer(); gl.bindFramebuffer(gl.FRAMEBUFFER, fb);\n\
+                 gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);\n\
+                 gl.viewport(0, 0, 32, 32); gl.drawArrays(gl.POINTS, 0, 32 * 32);\n\
+                 const out = new Uint32Array(32 * 32 * 4); gl.readPixels(0, 0, 32, 32, gl.RGBA_INTEGER, gl.UNSIGNED_INT, out);\n\
+                 const err = gl.getError(); if (err !== 0) throw new Error('GL error ' + err); return Array.from(out);"
+            );
+            let (mut ls, mut vs) = (Vec::new(), Vec::new());
+            for y in 0..N {
+                for x in 0..N {
+                    let (l, v) = directions(x, y);
+                    ls.extend([l.x, l.y, l.z]);
+                    vs.extend([v.x, v.y, v.z]);
+                }
+            }
+            let got = client
+                .execute(&script, vec![json!(fragment), json!(ls), json!(vs)])
+                .await
+                .expect("the BRDF runs");
+            let bits: Vec<u32> = got
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_u64().unwrap() as u32)
+                .collect();
+            let light = |l: Vec3| {
+                let white = phong_core::Color::WHITE;
+                let c = phong_core::LightColor::new(phong_core::Color::BLACK, white, white).unwrap();
+                phong_core::Lighting::new(
+                    phong_core::Color::BLACK,
+                    vec![phong_core::Light::directional(-l, c).unwrap()],
+                )
+                .unwrap()
+            };
+            let mut worst = 0.0f32;
+            for y in 0..N {
+                for x in 0..N {
+                    let (l, v) = directions(x, y);
+                    let s = phong_core::shade(
+                        &phong_core::SurfacePoint {
+                            position: Vec3::ZERO,
+                            normal: Vec3::Z,
+                        },
+                        &phong_core::View::Infinite { to_viewer: v },
+                        &object.material,
+                        &light(l),
+                        &object.shading.options,
+                    );
+                    let want = (s.diffuse + s.specular) * (1.0 / l.z);
+                    let i = ((y * N + x) * 4) as usize;
+                    for (k, w) in want.to_array().into_iter().enumerate() {
+                        let g = f32::from_bits(bits[i + k]);
+                        let e = (g - w).abs() / w.abs().max(1.0);
+                        worst = worst.max(e);
+                        assert!(
+                            e <= 1e-4,
+                            "{}: L {l} V {v} channel {k}: BRDF {g}, shade {w}",
+                            object.name
+                        );
+                    }
+                }
+            }
+            eprintln!("brdf {:?}: worst {worst:e}", object.shading.options.specular);
+        }
+        client.close().await.expect("close");
+    });
+}

@@ -20,8 +20,10 @@ use phong_core::{
 use serde_json::{Value, json};
 use std::fmt::Write;
 
+mod brdf;
 mod page;
 mod three;
+pub use brdf::brdf;
 pub use page::html;
 pub use three::threejs;
 
@@ -248,6 +250,26 @@ fn equation(shading: &ShadingSettings) -> String {
     )
 }
 
+/// The GLSL that sets `float spec` from unit `L`, `N`, `V` and `uShininess`, for `o`'s model.
+fn specular_code(o: &phong_core::ShadingOptions) -> String {
+    match o.specular {
+        SpecularModel::None => "    float spec = 0.0;\n".to_string(),
+        SpecularModel::Phong => "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float spec = powPositive(dot(R, V), uShininess);\n".to_string(),
+        SpecularModel::BlinnPhong => "    vec3 LV = L + V;\n    float spec = dot(LV, LV) > 0.0 ? powPositive(dot(N, normalize(LV)), uShininess) : 0.0;\n".to_string(),
+        SpecularModel::Lyon { squarings, lambda } => {
+            let lam = match lambda {
+                LyonLambda::Dot => "1.0 - rv",
+                LyonLambda::Difference => "0.5 * dot(R - V, R - V)",
+            };
+            let k = squarings.min(16);
+            format!(
+                "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float rv = dot(R, V);\n    float spec = 0.0;\n    if (rv > 0.0) {{\n        float g = {g:.1};\n        spec = max(1.0 - (uShininess / g) * max({lam}, 0.0), 0.0);\n        for (int k = 0; k < {k}; k++) spec *= spec;\n    }}\n",
+                g = f64::from(1u32 << k)
+            )
+        }
+    }
+}
+
 /// The uniform declarations and the `light(P, N, out ambient, out diffuse, out specular)`
 /// function: every light's code, its kind compiled in.
 fn lighting_glsl(scene: &Scene, shading: &ShadingSettings) -> String {
@@ -267,22 +289,7 @@ fn lighting_glsl(scene: &Scene, shading: &ShadingSettings) -> String {
     }
     s += "\n// (x+)^s with 0^s = 0, x taken as at most 1 against rounding.\n\
           float powPositive(float x, float s) { return x > 0.0 ? pow(min(x, 1.0), s) : 0.0; }\n\n";
-    let spec = match o.specular {
-        SpecularModel::None => "    float spec = 0.0;\n".to_string(),
-        SpecularModel::Phong => "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float spec = powPositive(dot(R, V), uShininess);\n".to_string(),
-        SpecularModel::BlinnPhong => "    vec3 LV = L + V;\n    float spec = dot(LV, LV) > 0.0 ? powPositive(dot(N, normalize(LV)), uShininess) : 0.0;\n".to_string(),
-        SpecularModel::Lyon { squarings, lambda } => {
-            let lam = match lambda {
-                LyonLambda::Dot => "1.0 - rv",
-                LyonLambda::Difference => "0.5 * dot(R - V, R - V)",
-            };
-            let k = squarings.min(16);
-            format!(
-                "    vec3 R = 2.0 * dot(L, N) * N - L;\n    float rv = dot(R, V);\n    float spec = 0.0;\n    if (rv > 0.0) {{\n        float g = {g:.1};\n        spec = max(1.0 - (uShininess / g) * max({lam}, 0.0), 0.0);\n        for (int k = 0; k < {k}; k++) spec *= spec;\n    }}\n",
-                g = f64::from(1u32 << k)
-            )
-        }
-    };
+    let spec = specular_code(o);
     let _ = write!(
         s,
         "// One light's share: att*spot, the direction to it, and the three terms.\n\
