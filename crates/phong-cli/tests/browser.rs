@@ -1207,6 +1207,103 @@ fn exported_html_draws_phongs_pixels() {
         std::fs::write(&path, text).unwrap();
         scenes.push(path);
     }
+    // Random scenes over every model, interpolation, light kind and option (a fixed seed: the
+    // same scenes every run), objects with their own overrides.
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move |n: u64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed % n
+    };
+    let pick = |k: u64, xs: &[&'static str]| xs[k as usize % xs.len()];
+    for r in 0..12 {
+        let model = pick(next(5), &["phong", "blinn-phong", "lambert", "phong-lyon", "opengl"]);
+        // OpenGL's model has no normalisation, always gates and clamps (the scene reader
+        // refuses the others).
+        let normalization = match model {
+            "opengl" => "none",
+            _ => pick(next(4), &["none", "phong", "blinn-phong", "blinn-phong-exact"]),
+        };
+        let mut t = format!(
+            "[image]\nwidth = 160\nheight = 120\nbackground = [0.1, 0.05, 0.02]\nencoding = \"{}\"\n\n{}\n\
+             [shading]\nmodel = \"{}\"\ninterpolation = \"{}\"\nnormalization = \"{}\"\nviewer = \"{}\"\n\
+             two_sided = {}\ngate_specular = {}\nclamp = {}\noutput = \"{}\"\nlyon_squarings = {}\nlyon_lambda = \"{}\"\n\
+             ambient = [{}, 0.1, 0.2]\n\n",
+            pick(next(2), &["linear", "srgb"]),
+            cameras[next(2) as usize],
+            model,
+            pick(next(3), &["phong", "gouraud", "flat"]),
+            normalization,
+            pick(next(2), &["local", "infinite"]),
+            next(2) == 0,
+            model == "opengl" || next(3) != 0,
+            model == "opengl" || next(3) != 0,
+            pick(next(6), &["color", "color", "color", "ambient", "diffuse", "specular"]),
+            1 + next(4),
+            pick(next(2), &["dot", "difference"]),
+            next(4) as f32 / 10.0,
+        );
+        for _ in 0..1 + next(4) {
+            let c = |k: u64| format!("[{:.2}, {:.2}, {:.2}]", k as f32 / 10.0, (10 - k) as f32 / 10.0, 0.8);
+            t += &match next(3) {
+                0 => format!(
+                    "[[light]]\ntype = \"directional\"\ndirection = [{}, -1.0, -1.0]\ncolor = {}\n",
+                    next(5) as f32 - 2.0,
+                    c(next(10))
+                ),
+                1 => format!(
+                    "[[light]]\ntype = \"point\"\nposition = [{}, 2.0, 3.0]\nattenuation = [1.0, {}, {}]\nambient = {}\ndiffuse = {}\nspecular = {}\n",
+                    next(5) as f32 - 2.0,
+                    next(3) as f32 / 10.0,
+                    next(3) as f32 / 20.0,
+                    c(next(3)),
+                    c(next(10)),
+                    c(next(10))
+                ),
+                _ => format!(
+                    "[[light]]\ntype = \"spot\"\nposition = [0.0, 3.0, 3.0]\ndirection = [{}, -1.0, -1.0]\ncutoff = {}\nexponent = {}\n",
+                    next(3) as f32 * 0.2 - 0.2,
+                    pick(next(4), &["15.0", "30.0", "60.0", "90.0"]),
+                    next(20)
+                ),
+            };
+        }
+        for k in 0..1 + next(3) {
+            let shape = pick(next(5), &["sphere", "torus", "cube", "teapot", "cone"]);
+            let material = match next(3) {
+                0 => format!(
+                    "\"{}\"",
+                    pick(next(6), &["gold", "ruby", "jade", "chrome", "pearl", "obsidian"])
+                ),
+                _ => format!(
+                    "{{ ambient = [0.2, 0.1, 0.1], diffuse = [{:.2}, 0.5, 0.3], specular = [0.8, 0.8, {:.2}], emission = [0.0, {:.2}, 0.0], shininess = {} }}",
+                    next(10) as f32 / 10.0,
+                    next(10) as f32 / 10.0,
+                    next(3) as f32 / 20.0,
+                    pick(next(5), &["0.0", "1.0", "10.0", "64.0", "200.0"])
+                ),
+            };
+            let own = match next(4) {
+                0 => format!(
+                    "model = \"{}\"\n",
+                    pick(next(5), &["phong", "blinn-phong", "lambert", "phong-lyon", "opengl"])
+                ),
+                1 => format!("interpolation = \"{}\"\n", pick(next(3), &["phong", "gouraud", "flat"])),
+                _ => String::new(),
+            };
+            t += &format!(
+                "[[object]]\nshape = \"{shape}\"\nmaterial = {material}\nposition = [{}, {}, 0.0]\nrotation = [{}, {}, 0.0]\nscale = 0.6\n{own}\n",
+                k as f32 * 1.1 - 1.1,
+                next(3) as f32 * 0.3 - 0.3,
+                next(90),
+                next(90)
+            );
+        }
+        let path = dir.path().join(format!("random{r}.toml"));
+        std::fs::write(&path, t).unwrap();
+        scenes.push(path);
+    }
     // Every example scene the export can draw (all but the textured one): objects shaded
     // differently each drawn with its own program, flat objects, labels.
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
