@@ -17,6 +17,8 @@ pub enum Target {
     Glsl300es,
     /// One standalone WebGL2 page drawing the scene with the shaders.
     Html,
+    /// One WGSL module (`vs_main`, `fs_main`) for WebGPU, with its uniforms as JSON.
+    Wgsl,
     /// A BRDF Explorer analytic file (`.brdf`) of one object's material under its model.
     Brdf,
     /// A three.js module (`phong-material.js`: `phongMaterial(THREE, i)`) and an example page
@@ -50,6 +52,24 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
     let unsupported = |e: phong_shader::Unsupported| InputError(format!("{}: cannot export: {e}", job.input.display()));
     let files: Vec<(Option<PathBuf>, String)> = match a.target {
         Target::Html => vec![(a.output.clone(), html(&job.scene).map_err(unsupported)?)],
+        Target::Wgsl => {
+            let index = a.object.as_deref().map(|o| object_index(&job.scene, o)).transpose()?;
+            let module = phong_shader::wgsl(&job.scene, index).map_err(unsupported)?;
+            let values = match index {
+                Some(i) => program_of(&job.scene, i, Version::Es300),
+                None => program(&job.scene, Version::Es300),
+            }
+            .map_err(unsupported)?
+            .uniforms;
+            let json = serde_json::to_string_pretty(&values)? + "\n";
+            match &a.output {
+                None => vec![(None, module)],
+                Some(stem) => vec![
+                    (Some(stem.with_extension("wgsl")), module),
+                    (Some(stem.with_extension("json")), json),
+                ],
+            }
+        }
         Target::Brdf => {
             let index = object_index(&job.scene, a.object.as_deref().unwrap_or("0"))?;
             vec![(

@@ -23,9 +23,11 @@ use std::fmt::Write;
 mod brdf;
 mod page;
 mod three;
+mod wgsl;
 pub use brdf::brdf;
 pub use page::html;
 pub use three::threejs;
+pub use wgsl::buffers as wgsl_buffers;
 
 /// Why a scene cannot be exported exactly.
 #[derive(Debug, thiserror::Error)]
@@ -162,6 +164,23 @@ pub fn program_of(scene: &Scene, index: usize, version: Version) -> Result<Progr
         .ok_or_else(|| Unsupported(format!("the scene has no object {index}")))?;
     check_object(o)?;
     Ok(program_for(scene, &o.shading, &[o], version))
+}
+
+/// The scene's model as one WGSL module (`vs_main`, `fs_main`; see the `wgsl` module's
+/// bindings): the scene's, whose objects must share one shading, or object `index`'s.
+pub fn wgsl(scene: &Scene, index: Option<usize>) -> Result<String, Unsupported> {
+    let shading = match index {
+        None => shared_shading(scene)?,
+        Some(i) => {
+            let o = scene
+                .objects
+                .get(i)
+                .ok_or_else(|| Unsupported(format!("the scene has no object {i}")))?;
+            check_object(o)?;
+            o.shading
+        }
+    };
+    Ok(wgsl::module(scene, &shading))
 }
 
 /// The program of `shading` for `objects` (which are shaded so).
