@@ -1304,6 +1304,55 @@ fn exported_html_draws_phongs_pixels() {
         std::fs::write(&path, t).unwrap();
         scenes.push(path);
     }
+    // Textured: a checker (magnified, bilinear, repeated) as diffuse and specular maps, and
+    // waves (minified, trilinear mipmaps) on a torus; each interpolation.
+    let image = |name: &str, size: u32, f: &dyn Fn(u32, u32) -> [u8; 4]| {
+        let mut bytes = Vec::new();
+        {
+            let mut e = png::Encoder::new(&mut bytes, size, size);
+            e.set_color(png::ColorType::Rgba);
+            e.set_depth(png::BitDepth::Eight);
+            let mut w = e.write_header().unwrap();
+            let data: Vec<u8> = (0..size * size).flat_map(|i| f(i % size, i / size)).collect();
+            w.write_image_data(&data).unwrap();
+        }
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    };
+    image("checker.png", 8, &|x, y| {
+        if (x + y) % 2 == 0 {
+            [230, 200, 40, 255]
+        } else {
+            [30, 60, 200, 255]
+        }
+    });
+    // Waves of a few periods across the image: a picture's content, not noise at the texel
+    // frequency (whose minified texels would differ by each implementation's level of detail).
+    image("waves.png", 64, &|x, y| {
+        let (u, v) = (
+            x as f32 / 64.0 * std::f32::consts::TAU,
+            y as f32 / 64.0 * std::f32::consts::TAU,
+        );
+        let c = |t: f32| (127.5 + 127.5 * t.sin()) as u8;
+        [c(3.0 * u), c(2.0 * v + 1.0), c(u + v), 255]
+    });
+    for (k, interp) in ["phong", "gouraud", "flat"].into_iter().enumerate() {
+        let text = format!(
+            "[image]\nwidth = 160\nheight = 120\nbackground = [0.05, 0.05, 0.07]\nencoding = \"{}\"\n\n{}\n\
+             [shading]\nmodel = \"phong\"\ninterpolation = \"{interp}\"\n\n{}\n\
+             [[object]]\nshape = \"plane\"\nposition = [0.0, -1.0, 0.0]\nscale = 3.0\n\
+             material = {{ diffuse = [1, 1, 1], specular = [0.5, 0.5, 0.5], shininess = 20.0, diffuse_map = \"checker.png\", filter = \"bilinear\", uv_scale = [2.0, 2.0] }}\n\n\
+             [[object]]\nshape = \"sphere\"\nposition = [-0.6, 0.0, 0.0]\nscale = 0.8\n\
+             material = {{ diffuse = [1, 1, 1], specular = [1, 1, 1], shininess = 30.0, diffuse_map = \"checker.png\", specular_map = \"checker.png\", filter = \"bilinear\" }}\n\n\
+             [[object]]\nshape = \"torus\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n\
+             material = {{ diffuse = [1, 1, 1], diffuse_map = \"waves.png\", uv_scale = [4.0, 1.0] }}\n",
+            if k == 1 { "srgb" } else { "linear" },
+            cameras[k % 2],
+            lights[k % lights.len()],
+        );
+        let path = dir.path().join(format!("textured-{interp}.toml"));
+        std::fs::write(&path, text).unwrap();
+        scenes.push(path);
+    }
     // Every example scene the export can draw (all but the textured one): objects shaded
     // differently each drawn with its own program, flat objects, labels.
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");

@@ -686,7 +686,11 @@ fn shader_exports_glsl_and_refuses_what_it_cannot_express() {
         "{text}"
     );
     for (scene, target, says) in [
-        ("examples/scenes/textures.toml", "html", "texture maps"),
+        (
+            "examples/scenes/textures.toml",
+            "html",
+            "has normal or bump maps: the shader export draws diffuse and specular maps only",
+        ),
         ("examples/scenes/gouraud_vs_phong.toml", "glsl", "shaded differently"),
         (
             "examples/scenes/gouraud_vs_phong.toml",

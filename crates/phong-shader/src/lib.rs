@@ -22,6 +22,7 @@ use std::fmt::Write;
 
 mod brdf;
 mod page;
+mod texture;
 mod three;
 mod wgsl;
 pub use brdf::brdf;
@@ -56,11 +57,60 @@ pub struct Program {
     pub uniforms: Value,
 }
 
-/// Why object `o` cannot be drawn by an exported shader, if it cannot.
-fn check_object(o: &Object) -> Result<(), Unsupported> {
-    if !o.maps.is_empty() {
+/// The maps an object's shaders sample: its diffuse and specular maps (OpenGL's
+/// `GL_MODULATE` with a separate specular colour, as phong applies them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Sampled {
+    pub diffuse: bool,
+    pub specular: bool,
+}
+
+impl Sampled {
+    pub(crate) fn of(o: &Object) -> Sampled {
+        Sampled {
+            diffuse: o.maps.diffuse.is_some(),
+            specular: o.maps.specular.is_some(),
+        }
+    }
+
+    fn any(self) -> bool {
+        self.diffuse || self.specular
+    }
+}
+
+/// Why object `o` cannot be drawn by an exported shader, if it cannot; `maps`: whether the
+/// target draws diffuse and specular maps.
+fn check_object(o: &Object, maps: bool) -> Result<(), Unsupported> {
+    let m = &o.maps;
+    let others = [
+        (m.ambient.is_some(), "ambient (map_Ka)"),
+        (m.emission.is_some(), "emission (map_Ke)"),
+        (m.shininess.is_some(), "shininess (map_Ns)"),
+        (
+            m.alpha.is_some() || m.alpha_cutoff.is_some(),
+            "alpha (map_d, the alpha test)",
+        ),
+        (m.normal.is_some(), "normal or bump"),
+        (m.metal_rough.is_some(), "metallic-roughness"),
+        (m.occlusion.is_some(), "occlusion"),
+    ];
+    let unsupported: Vec<&str> = others.iter().filter(|(has, _)| *has).map(|(_, what)| *what).collect();
+    if !unsupported.is_empty() {
         return Err(Unsupported(format!(
-            "object `{}` has texture maps: the shader export draws untextured materials only",
+            "object `{}` has {} maps: the shader export draws diffuse and specular maps only",
+            o.name,
+            unsupported.join(", ")
+        )));
+    }
+    if Sampled::of(o).any() && !maps {
+        return Err(Unsupported(format!(
+            "object `{}` has texture maps: this target draws untextured materials (the glsl and html targets draw diffuse and specular maps)",
+            o.name
+        )));
+    }
+    if [&m.diffuse, &m.specular].into_iter().flatten().any(|t| t.set != 0) {
+        return Err(Unsupported(format!(
+            "object `{}`: a map on the second texture coordinates (TEXCOORD_1): the shader export reads the first",
             o.name
         )));
     }
@@ -80,16 +130,16 @@ fn check_object(o: &Object) -> Result<(), Unsupported> {
 }
 
 /// The shading every object of `scene` shares, or why there is none.
-fn shared_shading(scene: &Scene) -> Result<ShadingSettings, Unsupported> {
+fn shared_shading(scene: &Scene, maps: bool) -> Result<ShadingSettings, Unsupported> {
     let first = scene
         .objects
         .first()
         .ok_or_else(|| Unsupported("the scene has no objects".into()))?;
     for o in &scene.objects {
-        check_object(o)?;
-        if o.shading != first.shading {
+        check_object(o, maps)?;
+        if o.shading != first.shading || Sampled::of(o) != Sampled::of(first) {
             return Err(Unsupported(format!(
-                "objects `{}` and `{}` are shaded differently (model, interpolation, viewer or output): \
+                "objects `{}` and `{}` are shaded differently (model, interpolation, viewer, output or maps): \
                  a program has one; choose one with --object (the html target draws each with its own)",
                 first.name, o.name
             )));
@@ -147,7 +197,7 @@ fn material_uniforms(o: &Object) -> Value {
 /// The exact shaders for `scene` in `version` (its objects all shaded alike), or why it
 /// cannot be exported.
 pub fn program(scene: &Scene, version: Version) -> Result<Program, Unsupported> {
-    let shading = shared_shading(scene)?;
+    let shading = shared_shading(scene, true)?;
     Ok(program_for(
         scene,
         &shading,
@@ -162,7 +212,7 @@ pub fn program_of(scene: &Scene, index: usize, version: Version) -> Result<Progr
         .objects
         .get(index)
         .ok_or_else(|| Unsupported(format!("the scene has no object {index}")))?;
-    check_object(o)?;
+    check_object(o, true)?;
     Ok(program_for(scene, &o.shading, &[o], version))
 }
 
@@ -170,13 +220,13 @@ pub fn program_of(scene: &Scene, index: usize, version: Version) -> Result<Progr
 /// bindings): the scene's, whose objects must share one shading, or object `index`'s.
 pub fn wgsl(scene: &Scene, index: Option<usize>) -> Result<String, Unsupported> {
     let shading = match index {
-        None => shared_shading(scene)?,
+        None => shared_shading(scene, false)?,
         Some(i) => {
             let o = scene
                 .objects
                 .get(i)
                 .ok_or_else(|| Unsupported(format!("the scene has no object {i}")))?;
-            check_object(o)?;
+            check_object(o, false)?;
             o.shading
         }
     };
@@ -185,15 +235,22 @@ pub fn wgsl(scene: &Scene, index: Option<usize>) -> Result<String, Unsupported> 
 
 /// The program of `shading` for `objects` (which are shaded so).
 fn program_for(scene: &Scene, shading: &ShadingSettings, objects: &[&Object], version: Version) -> Program {
+    let sampled = objects.first().map_or(Sampled::default(), |o| Sampled::of(o));
     let lighting = lighting_glsl(scene, shading);
-    let (vertex, fragment) = match shading.interpolation {
-        Interpolation::Gouraud => gouraud(&lighting, shading, false),
-        Interpolation::Flat => gouraud(&lighting, shading, true),
-        Interpolation::Phong => per_fragment(&lighting, shading),
+    let (vertex, fragment) = match (shading.interpolation, sampled.any()) {
+        (Interpolation::Gouraud, false) => gouraud(&lighting, shading, false),
+        (Interpolation::Flat, false) => gouraud(&lighting, shading, true),
+        (Interpolation::Phong, false) => per_fragment(&lighting, shading),
+        (Interpolation::Phong, true) => texture::per_fragment(&lighting, shading, sampled),
+        (_, true) => texture::per_vertex(&lighting, shading, sampled),
     };
     let uniforms = json!({
         "scene": scene_uniforms(scene),
-        "objects": objects.iter().map(|o| json!({"name": o.name, "uniforms": material_uniforms(o)})).collect::<Vec<_>>(),
+        "objects": objects.iter().map(|o| {
+            let mut u = material_uniforms(o);
+            texture::uv_uniforms(o, &mut u);
+            json!({"name": o.name, "uniforms": u, "maps": texture::describe(o)})
+        }).collect::<Vec<_>>(),
     });
     Program {
         vertex: dialect(&vertex, version, true),
@@ -210,7 +267,10 @@ fn dialect(src: &str, version: Version, vertex: bool) -> String {
         Version::Legacy120 => {
             let mut out = String::from("#version 120\n");
             for line in src.lines() {
-                let line = line.replace("flat out ", "out ").replace("flat in ", "in ");
+                let line = line
+                    .replace("flat out ", "out ")
+                    .replace("flat in ", "in ")
+                    .replace("texture(", "texture2D(");
                 let line = line.as_str();
                 let l = if vertex {
                     line.replacen("in ", "attribute ", usize::from(line.starts_with("in ")))
@@ -499,21 +559,24 @@ pub(crate) fn mesh_data(o: &Object, program: usize) -> Value {
     let f = |v: &[Vec3]| b64(v.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect());
     let m = &o.mesh;
     let flat = o.shading.interpolation == Interpolation::Flat;
+    let mut uvs: Vec<glam::Vec2> = Vec::new();
     let (positions, normals, centroids, indices): (Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<u32>) = if flat {
         let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for t in 0..m.triangles().len() {
+        for (t, tri) in m.triangles().iter().enumerate() {
             let [a, b, c] = m.corners(t);
             let n = phong_core::mesh::facet_normal(a, b, c);
             let centroid = (a + b + c) / 3.0;
-            for p in [a, b, c] {
+            for (p, &v) in [a, b, c].into_iter().zip(tri) {
                 out.3.push(out.0.len() as u32);
                 out.0.push(p);
                 out.1.push(n);
                 out.2.push(centroid);
+                uvs.extend(m.uvs().get(v as usize));
             }
         }
         out
     } else {
+        uvs = m.uvs().to_vec();
         (
             m.positions().to_vec(),
             m.normals().to_vec(),
@@ -526,6 +589,7 @@ pub(crate) fn mesh_data(o: &Object, program: usize) -> Value {
         "positions": f(&positions),
         "normals": f(&normals),
         "centroids": f(&centroids),
+        "uvs": b64(uvs.iter().flat_map(|t| t.to_array()).flat_map(f32::to_le_bytes).collect()),
         "indices": b64(indices.iter().flat_map(|i| i.to_le_bytes()).collect()),
         "count": indices.len(),
         "cull": !o.shading.options.two_sided,

@@ -13,20 +13,24 @@ pub fn html(scene: &Scene) -> Result<String, Unsupported> {
         return Err(Unsupported("the scene has no objects".into()));
     }
     // One program per distinct shading, in the objects' order; each object's index in it.
-    let mut shadings: Vec<phong_core::ShadingSettings> = Vec::new();
+    let mut shadings: Vec<(phong_core::ShadingSettings, crate::Sampled)> = Vec::new();
     let mut meshes = Vec::new();
     let mut materials = Vec::new();
     for (i, o) in scene.objects.iter().enumerate() {
-        let k = match shadings.iter().position(|s| *s == o.shading) {
+        let key = (o.shading, crate::Sampled::of(o));
+        let k = match shadings.iter().position(|s| *s == key) {
             Some(k) => k,
             None => {
-                shadings.push(o.shading);
+                shadings.push(key);
                 shadings.len() - 1
             }
         };
         let p = program_of(scene, i, Version::Es300)?;
         materials.push(p.uniforms["objects"][0]["uniforms"].clone());
-        meshes.push(mesh_data(o, k));
+        let mut mesh = mesh_data(o, k);
+        let page = |m: &Option<phong_core::TextureMap>| m.as_ref().map(crate::texture::page_data).transpose();
+        mesh["textures"] = json!({"diffuse": page(&o.maps.diffuse)?, "specular": page(&o.maps.specular)?});
+        meshes.push(mesh);
     }
     let programs: Vec<_> = shadings
         .iter()
@@ -34,7 +38,7 @@ pub fn html(scene: &Scene) -> Result<String, Unsupported> {
             let first = scene
                 .objects
                 .iter()
-                .position(|o| o.shading == *s)
+                .position(|o| (o.shading, crate::Sampled::of(o)) == *s)
                 .expect("an object has it");
             let p = program_of(scene, first, Version::Es300).expect("checked above");
             json!({"vertex": p.vertex, "fragment": p.fragment})
@@ -106,6 +110,7 @@ function run() {{
     gl.bindAttribLocation(prog, 0, "position");
     gl.bindAttribLocation(prog, 1, "normal");
     gl.bindAttribLocation(prog, 2, "triangleCentroid");
+    gl.bindAttribLocation(prog, 3, "uv");
     gl.linkProgram(prog);
     if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
     return prog;
@@ -117,6 +122,7 @@ function run() {{
     const arr = Array.isArray(v) ? v.flat() : [v];
     if (arr.length === 0) return;
     if (name === "uClipFromWorld") gl.uniformMatrix4fv(at, false, arr);
+    else if (name.endsWith("Uv")) gl.uniformMatrix3fv(at, false, arr);
     else if (floats.includes(name)) gl.uniform1fv(at, arr);
     else gl.uniform3fv(at, arr);
   }};
@@ -132,13 +138,30 @@ function run() {{
     for (const [k, v] of Object.entries(scene.materials[i])) set(prog, k, v);
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
-    [m.positions, m.normals, m.centroids].forEach((b, loc) => {{
+    [m.positions, m.normals, m.centroids, m.uvs].forEach((b, loc) => {{
       if (b.length === 0) return;
       const buf = gl.createBuffer();
       gl.bindBuffer(gl.ARRAY_BUFFER, buf);
       gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(bytes(b)), gl.STATIC_DRAW);
       gl.enableVertexAttribArray(loc);
-      gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
+      gl.vertexAttribPointer(loc, loc === 3 ? 2 : 3, gl.FLOAT, false, 0, 0);
+    }});
+    // The maps: phong's own mipmap levels, with the map's wrap and filters.
+    [["uDiffuseMap", m.textures.diffuse], ["uSpecularMap", m.textures.specular]].forEach(([name, t], unit) => {{
+      if (!t) return;
+      gl.activeTexture(gl.TEXTURE0 + unit);
+      gl.bindTexture(gl.TEXTURE_2D, gl.createTexture());
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+      t.levels.forEach((l, level) => {{
+        if (t.half) gl.texImage2D(gl.TEXTURE_2D, level, gl.RGBA16F, l.width, l.height, 0, gl.RGBA, gl.HALF_FLOAT, new Uint16Array(bytes(l.data)));
+        else gl.texImage2D(gl.TEXTURE_2D, level, gl.RGBA8, l.width, l.height, 0, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(bytes(l.data)));
+      }});
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAX_LEVEL, t.levels.length - 1);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, t.wrapS);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, t.wrapT);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, t.mag);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, t.min);
+      gl.uniform1i(gl.getUniformLocation(prog, name), unit);
     }});
     const ib = gl.createBuffer();
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib);

@@ -75,6 +75,12 @@ pub fn threejs(scene: &Scene) -> Result<(String, String), Unsupported> {
     let mut objects = Vec::new();
     let mut meshes = Vec::new();
     for (i, o) in scene.objects.iter().enumerate() {
+        if crate::Sampled::of(o) != crate::Sampled::default() {
+            return Err(Unsupported(format!(
+                "object `{}` has texture maps: the threejs target draws untextured materials (the glsl and html targets draw diffuse and specular maps)",
+                o.name
+            )));
+        }
         let p = program_of(scene, i, Version::Es300)?;
         let k = match shadings.iter().position(|s| *s == o.shading) {
             Some(k) => k,
