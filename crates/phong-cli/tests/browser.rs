@@ -1417,7 +1417,8 @@ fn exported_html_draws_phongs_pixels() {
             let share = off as f64 / f64::from(w * hh);
             assert!(
                 share <= 0.005,
-                "{}: {:.2}% of pixels differ by more than 2/255 (worst {worst} at {at:?})",
+                "{}: {:.2}% of pixels differ by more than 2/255 (worst {worst} at {at:?}); edges differ by \
+                 each rasteriser's rule, more than that is the shaders'",
                 scene.display(),
                 share * 100.0
             );

@@ -56,6 +56,14 @@ pub fn html(scene: &Scene) -> Result<String, Unsupported> {
         "meshes": meshes,
         "labels": label_runs(scene),
     });
+    // WebGL2 draws one sample a pixel; phong's antialiasing samples its own pattern.
+    let samples = match scene.image.samples.count() {
+        1 => String::new(),
+        n => format!(
+            "<p>One sample a pixel: compare with <code>phong render SCENE --antialias 1</code> \
+             (the scene asks for {n}, in phong's own sample pattern, which WebGL2 cannot reproduce).</p>\n"
+        ),
+    };
     // `</` cannot close the script from inside a JSON string.
     let data = data.to_string().replace("</", "<\\/");
     Ok(format!(
@@ -72,7 +80,7 @@ pre {{ background: #111; padding: 1em; overflow: auto; max-height: 30em; }}
 </head>
 <body>
 <canvas id="phong"></canvas>
-<div id="shaders"></div>
+{samples}<div id="shaders"></div>
 <script>
 const scene = {data};
 function bytes(b64) {{
