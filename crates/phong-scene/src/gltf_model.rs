@@ -220,20 +220,9 @@ pub fn read_gltf(
                     .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
             }
             let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let packed_positions = prim
-                .get(&::gltf::Semantic::Positions)
-                .and_then(|a| packed(&a, &buffers))
-                .filter(|(_, t)| *t == ::gltf::accessor::DataType::F32);
-            let positions: Vec<[f32; 3]> = match packed_positions {
-                Some((bytes, _)) => bytes
-                    .chunks_exact(12)
-                    .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
-                    .collect(),
-                None => reader
-                    .read_positions()
-                    .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?
-                    .collect(),
-            };
+            let positions = packed_positions(&prim, &buffers)
+                .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
+                .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
             if let Some((i, p)) = positions
                 .iter()
                 .enumerate()
@@ -258,17 +247,10 @@ pub fn read_gltf(
                 }
                 None => Vec::new(),
             };
-            let indices: Vec<u32> = match (prim.indices().and_then(|a| packed(&a, &buffers)), reader.read_indices()) {
-                (Some((b, ::gltf::accessor::DataType::U32)), _) => b
-                    .chunks_exact(4)
-                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                    .collect(),
-                (Some((b, ::gltf::accessor::DataType::U16)), _) => b
-                    .chunks_exact(2)
-                    .map(|c| u32::from(u16::from_le_bytes([c[0], c[1]])))
-                    .collect(),
-                (_, Some(i)) => i.into_u32().collect(),
-                (_, None) => (0..n as u32).collect(),
+            let indices: Vec<u32> = match (packed_indices(&prim, &buffers), reader.read_indices()) {
+                (Some(i), _) => i,
+                (None, Some(i)) => i.into_u32().collect(),
+                (None, None) => (0..n as u32).collect(),
             };
             if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
                 return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
@@ -653,6 +635,35 @@ fn phong_material(m: &::gltf::Material) -> Material {
 
 /// Checks an accessor before the reader trusts it: its type, a float component type where
 /// `float`, at least one element, and every element inside its buffer view and buffer.
+/// A primitive's positions read as a slice, where they are packed 32-bit floats.
+fn packed_positions(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<[f32; 3]>> {
+    let (bytes, kind) = packed(&prim.get(&::gltf::Semantic::Positions)?, buffers)?;
+    (kind == ::gltf::accessor::DataType::F32).then(|| {
+        bytes
+            .chunks_exact(12)
+            .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
+            .collect()
+    })
+}
+
+/// A primitive's indices read as a slice, where they are packed 16- or 32-bit integers.
+fn packed_indices(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<u32>> {
+    let (b, kind) = packed(&prim.indices()?, buffers)?;
+    match kind {
+        ::gltf::accessor::DataType::U32 => Some(
+            b.chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect(),
+        ),
+        ::gltf::accessor::DataType::U16 => Some(
+            b.chunks_exact(2)
+                .map(|c| u32::from(u16::from_le_bytes([c[0], c[1]])))
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
 /// An accessor's elements as one run of bytes, and their component type, where they are
 /// tightly packed (no stride between them, nothing sparse) and lie inside their buffer: read
 /// as a slice rather than element by element.

@@ -551,39 +551,63 @@ fn gouraud(lighting: &str, shading: &ShadingSettings, flat: bool) -> (String, St
     (vertex, fragment)
 }
 
-/// A mesh's arrays as base64 of little-endian values (positions, normals and, for flat
-/// objects, centroids as f32 × 3; indices u32 × 3); a flat object's vertices unshared, each
-/// with its triangle's facet normal and centroid.
+/// The vertex arrays the shaders take for an object: `position`, `normal`, for flat objects
+/// `triangleCentroid` (every vertex unshared, with its triangle's facet normal and centroid),
+/// `uv` where the mesh has texture coordinates, and the triangles' indices.
+#[derive(Clone, Debug, Default)]
+pub struct VertexArrays {
+    /// World-space positions.
+    pub positions: Vec<Vec3>,
+    /// World-space normals (facet normals for flat objects).
+    pub normals: Vec<Vec3>,
+    /// Each vertex's triangle's centroid (flat objects only, else empty).
+    pub centroids: Vec<Vec3>,
+    /// Texture coordinates (empty where the mesh has none).
+    pub uvs: Vec<glam::Vec2>,
+    /// Three indices a triangle.
+    pub indices: Vec<u32>,
+}
+
+/// [`VertexArrays`] of object `o`.
+pub fn vertex_arrays(o: &Object) -> VertexArrays {
+    let m = &o.mesh;
+    if o.shading.interpolation != Interpolation::Flat {
+        return VertexArrays {
+            positions: m.positions().to_vec(),
+            normals: m.normals().to_vec(),
+            centroids: Vec::new(),
+            uvs: m.uvs().to_vec(),
+            indices: m.triangles().iter().flatten().copied().collect(),
+        };
+    }
+    let mut out = VertexArrays::default();
+    for (t, tri) in m.triangles().iter().enumerate() {
+        let [a, b, c] = m.corners(t);
+        let n = phong_core::mesh::facet_normal(a, b, c);
+        let centroid = (a + b + c) / 3.0;
+        for (p, &v) in [a, b, c].into_iter().zip(tri) {
+            out.indices.push(out.positions.len() as u32);
+            out.positions.push(p);
+            out.normals.push(n);
+            out.centroids.push(centroid);
+            out.uvs.extend(m.uvs().get(v as usize));
+        }
+    }
+    out
+}
+
+/// A mesh's arrays as base64 of little-endian values (positions, normals, centroids as
+/// f32 × 3, texture coordinates f32 × 2, indices u32), for the page.
 pub(crate) fn mesh_data(o: &Object, program: usize) -> Value {
     let b64 = |bytes: Vec<u8>| base64::engine::general_purpose::STANDARD.encode(bytes);
     let f = |v: &[Vec3]| b64(v.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect());
-    let m = &o.mesh;
-    let flat = o.shading.interpolation == Interpolation::Flat;
-    let mut uvs: Vec<glam::Vec2> = Vec::new();
-    let (positions, normals, centroids, indices): (Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<u32>) = if flat {
-        let mut out = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for (t, tri) in m.triangles().iter().enumerate() {
-            let [a, b, c] = m.corners(t);
-            let n = phong_core::mesh::facet_normal(a, b, c);
-            let centroid = (a + b + c) / 3.0;
-            for (p, &v) in [a, b, c].into_iter().zip(tri) {
-                out.3.push(out.0.len() as u32);
-                out.0.push(p);
-                out.1.push(n);
-                out.2.push(centroid);
-                uvs.extend(m.uvs().get(v as usize));
-            }
-        }
-        out
-    } else {
-        uvs = m.uvs().to_vec();
-        (
-            m.positions().to_vec(),
-            m.normals().to_vec(),
-            Vec::new(),
-            m.triangles().iter().flatten().copied().collect(),
-        )
-    };
+    let VertexArrays {
+        positions,
+        normals,
+        centroids,
+        uvs,
+        indices,
+    } = vertex_arrays(o);
     json!({
         "program": program,
         "positions": f(&positions),

@@ -111,24 +111,10 @@ fn input(scene: &Scene, version: Version) -> String {
     for (i, o) in scene.objects.iter().enumerate() {
         uniforms(&mut s, &p.uniforms["objects"][i]["uniforms"]);
         let flat = o.shading.interpolation == Interpolation::Flat;
-        let m = &o.mesh;
-        let (mut pos, mut nor, mut cen, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        if flat {
-            for t in 0..m.triangles().len() {
-                let [a, b, c] = m.corners(t);
-                let n = phong_core::mesh::facet_normal(a, b, c);
-                for q in [a, b, c] {
-                    idx.push(pos.len() as u32);
-                    pos.push(q);
-                    nor.push(n);
-                    cen.push((a + b + c) / 3.0);
-                }
-            }
-        } else {
-            pos = m.positions().to_vec();
-            nor = m.normals().to_vec();
-            idx = m.triangles().iter().flatten().copied().collect();
-        }
+        let arrays = phong_shader::vertex_arrays(o);
+        let (pos, nor, idx) = (arrays.positions, arrays.normals, arrays.indices);
+        // Centroids for flat objects only (glsl.c reads them only there).
+        let cen = arrays.centroids;
         let _ = writeln!(
             s,
             "{} {} {} {}",

@@ -113,25 +113,13 @@ fn draw(device: &wgpu::Device, queue: &wgpu::Queue, scene: &Scene) -> Vec<u8> {
             source: wgpu::ShaderSource::Wgsl(src.into()),
         });
         let flat = o.shading.interpolation == Interpolation::Flat;
-        let m = &o.mesh;
-        let (mut pos, mut nor, mut cen, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        if flat {
-            for t in 0..m.triangles().len() {
-                let [a, b, c] = m.corners(t);
-                let n = phong_core::mesh::facet_normal(a, b, c);
-                for p in [a, b, c] {
-                    idx.push(pos.len() as u32);
-                    pos.push(p);
-                    nor.push(n);
-                    cen.push((a + b + c) / 3.0);
-                }
-            }
+        let arrays = phong_shader::vertex_arrays(o);
+        let (pos, nor, idx) = (arrays.positions, arrays.normals, arrays.indices);
+        let cen = if flat {
+            arrays.centroids
         } else {
-            pos = m.positions().to_vec();
-            nor = m.normals().to_vec();
-            cen = vec![glam::Vec3::ZERO; pos.len()];
-            idx = m.triangles().iter().flatten().copied().collect();
-        }
+            vec![glam::Vec3::ZERO; pos.len()]
+        };
         let buffer = |bytes: Vec<u8>, usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: None,
