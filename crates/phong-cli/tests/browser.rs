@@ -1828,3 +1828,80 @@ fn brdf_file_evaluates_to_shade_in_webgl() {
         client.close().await.expect("close");
     });
 }
+
+/// Every view draws its pictures at the width it shows them (device pixels), not at the
+/// hidden Render view's size, and again after the window changes; the Terms images add up to
+/// the total at that size.
+#[test]
+fn every_view_draws_at_the_size_it_shows() {
+    if !browser_available() {
+        return;
+    }
+    run(async {
+        let s = open("sizes", "", &[]).await.expect("the page opens");
+        s.step("one sample a pixel", async {
+            s.control("Antialias").await?.select_by_value("1").await?;
+            s.idle().await
+        })
+        .await;
+        // Each view's pictures: [drawn width, shown width in device pixels].
+        let measure = r#"
+            const dpr = window.devicePixelRatio || 1;
+            const shown = (e) => Math.round(e.clientWidth * dpr);
+            const ids = {
+              render: ['frame'], terms: ['term-ambient', 'term-diffuse', 'term-specular', 'term-total'],
+              compare: ['compare-canvas'], shader: ['shader-phong'] }[arguments[0]];
+            return ids.map((id) => {
+              const e = document.getElementById(id);
+              return [e.naturalWidth !== undefined ? e.naturalWidth : e.width, shown(e)];
+            });"#;
+        for (window, views) in [
+            ((1400, 1000), ["Render", "Terms", "Compare", "Shader"]),
+            ((900, 800), ["Terms", "Compare", "Render", "Shader"]),
+        ] {
+            s.client
+                .set_window_size(window.0, window.1)
+                .await
+                .expect("the window resizes");
+            for view in views {
+                s.step(&format!("{view} at {window:?}"), async {
+                    s.client
+                        .find(Locator::XPath(&format!("//button[normalize-space(.)='{view}']")))
+                        .await?
+                        .click()
+                        .await?;
+                    s.idle().await?;
+                    let sizes = s.client.execute(measure, vec![json!(view.to_lowercase())]).await?;
+                    for pair in sizes.as_array().context("sizes")? {
+                        let (drawn, shown) = (pair[0].as_i64().unwrap_or(0), pair[1].as_i64().unwrap_or(0));
+                        ensure!(shown > 100, "{view}: shown {shown} pixels wide");
+                        ensure!(
+                            (drawn - shown).abs() <= 2,
+                            "{view}: drawn {drawn} pixels wide, shown at {shown}"
+                        );
+                    }
+                    if view == "Terms" {
+                        let px = term_pixels(&s).await?;
+                        let (mut worst, mut checked) = (0i32, 0);
+                        for i in (0..px[0].len()).step_by(4) {
+                            for k in 0..3 {
+                                let (a, d, sp, t) = (px[0][i + k], px[1][i + k], px[2][i + k], px[3][i + k]);
+                                if t < 250 && a < 255 && d < 255 && sp < 255 {
+                                    worst =
+                                        worst.max((i32::from(a) + i32::from(d) + i32::from(sp) - i32::from(t)).abs());
+                                    checked += 1;
+                                }
+                            }
+                        }
+                        ensure!(
+                            checked > 10_000 && worst <= 2,
+                            "terms add up within {worst} over {checked} channels"
+                        );
+                    }
+                    Ok(())
+                })
+                .await;
+            }
+        }
+    });
+}

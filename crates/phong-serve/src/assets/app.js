@@ -94,11 +94,17 @@ const shininessFromSlider = (p) => (p <= 0 ? 0 : Math.round(Math.pow(1000, p / 1
 const sliderFromShininess = (s) => (s <= 0 ? 0 : Math.max(1, Math.round((1000 * Math.log(Math.max(1, s))) / Math.log(1000))));
 
 // ---------- image size ----------
-function frameSize() {
+// The size a picture is drawn at: the width `el` is shown at, in device pixels, at the
+// viewport's 16:9 (or the URL's `size`, which pins every view's).
+function shownSize(el) {
   if (S.size) return S.size;
-  const vp = $('viewport');
-  const w = Math.max(64, Math.min(3840, Math.round(vp.clientWidth)));
+  const w = Math.max(64, Math.min(3840, Math.round(el.clientWidth * (window.devicePixelRatio || 1))));
   return [w, Math.max(36, Math.round((w * 9) / 16))];
+}
+
+// The render view's frame: its viewport, or where that view is hidden, the stage it would fill.
+function frameSize() {
+  return shownSize($('viewport').clientWidth ? $('viewport') : $('stage'));
 }
 
 // Previews (while the user drags) have one sample, and half the size where the frame has
@@ -258,8 +264,8 @@ function blobBase64(blob) {
 
 async function renderTerms() {
   const g = generation;
-  const [w, h] = frameSize();
-  const half = [Math.max(32, Math.round(w / 2)), Math.max(18, Math.round(h / 2))];
+  // Each term at the width its figure is shown at.
+  const half = shownSize($('term-total').parentElement);
   const terms = { ambient: 'term-ambient', diffuse: 'term-diffuse', specular: 'term-specular', color: 'term-total' };
   hooks.active++;
   try {
@@ -311,8 +317,11 @@ let compareImages = null;
 async function renderCompare() {
   const g = generation;
   const [name, change] = variant(S.compare);
-  const a = sceneFor(false);
-  const b = sceneFor(false, change);
+  // At the width the comparison is shown at.
+  const [w, h] = shownSize($('compare-canvas'));
+  const sized = (s) => { s.image.width = w; s.image.height = h; };
+  const a = sceneFor(false, sized);
+  const b = sceneFor(false, (s) => { change(s); sized(s); });
   hooks.active++;
   try {
     const [ra, rb] = await Promise.all([post('/api/render', a), post('/api/render', b)]);
