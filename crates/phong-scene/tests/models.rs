@@ -1065,3 +1065,45 @@ fn gltf_second_texture_coordinate_set_is_read() {
     assert_eq!(maps.normal.as_ref().map(|n| n.map.set), Some(0));
     assert!(w.is_empty(), "{w:?}");
 }
+
+/// MTL files as exporters write them: a non-numeric `Ni` (not used) is a warning at the
+/// MTL's own file and line and the library is still read; `Tr 1` with no `d` in every material
+/// would make the model vanish, so it is read as the opacity, with a warning, while `Tr 1` in
+/// one material of two keeps its meaning (transparent); `Ns 0` (or no `Ns`) with `Ks` above 0
+/// is read as no highlight, with a warning naming the materials, and `Ns 10` is kept.
+#[test]
+fn mtl_values_exporters_write() {
+    let d = dir("mtl-exporters");
+    let obj = |mtl: &str| format!("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl {mtl}\nf 1 2 3\n");
+    let load = |mtl_text: &str, used: &str| {
+        write(&d, "m.mtl", mtl_text.as_bytes());
+        let p = write(&d, "m.obj", obj(used).as_bytes());
+        let mut w = Vec::new();
+        let parts = load_model(&p, &mut w).unwrap_or_else(|e| panic!("{mtl_text}: {e}"));
+        (parts[0].material.expect("a material"), w)
+    };
+    let (m, w) = load("newmtl a\nKd 0.5 0.25 0.125\nNi abc\n", "a");
+    assert_eq!(m.diffuse().to_array(), [0.5, 0.25, 0.125], "the library is read");
+    assert!(
+        w.iter()
+            .any(|w| w.contains("m.mtl:3:") && w.contains("\"abc\" is not a finite number")),
+        "{w:?}"
+    );
+    let (m, w) = load("newmtl a\nKd 1 0 0\nTr 1\nnewmtl b\nKd 0 1 0\nTr 1\n", "a");
+    assert_eq!(m.alpha(), 1.0);
+    assert!(w.iter().any(|w| w.contains("read as the opacity")), "{w:?}");
+    let (m, w) = load("newmtl a\nKd 1 0 0\nTr 1\nnewmtl b\nKd 0 1 0\nd 1\n", "a");
+    assert_eq!(m.alpha(), 0.0, "one material transparent by Tr: as the file says");
+    assert!(!w.iter().any(|w| w.contains("opacity")), "{w:?}");
+    let (m, w) = load("newmtl shiny\nKd 1 1 1\nKs 0.5 0.5 0.5\nNs 0\n", "shiny");
+    assert_eq!(m.specular().to_array(), [0.0; 3]);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("\"shiny\"") && w.contains("no specular highlight")),
+        "{w:?}"
+    );
+    let (m, w) = load("newmtl kept\nKd 1 1 1\nKs 0.5 0.5 0.5\nNs 10\n", "kept");
+    assert_eq!(m.specular().to_array(), [0.5; 3]);
+    assert_eq!(m.shininess(), 10.0);
+    assert!(!w.iter().any(|w| w.contains("highlight")), "{w:?}");
+}

@@ -22,7 +22,7 @@ mod text;
 use crate::Error;
 use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, prefetch, resolve};
 use glam::{DVec3, Vec2, Vec3};
-use mtl::{check_mtl, mtl_names, normalize_mtl, to_material};
+use mtl::{check_mtl, mtl_names, normalize_mtl, to_material, transparency};
 use phong_core::{Color, Maps, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -124,6 +124,38 @@ fn undefined_materials(path: &Path, used: &[String], defined: &[tobj::Material],
             path.display()
         ));
     }
+}
+
+/// The libraries' materials as phong's, with warnings for what is read otherwise than the
+/// file literally says: `Tr` as opacity where every material would vanish by it, `Ns 0` with
+/// `Ks` above 0 as no highlight.
+fn materials_of(path: &Path, mtl: &[tobj::Material], warnings: &mut Vec<String>) -> Vec<Material> {
+    // Every material made wholly invisible by `Tr` alone (`Tr 1`, no `d`): the exporter
+    // meant `Tr` as the opacity.
+    let vanish = !mtl.is_empty() && mtl.iter().all(|m| transparency(m) == Some(1.0));
+    if vanish {
+        warnings.push(format!(
+            "{}: `Tr 1` with no `d` would make every material of the model invisible (Tr is the \
+             transparency, 1 - d): read as the opacity, as some exporters write it (`d 1` says opaque)",
+            path.display()
+        ));
+    }
+    let (materials, dimmed): (Vec<Material>, Vec<bool>) = mtl.iter().map(|m| to_material(m, vanish)).unzip();
+    let names: Vec<String> = mtl
+        .iter()
+        .zip(&dimmed)
+        .filter(|(_, d)| **d)
+        .map(|(m, _)| format!("{:?}", m.name))
+        .collect();
+    if !names.is_empty() {
+        warnings.push(format!(
+            "{}: materials {}: `Ns 0` (or no `Ns`) with `Ks` above 0 would light every lit point fully: \
+             read as no specular highlight, as Blender reads it",
+            path.display(),
+            names.join(", ")
+        ));
+    }
+    materials
 }
 
 /// Loads an OBJ file and its MTL materials: one part per group and material.
@@ -289,7 +321,7 @@ pub fn load_obj_text(
     let (models, materials) = (prepared.models, prepared.materials);
     let tobj_materials: Vec<tobj::Material> = materials.unwrap_or_default();
     undefined_materials(path, &prepared.used, &tobj_materials, warnings);
-    let materials: Vec<Material> = tobj_materials.iter().map(to_material).collect();
+    let materials = materials_of(path, &tobj_materials, warnings);
     // Each material's maps, its images read once for the whole file.
     let requests = map_requests.into_inner();
     let mut cache = TextureCache::default();

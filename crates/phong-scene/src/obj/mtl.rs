@@ -64,6 +64,8 @@ pub(super) fn normalize_mtl(src: &str) -> String {
             [kw @ ("Ka" | "Kd" | "Ks" | "Ke"), v] => {
                 out.push_str(&format!("{kw} {v} {v} {v}\n"));
             }
+            // The optical density is not used; tobj would drop the whole library for a bad one.
+            ["Ni", ..] => out.push('\n'),
             _ => out.push_str(line),
         }
     }
@@ -139,10 +141,15 @@ pub(super) fn check_mtl(
                     return Err(c.err(start, line, 1, kw, format!("shininess must be >= 0, got {x}")));
                 }
             }
-            "d" => {
+            "d" | "Tr" => {
                 let x = num(0)?;
                 if !(0.0..=1.0).contains(&x) {
                     return Err(c.err(start, line, 1, kw, format!("must be in [0, 1], got {x}")));
+                }
+            }
+            "Ni" => {
+                if let Err(e) = num(0) {
+                    warnings.push(format!("{e}: the optical density is not used; ignored"));
                 }
             }
             "illum" => {
@@ -171,7 +178,18 @@ pub(super) fn check_mtl(
     Ok(())
 }
 
-pub(super) fn to_material(m: &tobj::Material) -> Material {
+/// The `Tr` of a material that has no `d`: its transparency, as tinyobjloader reads it.
+pub(super) fn transparency(m: &tobj::Material) -> Option<f32> {
+    if m.dissolve.is_some() {
+        return None;
+    }
+    m.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok())
+}
+
+/// An MTL material as phong's; `tr_is_opacity` reads `Tr` as the opacity (some exporters
+/// write it so). `Ns 0` (or no `Ns`) with `Ks` above 0 is read as no highlight, as Blender
+/// reads it (its `(x⁺)⁰` would light every lit point fully): the second value says so.
+pub(super) fn to_material(m: &tobj::Material, tr_is_opacity: bool) -> (Material, bool) {
     let def = Material::default();
     let c = |v: Option<[f32; 3]>, d: Color| v.map(Color::from_array).unwrap_or(d);
     let kd = c(m.diffuse, def.diffuse());
@@ -181,6 +199,8 @@ pub(super) fn to_material(m: &tobj::Material) -> Material {
         c(m.emissive, Color::BLACK),
     );
     let ns = m.shininess.unwrap_or(0.0);
+    let no_highlight = ns == 0.0 && ks.to_array().iter().any(|&x| x > 0.0);
+    let ks = if no_highlight { Color::BLACK } else { ks };
     let built = match m.illumination_model.unwrap_or(2) {
         0 => Material::new(Color::BLACK, Color::BLACK, Color::BLACK, kd, 0.0),
         1 => Material::new(ka, kd, Color::BLACK, ke, ns),
@@ -188,13 +208,11 @@ pub(super) fn to_material(m: &tobj::Material) -> Material {
     };
     // Values were checked line by line before tobj parsed them.
     let built = built.unwrap_or_default();
-    // `d` is the opacity; `Tr`, where there is no `d`, its complement (tinyobjloader's reading).
-    let tr = m
-        .unknown_param
-        .get("Tr")
-        .and_then(|t| t.trim().parse::<f32>().ok())
-        .map(|t| 1.0 - t);
-    built
+    // `d` is the opacity; `Tr`, where there is no `d`, its complement (tinyobjloader's
+    // reading), or the opacity itself where the model would otherwise vanish.
+    let tr = transparency(m).map(|t| if tr_is_opacity { t } else { 1.0 - t });
+    let material = built
         .with_alpha(m.dissolve.or(tr).unwrap_or(1.0).clamp(0.0, 1.0))
-        .unwrap_or(built)
+        .unwrap_or(built);
+    (material, no_highlight && m.illumination_model.unwrap_or(2) >= 2)
 }
