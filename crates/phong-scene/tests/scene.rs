@@ -143,7 +143,47 @@ color = [1, 0, 0]
 fn syntax_and_type_errors_have_line_column_and_key() {
     assert_err(
         "[image]\nwidth = 800\nheight = \"tall\"\n",
-        &["scene.toml:3:10", "`height`", "invalid type"],
+        &[
+            "scene.toml:3:10",
+            "`height`",
+            "must be an integer, got the text \"tall\"",
+        ],
+    );
+    // In the user's words, never serde's ("invalid type: ..., expected f32").
+    for (text, says) in [
+        (
+            "[image]\nbackground = \"red\"\n",
+            "`background`: must be a list ([...]), got the text \"red\"",
+        ),
+        ("[image]\nencoding = 3\n", "`encoding`: must be text in quotes, got 3"),
+        (
+            "[image]\nantialias = true\n",
+            "`antialias`: must be an integer, got true",
+        ),
+        (
+            "[shading]\ntwo_sided = 1\n",
+            "`two_sided`: must be true or false, got 1",
+        ),
+    ] {
+        assert_err(text, &[says]);
+        let e = parse_scene(text, std::path::Path::new("scene.toml"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(!e.contains("invalid type") && !e.contains("expected"), "{e}");
+    }
+    // Inside an inline table, the key inside it, at its column.
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nmaterial = { diffuse = [1, 0, 0], shininess = \"high\" }\n",
+        &[
+            "scene.toml:3:35",
+            "`shininess`",
+            "must be a number, got the text \"high\"",
+        ],
+    );
+    assert_err(
+        "[[object]]\nshape = \"sphere\"\nmaterial = { difuse = [1, 0, 0] }\n",
+        &["scene.toml:3:14", "`difuse`", "unknown field `difuse`"],
     );
     assert_err("[image\nwidth = 1\n", &["scene.toml:1:"]);
     assert_err("[image]\nwidht = 800\n", &["scene.toml:2:1", "unknown field `widht`"]);
@@ -466,6 +506,11 @@ fn untagged_forms_are_explained_in_the_users_words() {
     for (src, key, says) in [
         (
             "[[object]]\nshape = \"sphere\"\nmaterial = { diffuse = \"red\" }\n",
+            "`diffuse`",
+            "must be a list ([...]), got the text \"red\"",
+        ),
+        (
+            "[[object]]\nshape = \"sphere\"\nmaterial = 5\n",
             "`material`",
             "must be a material's name or a table of its keys",
         ),

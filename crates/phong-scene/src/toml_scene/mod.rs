@@ -60,10 +60,7 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
             .map(|(k, _)| k.trim().to_string())
             .filter(|k| !k.is_empty())
             .map(|k| unquote_key(&k));
-        let message = integer_message(e.message().trim())
-            .replace("expected i64", "expected an integer")
-            .replace("expected f32", "expected a number")
-            .replace("expected a sequence", "expected an array")
+        let message = user_words(e.message().trim())
             // serde's words for a value that is none of a key's forms, in the user's words.
             .replace(
                 "data did not match any variant of untagged enum MaterialRef",
@@ -82,6 +79,12 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
             .map(|(k, _)| k.trim())
             .filter(|k| message.starts_with("duplicate key") && !k.is_empty() && !k.contains([',', '{', '[']))
             .map(unquote_key);
+        // Inside an inline material table, the key inside it and what is wrong with it.
+        if e.message().contains("untagged enum MaterialRef")
+            && let Some((inner_offset, key, inner)) = inline_material_error(src, offset)
+        {
+            return Error::at(path, src, inner_offset, Some(&key), inner);
+        }
         Error::at(path, src, offset, at_key.or(line_key).as_deref(), message)
     })?;
     let mut ctx = Ctx {
@@ -105,18 +108,74 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
     })
 }
 
-/// toml's messages for integers past `i64` ("invalid type: integer `N` as i128", "invalid
-/// value: integer `N`"), in words; other messages as they are.
-fn integer_message(m: &str) -> String {
-    let number = m
+/// toml's and serde's messages in the user's words: "invalid type: string \"tall\", expected
+/// i64" becomes "must be an integer, got the text \"tall\""; an integer past `i64` says so.
+fn user_words(m: &str) -> String {
+    let big = m
         .strip_prefix("invalid type: integer `")
+        .filter(|r| r.contains("as i128"))
         .or_else(|| m.strip_prefix("invalid value: integer `"))
         .and_then(|r| r.split_once('`'))
-        .map(|(n, _)| n);
-    match number {
-        Some(n) => format!("{n} is too large: integers here are at most {}", i64::MAX),
-        None => m.to_string(),
+        .map(|(n, _)| n)
+        .filter(|n| n.parse::<i64>().is_err());
+    if let Some(n) = big {
+        return format!("{n} is too large: integers here are at most {}", i64::MAX);
     }
+    let Some((got, wanted)) = m
+        .strip_prefix("invalid type: ")
+        .and_then(|r| r.split_once(", expected "))
+    else {
+        return m.to_string();
+    };
+    let wanted = match wanted {
+        "i64" | "u32" | "u8" | "i32" | "an integer" => "an integer".to_string(),
+        "f32" | "f64" => "a number".into(),
+        "a sequence" => "a list ([...])".into(),
+        "a string" => "text in quotes".into(),
+        "a boolean" => "true or false".into(),
+        w if w.starts_with("struct ") || w == "a map" => "a table ({ ... } or [section])".into(),
+        w => w.to_string(),
+    };
+    let got = if let Some(t) = got.strip_prefix("string ") {
+        format!("the text {t}")
+    } else if let Some(v) = ["floating point ", "integer ", "boolean "]
+        .iter()
+        .find_map(|p| got.strip_prefix(p))
+    {
+        v.trim_matches('`').to_string()
+    } else {
+        match got {
+            "sequence" => "a list".to_string(),
+            "map" => "a table".to_string(),
+            other => other.to_string(),
+        }
+    };
+    format!("must be {wanted}, got {got}")
+}
+
+/// The error inside an inline material table `{ ... }` whose value starts at `offset`: the
+/// offset of the faulty key in `src`, the key, and the message (the table read alone as a
+/// material's keys).
+fn inline_material_error(src: &str, offset: usize) -> Option<(usize, String, String)> {
+    let rest = src.get(offset..)?;
+    if !rest.starts_with('{') {
+        return None;
+    }
+    let text = &rest[..rest.find('\n').unwrap_or(rest.len())];
+    let table: toml::Table = toml::from_str(&format!("t = {text}")).ok()?;
+    let inner = table.get("t")?.as_table()?;
+    // The table as a document of its own: one key a line, each error located there.
+    let doc = toml::to_string(inner).ok()?;
+    let e = match toml::from_str::<raw::PlainMaterial>(&doc) {
+        Ok(_) => return None,
+        Err(e) => e,
+    };
+    let at = e.span().map_or(0, |s| s.start);
+    let line_start = doc[..at.min(doc.len())].rfind('\n').map_or(0, |i| i + 1);
+    let key = doc[line_start..].split_once('=').map(|(k, _)| unquote_key(k.trim()))?;
+    // The key's place in the original line.
+    let key_offset = text.find(&key).map_or(offset, |i| offset + i);
+    Some((key_offset, key, user_words(e.message().trim())))
 }
 
 /// A quoted key (`"my key"`) as the key itself; a bare key as it is.
