@@ -1490,18 +1490,19 @@ fn shader_view_runs_the_exported_glsl_beside_phong() {
     });
 }
 
-/// three.js, vendored from the npm registry into the target folder (once), for the threejs
+/// three.js 0.187.0 (pinned: the check must not move with three's releases), vendored from
+/// the npm registry into the target folder (once), for the threejs
 /// target's example page; `None` (skipped) where npm is missing, a failure under
 /// PHONG_REQUIRE_BROWSER=1.
 fn vendored_three() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("three");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("three-0.187.0");
     let build = dir.join("package/build");
     if build.join("three.module.js").exists() {
         return Some(build);
     }
     std::fs::create_dir_all(&dir).ok()?;
     let packed = Command::new("npm")
-        .args(["pack", "three", "--silent"])
+        .args(["pack", "three@0.187.0", "--silent"])
         .current_dir(&dir)
         .output();
     let name = match packed {
