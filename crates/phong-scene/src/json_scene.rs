@@ -228,7 +228,7 @@ fn parse_json_with(
 /// A TOML scene file's text as the JSON value of the same scene (what [`parse_scene_json`]
 /// reads), an error at its line and column where it is not TOML.
 pub fn toml_to_json(src: &str, path: &Path) -> Result<Value, Error> {
-    let value: toml::Value = toml::from_str(src).map_err(|e| {
+    let value: toml::Value = toml::from_str(&crate::toml_scene::quiet_blank_lines(src)).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
         Error::at(path, src, offset, None, e.message().trim().to_string())
     })?;

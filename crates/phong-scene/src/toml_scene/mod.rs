@@ -47,7 +47,7 @@ pub fn parse_scene_with(src: &str, path: &Path, meshes: Option<&MeshLookup>) -> 
 /// refusing them (a scene sent to `phong serve`).
 pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, files: bool) -> Result<Loaded, Error> {
     let _budget = crate::texture_file::TextureBudget::start();
-    let raw: RawScene = toml::from_str(src).map_err(|e| {
+    let raw: RawScene = toml::from_str(&quiet_blank_lines(src)).map_err(|e| {
         let offset = e.span().map_or(0, |s| s.start);
         // The whole line the error is on (an error at a key's start, as "duplicate key", has
         // nothing before it on the line).
@@ -106,6 +106,50 @@ pub fn parse_scene_from(src: &str, path: &Path, meshes: Option<&MeshLookup>, fil
         textures: Default::default(),
         times: Default::default(),
     })
+}
+
+/// `src` with every run of blank or comment-only lines after a newline turned into spaces,
+/// byte for byte (so that every offset, and so every line and column reported, is the file's
+/// own): the TOML parser keeps a token or two a line, about 48 bytes each, so a file of 10 MB
+/// of newlines or comments took half a gigabyte. A file with multi-line strings (whose blank
+/// lines are their text) is left as it is.
+pub(crate) fn quiet_blank_lines(src: &str) -> std::borrow::Cow<'_, str> {
+    let b = src.as_bytes();
+    let lines = b.iter().filter(|&&c| c == b'\n').count();
+    if lines < 1024 || src.contains("\"\"\"") || src.contains("\'\'\'") {
+        return std::borrow::Cow::Borrowed(src);
+    }
+    let quiet = |line: &[u8]| {
+        let rest: &[u8] = match line.iter().position(|c| !matches!(c, b' ' | b'\t' | b'\r')) {
+            None => return true,
+            Some(k) => &line[k..],
+        };
+        rest.first() == Some(&b'#')
+    };
+    let mut out = b.to_vec();
+    let mut i = 0;
+    while i < out.len() {
+        if out[i] != b'\n' {
+            i += 1;
+            continue;
+        }
+        // A newline: the quiet lines after it, newlines and all, become spaces (the first
+        // line that says something keeps its own text).
+        let (mut j, mut last) = (i + 1, i);
+        while let Some(end) = out[j..].iter().position(|&c| c == b'\n').map(|k| j + k) {
+            if !quiet(&out[j..end]) {
+                break;
+            }
+            last = end;
+            j = end + 1;
+        }
+        for c in &mut out[i + 1..=last] {
+            *c = b' ';
+        }
+        i = last.max(i) + 1;
+    }
+    // Whole lines of comments and blanks became spaces: still UTF-8.
+    std::borrow::Cow::Owned(String::from_utf8(out).expect("still UTF-8"))
 }
 
 /// toml's and serde's messages in the user's words: "invalid type: string \"tall\", expected
@@ -258,4 +302,30 @@ fn build(ctx: &mut Ctx, raw: RawScene) -> Result<Scene, Error> {
         objects,
         labels,
     })
+}
+
+#[cfg(test)]
+mod quiet_tests {
+    use super::quiet_blank_lines;
+
+    #[test]
+    fn blank_and_comment_lines_become_spaces_offsets_kept() {
+        let filler = "\n  \n# a comment, é\n\t\n".repeat(400);
+        let src = format!("a = 1\n{filler}b = [\n1,\n{filler}2]\n");
+        let q = quiet_blank_lines(&src);
+        assert_eq!(q.len(), src.len(), "byte for byte");
+        assert_eq!(q.find("b = ["), src.find("b = ["));
+        assert!(!q.contains('#'));
+        let t: toml::Table = toml::from_str(&q).expect("still TOML");
+        assert_eq!(t["a"].as_integer(), Some(1));
+        assert_eq!(t["b"].as_array().map(Vec::len), Some(2));
+        // Multi-line strings keep their blank lines: the text is left as it is.
+        let s = format!("s = \"\"\"\n{filler}\"\"\"\n");
+        assert_eq!(quiet_blank_lines(&s), s);
+        // Small files are not touched.
+        assert!(matches!(
+            quiet_blank_lines("a = 1\n\n\nb = 2\n"),
+            std::borrow::Cow::Borrowed(_)
+        ));
+    }
 }
