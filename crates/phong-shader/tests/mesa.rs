@@ -4,6 +4,8 @@
 //! one sample: at most 0.5% of the pixels past 2/255. Without OSMesa (Debian's
 //! libosmesa6-dev) the test is skipped, and with `PHONG_REQUIRE_MESA=1` (CI) that is a failure.
 
+mod common;
+use common::scenes;
 use phong_core::{Interpolation, Scene};
 use phong_shader::Version;
 use serde_json::Value;
@@ -40,21 +42,6 @@ fn reference() -> Option<PathBuf> {
             None
         }
     }
-}
-
-fn scene(shading: &str, camera: &str, encoding: &str) -> Scene {
-    let text = format!(
-        "[image]\nwidth = 160\nheight = 120\nbackground = [0.05, 0.05, 0.07]\nencoding = \"{encoding}\"\n\n{camera}\n\
-         [shading]\n{shading}\nambient = [0.2, 0.2, 0.2]\n\n\
-         [[light]]\ntype = \"directional\"\ndirection = [-1.0, -1.0, -1.5]\ncolor = [0.6, 0.6, 0.6]\n\
-         [[light]]\ntype = \"point\"\nposition = [2.0, 2.0, 3.0]\nattenuation = [1.0, 0.05, 0.01]\n\
-         [[light]]\ntype = \"spot\"\nposition = [0.0, 3.0, 3.0]\ndirection = [0.0, -1.0, -1.0]\ncutoff = 40.0\nexponent = 4.0\n\n\
-         [[object]]\nshape = \"sphere\"\nmaterial = \"gold\"\nposition = [-0.6, 0.0, 0.0]\nscale = 0.8\n\n\
-         [[object]]\nshape = \"torus\"\nmaterial = \"jade\"\nposition = [0.8, 0.0, -0.5]\nrotation = [60.0, 0.0, 0.0]\nscale = 0.6\n"
-    );
-    phong_scene::parse_scene(&text, std::path::Path::new("mesa.toml"))
-        .expect("the scene")
-        .scene
 }
 
 /// The uniforms of a program's JSON in `glsl.c`'s form.
@@ -140,62 +127,48 @@ fn input(scene: &Scene, version: Version) -> String {
 #[test]
 fn glsl_pairs_on_mesa_draw_phongs_pixels() {
     let Some(exe) = reference() else { return };
-    let perspective = "[camera]\nposition = [0.5, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 45.0\n";
-    let orthographic = "[camera]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 10.0]\nheight = 3.2\n";
-    let models = ["phong", "blinn-phong", "lambert", "phong-lyon", "opengl"];
-    for (k, model) in models.iter().enumerate() {
-        for interp in ["phong", "gouraud", "flat"] {
-            let extra = match k % 3 {
-                0 => "two_sided = true",
-                1 if *model != "opengl" => "normalization = \"blinn-phong\"\noutput = \"specular\"",
-                _ => "viewer = \"infinite\"",
-            };
-            let shading = format!("model = \"{model}\"\ninterpolation = \"{interp}\"\n{extra}");
-            let camera = if k % 2 == 0 { perspective } else { orthographic };
-            let encoding = if interp == "gouraud" { "srgb" } else { "linear" };
-            let scene = scene(&shading, camera, encoding);
-            let mut renderer = phong_raster::Renderer::new();
-            let options = phong_raster::RenderOptions::default();
-            let (picture, _) =
-                phong_run::draw(&scene, phong_run::Backend::Cpu(&options), &mut renderer).expect("phong's render");
-            let ours = picture.rgba8();
-            for version in [Version::Legacy120, Version::Core330] {
-                let mut child = Command::new(&exe)
-                    .stdin(Stdio::piped())
-                    .stdout(Stdio::piped())
-                    .stderr(Stdio::piped())
-                    .spawn()
-                    .expect("the OSMesa program runs");
-                child
-                    .stdin
-                    .take()
-                    .expect("stdin")
-                    .write_all(input(&scene, version).as_bytes())
-                    .expect("written");
-                let out = child.wait_with_output().expect("its output");
-                assert!(
-                    out.status.success(),
-                    "{shading} {version:?}: {}",
-                    String::from_utf8_lossy(&out.stderr)
-                );
-                let (w, h) = (scene.image.width as usize, scene.image.height as usize);
-                // OSMesa's rows are from the bottom.
-                let mesa: Vec<u8> = (0..h)
-                    .rev()
-                    .flat_map(|y| out.stdout[y * w * 4..(y + 1) * w * 4].to_vec())
-                    .collect();
-                let off = (0..w * h)
-                    .filter(|&i| (0..3).any(|c| mesa[i * 4 + c].abs_diff(ours[i * 4 + c]) > 2))
-                    .count();
-                let drawn = (0..w * h).filter(|&i| mesa[i * 4..i * 4 + 3] != mesa[..3]).count();
-                eprintln!("{shading:?} {version:?}: {off} pixels past 2/255, {drawn} drawn");
-                assert!(drawn * 10 >= w * h, "{shading} {version:?}: only {drawn} pixels drawn");
-                assert!(
-                    off * 200 <= w * h,
-                    "{shading} {version:?}: {off} of {} pixels past 2/255",
-                    w * h
-                );
-            }
+    for (shading, scene) in scenes() {
+        let mut renderer = phong_raster::Renderer::new();
+        let options = phong_raster::RenderOptions::default();
+        let (picture, _) =
+            phong_run::draw(&scene, phong_run::Backend::Cpu(&options), &mut renderer).expect("phong's render");
+        let ours = picture.rgba8();
+        for version in [Version::Legacy120, Version::Core330] {
+            let mut child = Command::new(&exe)
+                .stdin(Stdio::piped())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the OSMesa program runs");
+            child
+                .stdin
+                .take()
+                .expect("stdin")
+                .write_all(input(&scene, version).as_bytes())
+                .expect("written");
+            let out = child.wait_with_output().expect("its output");
+            assert!(
+                out.status.success(),
+                "{shading} {version:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let (w, h) = (scene.image.width as usize, scene.image.height as usize);
+            // OSMesa's rows are from the bottom.
+            let mesa: Vec<u8> = (0..h)
+                .rev()
+                .flat_map(|y| out.stdout[y * w * 4..(y + 1) * w * 4].to_vec())
+                .collect();
+            let off = (0..w * h)
+                .filter(|&i| (0..3).any(|c| mesa[i * 4 + c].abs_diff(ours[i * 4 + c]) > 2))
+                .count();
+            let drawn = (0..w * h).filter(|&i| mesa[i * 4..i * 4 + 3] != mesa[..3]).count();
+            eprintln!("{shading:?} {version:?}: {off} pixels past 2/255, {drawn} drawn");
+            assert!(drawn * 10 >= w * h, "{shading} {version:?}: only {drawn} pixels drawn");
+            assert!(
+                off * 200 <= w * h,
+                "{shading} {version:?}: {off} of {} pixels past 2/255",
+                w * h
+            );
         }
     }
     let _ = std::fs::remove_file(exe);
