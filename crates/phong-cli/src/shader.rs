@@ -129,6 +129,9 @@ pub fn shader(a: ShaderArgs) -> Result<()> {
                 if p.as_os_str().is_empty() {
                     bail!(InputError("an empty output path".into()));
                 }
+                if p.is_dir() {
+                    bail!(InputError(format!("output {} is a folder: name a file", p.display())));
+                }
                 refuse_overwriting(&p, &job.sources)?;
                 phong_scene::write_file(&p, text.as_bytes())?;
             }

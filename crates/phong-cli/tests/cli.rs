@@ -707,6 +707,18 @@ fn shader_exports_glsl_and_refuses_what_it_cannot_express() {
         assert!(stderr(&o).contains(says), "{scene}: {}", stderr(&o));
         assert!(!page.exists() && !page.with_extension("vert").exists());
     }
+    // An output that is a folder: exit 2, saying so.
+    let folder = tempfile::tempdir().unwrap();
+    let o = phong(&[
+        "shader",
+        "examples/scenes/shininess.toml",
+        "--target",
+        "html",
+        "-o",
+        folder.path().to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("is a folder"), "{}", stderr(&o));
     // A scene of objects shaded differently: the page draws each with its own program; the
     // GLSL pair is one object's (flat: lit at the triangle's centroid).
     let page = tmp("g.html");
