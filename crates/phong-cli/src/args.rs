@@ -51,10 +51,12 @@ pub struct RunArgs {
     /// CPU: the scalar reference path instead of the fast path.
     #[arg(long)]
     pub reference: bool,
-    /// CPU: keep the shading kernels to their AVX2 build where the CPU has AVX-512 (there the
-    /// default is the same code with AVX-512's 32 vector registers; the images are the same).
-    /// For comparisons.
-    #[arg(long)]
+    /// CPU: which builds of the fast path's vector kernels may run. The images are the same,
+    /// bit for bit; for comparisons.
+    #[arg(long, value_enum, default_value_t = KernelsArg::Auto)]
+    pub kernels: KernelsArg,
+    /// The same as `--kernels avx2` (kept for scripts that use it).
+    #[arg(long, hide = true)]
     pub no_avx512: bool,
     /// Print counts, the backend and the time of each stage.
     #[arg(short, long)]
@@ -161,7 +163,7 @@ pub struct Job {
     pub backend: Backend,
     pub gpu_path: GpuPathArg,
     pub reference: bool,
-    pub no_avx512: bool,
+    pub kernels: phong_raster::Kernels,
     pub verbose: bool,
 }
 
@@ -177,14 +179,7 @@ impl RunArgs {
                 bail!(InputError(format!("{flag} must be from 1 to {max}, got {v}")));
             }
         }
-        if let Some(t) = self.threads
-            && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
-        {
-            bail!(InputError(format!(
-                "--threads must be from 1 to {}, got {t}",
-                phong_core::limits::MAX_THREADS
-            )));
-        }
+        threads_flag(self.threads)?;
         let overrides = shading.map(ShadingArgs::overrides).transpose()?.unwrap_or_default();
         let samples = match shading.and_then(|s| s.antialias) {
             Some(n) => Some(
@@ -261,7 +256,11 @@ impl RunArgs {
             backend: self.backend,
             gpu_path: self.gpu_path,
             reference: self.reference,
-            no_avx512: self.no_avx512,
+            kernels: if self.no_avx512 {
+                phong_raster::Kernels::Avx2
+            } else {
+                self.kernels.into()
+            },
             verbose: self.verbose,
         })
     }
@@ -293,8 +292,7 @@ impl Job {
             threads: self.threads,
             progress,
             reference: self.reference,
-            no_avx2: false,
-            no_avx512: self.no_avx512,
+            kernels: self.kernels,
         }
     }
 
@@ -319,4 +317,38 @@ pub fn open_gpu(backend: Backend, path: GpuPathArg) -> Result<Option<phong_gpu::
         });
     }
     Ok(gpu)
+}
+
+/// `--kernels`: which builds of the CPU's vector kernels may run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum KernelsArg {
+    /// The best this CPU has (AVX2 with AVX-512's registers, AVX2, or portable)
+    Auto,
+    /// At most AVX2 with 16 vector registers
+    Avx2,
+    /// The portable build
+    Portable,
+}
+
+impl From<KernelsArg> for phong_raster::Kernels {
+    fn from(k: KernelsArg) -> Self {
+        match k {
+            KernelsArg::Auto => phong_raster::Kernels::Auto,
+            KernelsArg::Avx2 => phong_raster::Kernels::Avx2,
+            KernelsArg::Portable => phong_raster::Kernels::Portable,
+        }
+    }
+}
+
+/// `--threads`, checked by the renderer's one rule ([`phong_raster::Pool::check`]) and refused
+/// in the flag's name.
+pub fn threads_flag(threads: Option<usize>) -> Result<()> {
+    phong_raster::Pool::check(threads).map_err(|_| {
+        InputError(format!(
+            "--threads must be from 1 to {}, got {}",
+            phong_core::limits::MAX_THREADS,
+            threads.unwrap_or(0)
+        ))
+    })?;
+    Ok(())
 }

@@ -318,14 +318,7 @@ fn read_jobs(a: &BatchArgs, index: usize, count: usize) -> Result<Vec<Result<Job
 /// Runs `phong batch`.
 pub fn batch(a: BatchArgs) -> Result<()> {
     let (index, count) = shard(&a)?;
-    if let Some(t) = a.threads
-        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
-    {
-        bail!(InputError(format!(
-            "--threads must be from 1 to {}, got {t}",
-            phong_core::limits::MAX_THREADS
-        )));
-    }
+    crate::args::threads_flag(a.threads)?;
     let jobs = read_jobs(&a, index, count)?;
     let name = a.jobs.display().to_string();
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;

@@ -5,7 +5,7 @@
 use crate::InputError;
 use crate::args::RunArgs;
 use crate::report::{CpuSum, GpuSum};
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use phong_raster::{RenderOptions, Renderer};
 use std::time::{Duration, Instant};
 
@@ -67,10 +67,7 @@ pub fn bench(a: BenchArgs) -> Result<()> {
             // memory for all frames (llvmpipe's harness, too, draws every frame into the same
             // buffer), in the target `phong render` writes (8 bits where they are exact, as
             // llvmpipe renders into an RGBA8 buffer).
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(job.threads.unwrap_or(0))
-                .build()
-                .context("starting the rendering threads")?;
+            let pool = phong_raster::Pool::own(job.threads, "phong-bench")?;
             let options = RenderOptions {
                 threads: None,
                 ..job.options(None)

@@ -119,14 +119,7 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
     let Some(target_path) = &a.target else {
         bail!(InputError("phong fit SCENE needs --target TARGET.png".into()));
     };
-    if let Some(t) = a.threads
-        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
-    {
-        bail!(InputError(format!(
-            "--threads must be from 1 to {}, got {t}",
-            phong_core::limits::MAX_THREADS
-        )));
-    }
+    crate::args::threads_flag(a.threads)?;
     let free = phong_fit::image::Free::parse(&a.free)?;
     let loaded = phong_scene::load(scene_path)?;
     for w in &loaded.warnings {

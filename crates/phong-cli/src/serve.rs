@@ -1,7 +1,7 @@
 //! `phong serve`: arguments, and the server until Ctrl-C or SIGTERM.
 
-use crate::{Backend, GpuPathArg, InputError, open_gpu};
-use anyhow::{Context, Result, bail};
+use crate::{Backend, GpuPathArg, open_gpu};
+use anyhow::{Context, Result};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -30,14 +30,7 @@ pub(crate) struct ServeArgs {
 
 /// `phong serve`: the explorer until Ctrl-C.
 pub(crate) fn serve(a: ServeArgs) -> Result<()> {
-    if let Some(t) = a.threads
-        && !(1..=phong_core::limits::MAX_THREADS).contains(&t)
-    {
-        bail!(InputError(format!(
-            "--threads must be from 1 to {}, got {t}",
-            phong_core::limits::MAX_THREADS
-        )));
-    }
+    crate::args::threads_flag(a.threads)?;
     let (scene, library) = phong_serve::initial_scene(a.input.as_deref(), &a.view.options(None)?)?;
     let gpu = open_gpu(a.backend, GpuPathArg::Auto)?;
     let backend = match gpu {

@@ -64,8 +64,8 @@ fn free_port() -> u16 {
         .expect("a free port")
 }
 
-/// The browser session, its server and driver.
-struct Session {
+/// A page open in the browser, with its server and driver.
+struct Page {
     client: Client,
     url: String,
     name: &'static str,
@@ -74,15 +74,15 @@ struct Session {
     _profile: tempfile::TempDir,
 }
 
-async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<Session> {
+async fn open(name: &'static str, query: &str, server_args: &[&str]) -> Result<Page> {
     open_sized(name, query, server_args, (1400, 1000)).await
 }
 
-async fn open_sized(name: &'static str, query: &str, server_args: &[&str], window: (u32, u32)) -> Result<Session> {
+async fn open_sized(name: &'static str, query: &str, server_args: &[&str], window: (u32, u32)) -> Result<Page> {
     let (server, url) = start_server(server_args);
     let (client, driver, profile) = browser(window).await?;
     client.goto(&format!("{url}{query}")).await?;
-    let s = Session {
+    let s = Page {
         client,
         url,
         name,
@@ -126,11 +126,11 @@ async fn browser(window: (u32, u32)) -> Result<(Client, Proc, tempfile::TempDir)
         .capabilities(caps)
         .connect(&format!("http://127.0.0.1:{port}"))
         .await
-        .map_err(|e| anyhow!("WebDriver session: {e}"))?;
+        .map_err(|e| anyhow!("WebDriver: {e}"))?;
     Ok((client, driver, profile))
 }
 
-impl Session {
+impl Page {
     async fn js(&self, script: &str) -> Result<Value> {
         Ok(self.client.execute(script, vec![]).await?)
     }
@@ -449,7 +449,7 @@ fn dragging_a_light_moves_the_highlight() {
 }
 
 /// The page's Terms images, as RGBA bytes read back by a canvas.
-async fn term_pixels(s: &Session) -> Result<Vec<Vec<u8>>> {
+async fn term_pixels(s: &Page) -> Result<Vec<Vec<u8>>> {
     let v = s
         .js(r#"
         return ['term-ambient', 'term-diffuse', 'term-specular', 'term-total'].map((id) => {

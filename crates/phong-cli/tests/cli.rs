@@ -269,9 +269,84 @@ fn flags_override_the_file() {
         "specular without a specular term"
     );
     assert!(bytes.chunks(3).any(|p| p == [0, 0, 0]));
-    let mut normal = args.to_vec();
-    normal.extend(["--output", "normal", "--interpolation", "flat"]);
-    assert!(phong(&normal).status.success());
+    // `--output normal`: each object pixel is a unit normal, `(n + 1)/2`; `--interpolation
+    // flat` makes it the facet's, so a sphere of 8 segments shows at most its 64 triangles'
+    // normals where per-pixel interpolation shows hundreds.
+    let sphere = tmp("sphere.toml");
+    std::fs::write(
+        &sphere,
+        "[image]\nwidth = 96\nheight = 96\nbackground = [0.0, 0.0, 0.0]\n[[object]]\nshape = \"sphere\"\nsegments = 8\n",
+    )
+    .unwrap();
+    let normals = |interpolation: &str| {
+        let out = tmp("normal.png");
+        let o = phong(&[
+            "render",
+            sphere.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--output",
+            "normal",
+            "--interpolation",
+            interpolation,
+            "--antialias",
+            "1",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (_, _, n, bytes) = read_png(&out);
+        let object: Vec<&[u8]> = bytes.chunks(n).filter(|p| p[..3] != [0, 0, 0]).collect();
+        assert!(
+            object.len() > 1000,
+            "{interpolation}: the sphere covers {} pixels",
+            object.len()
+        );
+        for p in &object {
+            let n: f32 = p[..3].iter().map(|&c| (f32::from(c) / 255.0 * 2.0 - 1.0).powi(2)).sum();
+            assert!(
+                (n.sqrt() - 1.0).abs() < 0.02,
+                "{interpolation}: |n| = {} at {p:?}",
+                n.sqrt()
+            );
+        }
+        object
+            .iter()
+            .map(|p| p[..3].to_vec())
+            .collect::<std::collections::BTreeSet<_>>()
+            .len()
+    };
+    let (flat, smooth) = (normals("flat"), normals("phong"));
+    assert!(flat <= 64 && smooth > 300, "{flat} flat normals, {smooth} interpolated");
+}
+
+/// `--kernels`: every build of the vector kernels draws the same bytes.
+#[test]
+fn every_kernel_build_draws_the_same_image() {
+    let image = |kernels: &str| {
+        let out = tmp("k.png");
+        let o = phong(&[
+            "render",
+            "examples/scenes/textures.toml",
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--kernels",
+            kernels,
+            "-v",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stderr(&o), read_png(&out).3)
+    };
+    let (auto, avx2, portable) = (image("auto"), image("avx2"), image("portable"));
+    assert!(portable.0.contains("portable kernels"), "{}", portable.0);
+    assert!(
+        auto.1 == portable.1 && avx2.1 == portable.1,
+        "the builds' images differ"
+    );
+    let o = phong(&["render", "examples/scenes/tour.toml", "-o", "x.png", "--kernels", "sse"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
 #[test]

@@ -226,6 +226,18 @@ impl Camera {
     }
 }
 
+/// OpenGL's viewport transform for a `width × height` image stored top row first: clip-space
+/// `c` (`w > 0`) to window `x` right and `y` down in pixels, and depth in [0, 1]
+/// (`glDepthRange(0, 1)`); with `1/w`. Every renderer projects with this arithmetic (the CPU's
+/// setup, its labels, the GPU's checks; the WGSL and the AVX2 projection repeat it, tested).
+#[inline]
+pub fn window_from_clip(c: Vec4, width: f32, height: f32) -> (Vec3, f32) {
+    let iw = 1.0 / c.w;
+    let x = (c.x * iw * 0.5 + 0.5) * width;
+    let y = (0.5 - c.y * iw * 0.5) * height;
+    (Vec3::new(x, y, c.z * iw * 0.5 + 0.5), iw)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

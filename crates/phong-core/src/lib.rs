@@ -42,7 +42,7 @@ mod shading;
 pub mod text;
 pub mod texture;
 
-pub use camera::{Camera, Projection, Viewer};
+pub use camera::{Camera, Projection, Viewer, window_from_clip};
 pub use color::Color;
 pub use error::Error;
 pub use image::{Canvas, Encoding, Image, Image8};

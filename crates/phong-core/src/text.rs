@@ -3,7 +3,7 @@
 //! independent: applied to the image ([`crate::Image`] or [`crate::Image8`]) after rendering.
 
 use crate::{Camera, Canvas, Color, Label};
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
 /// Rows of a glyph, top first; bit 4 is the leftmost pixel.
 fn glyph(c: char) -> [u8; 7] {
@@ -106,8 +106,7 @@ pub fn draw_labels(image: &mut impl Canvas, camera: &Camera, labels: &[Label]) {
         if c.w <= 0.0 || !c.is_finite() {
             continue;
         }
-        let sx = (c.x / c.w * 0.5 + 0.5) * w;
-        let sy = (0.5 - c.y / c.w * 0.5) * h;
+        let (Vec3 { x: sx, y: sy, .. }, _) = crate::window_from_clip(c, w, h);
         let (tw, th) = text_size(&l.text, l.size);
         draw_text(
             image,

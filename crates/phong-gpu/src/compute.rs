@@ -143,8 +143,7 @@ impl Gpu {
                     if k & 4 == 0 { lo.z } else { hi.z },
                 );
                 let c = clip_from_world * p.extend(1.0);
-                let sx = (c.x / c.w * 0.5 + 0.5) * w;
-                let sy = (0.5 - c.y / c.w * 0.5) * h;
+                let (glam::Vec3 { x: sx, y: sy, .. }, _) = phong_core::window_from_clip(c, w, h);
                 // Snapped (× 256), |x| < 2^23: exact in f32 and in the shader's i32.
                 let inside = c.w > 0.0 && c.z >= -c.w && c.z <= c.w && sx.abs() < 32768.0 && sy.abs() < 32768.0;
                 if !inside {

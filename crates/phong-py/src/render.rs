@@ -76,7 +76,7 @@ pub(crate) struct Engine {
 
 impl Engine {
     fn new(threads: Option<usize>, backend: &str) -> PyResult<Engine> {
-        let pool = Pool::new(threads).map_err(py_err)?;
+        let pool = Pool::new(threads).map_err(|e| py_err(e.into()))?;
         let gpu = match backend {
             "cpu" => None,
             "gpu" => Some(phong_gpu::Gpu::new().map_err(|e| RenderError::new_err(format!("backend \"gpu\": {e}")))?),

@@ -53,7 +53,7 @@ fn kernel(c: &mut Criterion) {
     c.bench_function("shade8 (baseline build)", |b| {
         b.iter(|| black_box(shade8(Isa::PORTABLE, &prep, black_box(&pos), &nrm)))
     });
-    let avx2 = Isa::detect(true, true);
+    let avx2 = Isa::detect(phong_raster::Kernels::Auto);
     if avx2.is_avx2() {
         c.bench_function("shade8 (AVX2 build)", |b| {
             b.iter(|| black_box(shade8(avx2, &prep, black_box(&pos), &nrm)))

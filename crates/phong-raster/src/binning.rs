@@ -1,36 +1,51 @@
 //! Binning: each set-up triangle into the 64×64 tiles its box meets and its edges do not
 //! trivially reject, in the input's order.
 
-use crate::frame::Frame;
-use crate::setup::{Chunk, ID_INDEX_BITS, Tri};
+use crate::setup::{Chunk, Corners, ID_INDEX_BITS, Scratch, Tri};
+use crate::simd::Planes;
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
 use rayon::prelude::*;
 
-impl Frame<'_> {
-    /// The tiles each triangle of `chunk` goes into, as `(tile, index)` pairs in triangle order
-    /// (made in the setup's parallel tasks).
-    pub(crate) fn bin_entries(&self, chunk: &mut Chunk) {
-        // A setup chunk of SETUP_CHUNK input triangles makes at most 7 triangles of each.
-        debug_assert!(chunk.tris.len() < 1 << ID_INDEX_BITS);
-        for (i, t) in chunk.tris.iter().enumerate() {
-            let [px0, py0, px1, py1] = t.bbox();
-            let (tx0, tx1) = (px0 / TILE_SIZE, (px1 - 1) / TILE_SIZE);
-            let (ty0, ty1) = (py0 / TILE_SIZE, (py1 - 1) / TILE_SIZE);
-            let several = tx0 != tx1 || ty0 != ty1;
-            for ty in ty0..=ty1 {
-                for tx in tx0..=tx1 {
-                    if several && misses_tile(t, tx, ty) {
-                        continue;
-                    }
-                    chunk.binned.push((ty * self.tiles_x + tx, i as u32));
+/// The setup's result: the set-up triangles, in the chunks the parallel setup made them (not
+/// copied into one vector), and each tile's triangles in drawing order. Ids pack (chunk,
+/// index), see [`Binned::tri`].
+pub(crate) struct Binned {
+    pub tris: Vec<Chunk>,
+    pub bins: Vec<Vec<u32>>,
+}
+
+/// The tiles each triangle of `chunk` goes into, as `(tile, index)` pairs in triangle order
+/// (made in the setup's parallel tasks), in a frame `tiles_x` tiles wide.
+pub(crate) fn bin_entries(chunk: &mut Chunk, tiles_x: u32) {
+    // A setup chunk of SETUP_CHUNK input triangles makes at most 7 triangles of each.
+    debug_assert!(chunk.tris.len() < 1 << ID_INDEX_BITS);
+    for (i, t) in chunk.tris.iter().enumerate() {
+        let [px0, py0, px1, py1] = t.bbox();
+        let (tx0, tx1) = (px0 / TILE_SIZE, (px1 - 1) / TILE_SIZE);
+        let (ty0, ty1) = (py0 / TILE_SIZE, (py1 - 1) / TILE_SIZE);
+        let several = tx0 != tx1 || ty0 != ty1;
+        for ty in ty0..=ty1 {
+            for tx in tx0..=tx1 {
+                if several && misses_tile(t, tx, ty) {
+                    continue;
                 }
+                chunk.binned.push((ty * tiles_x + tx, i as u32));
             }
         }
+    }
+}
+
+impl Binned {
+    /// No triangles yet, `tiles` empty bins, in memory taken from `scratch`.
+    pub fn new(tiles: usize, scratch: &mut Scratch) -> Binned {
+        let mut bins = std::mem::take(&mut scratch.bins);
+        bins.resize(tiles, Vec::new());
+        Binned { tris: Vec::new(), bins }
     }
 
     /// Keeps set-up chunks and adds their triangles to the bins, in order (chunk by chunk,
     /// triangle by triangle: the tiles draw them in the input's order). Bands of tiles are
-    /// filled in parallel, each from every chunk's entries ([`Frame::bin_entries`]).
+    /// filled in parallel, each from every chunk's entries ([`bin_entries`]).
     pub(crate) fn bin_chunks(&mut self, chunks: Vec<Chunk>) {
         let base = self.tris.len() as u32;
         debug_assert!(base as usize + chunks.len() < 1 << (32 - ID_INDEX_BITS));
@@ -48,6 +63,55 @@ impl Frame<'_> {
             }
         });
         self.tris.extend(chunks);
+    }
+
+    /// Gives the memory back to `scratch`, emptied, for the next frame. Spare chunks are kept
+    /// up to the number this frame used: the full setup makes chunks of its own rather than
+    /// taking spare ones, and keeping all of them grew the memory of every repeated frame that
+    /// has such objects.
+    pub fn recycle(self, scratch: &mut Scratch) {
+        let keep = self.tris.len();
+        for mut chunk in self.tris {
+            if scratch.chunks.len() >= keep {
+                break;
+            }
+            chunk.clear();
+            scratch.chunks.push(chunk);
+        }
+        scratch.bins = self.bins;
+        for bin in &mut scratch.bins {
+            bin.clear();
+        }
+    }
+
+    /// The triangle with packed id `id` (chunk in the high bits, index in the low ones).
+    #[inline]
+    pub fn tri(&self, id: u32) -> &Tri {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].tris[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The object of triangle `id`.
+    #[inline]
+    pub fn object(&self, id: u32) -> usize {
+        self.tris[(id >> ID_INDEX_BITS) as usize].object as usize
+    }
+
+    /// The fast path's plane equations of triangle `id`.
+    #[inline]
+    pub fn planes(&self, id: u32) -> &Planes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].planes[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The planes of a textured triangle's texture coordinates (`Mode::Textured`).
+    #[inline]
+    pub fn uv_planes(&self, id: u32) -> &Planes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].uv[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The [`Corners`] of triangle `id` (kept for the reference path and scalar-shaded objects).
+    #[inline]
+    pub fn corners(&self, id: u32) -> &Corners {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].corners[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
     }
 }
 

@@ -4,8 +4,9 @@
 //!
 //! ## Pipeline, a module a stage
 //!
-//! 1. **Frame** (`frame`): the decisions made once per render (reference or fast path, the
-//!    instruction set, how each object is shaded, the sample pattern, the background).
+//! 1. **Plan** (`plan`): the decisions made once per frame (reference or fast path, the
+//!    instruction set, the sample pattern, the background) and per object (`ObjectPlan`: how
+//!    it is set up and shaded); `frame` runs the stages below on it.
 //! 2. **Vertices** (`vertex`): to clip space with `clip_from_world`, outcodes, window
 //!    positions snapped to 1/256 pixel (`fixed`); for Gouraud, the lighting of
 //!    [`phong_core::shade`] at each vertex that a drawn triangle uses.
@@ -32,6 +33,8 @@ mod census;
 mod clip;
 mod fixed;
 mod frame;
+mod plan;
+mod pool;
 mod setup;
 mod simd;
 mod stats;
@@ -42,6 +45,7 @@ mod vertex;
 pub use census::{Census, census};
 pub use frame::coverage_counts;
 pub use phong_core::limits::sample_pattern;
+pub use pool::Pool;
 pub use stats::RenderStats;
 
 /// The kernels and the clipper, for phong-raster's own benchmarks and tests: not a stable API.
@@ -93,13 +97,23 @@ pub struct RenderOptions<'a> {
     /// Use the scalar reference path (one `shade` per pixel and covering triangle, in
     /// drawing order) instead of the fast path (visibility first, 8-lane shading kernel).
     pub reference: bool,
-    /// Fast path: do not use the AVX2 build of the kernel even where the CPU has AVX2 (for
-    /// tests; the images are the same).
-    pub no_avx2: bool,
-    /// Fast path: do not use the wide-register (AVX-512VL) build of the shading kernels even
-    /// where the CPU has AVX-512 (for tests and comparisons; the images are the same, bit for
-    /// bit).
-    pub no_avx512: bool,
+    /// Fast path: which builds of the vector kernels may run (every choice draws the same
+    /// image, bit for bit).
+    pub kernels: Kernels,
+}
+
+/// Which builds of the fast path's vector kernels may run on this CPU. The images are the same
+/// whichever runs, bit for bit (tested); the choice is for tests and comparisons.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Kernels {
+    /// The best this CPU has: the AVX2 build, with AVX-512's 32 vector registers where the CPU
+    /// has AVX-512VL; the portable build without AVX2 and FMA.
+    #[default]
+    Auto,
+    /// At most the AVX2 build with its 16 vector registers.
+    Avx2,
+    /// The portable build, whatever the CPU has.
+    Portable,
 }
 
 /// The CPU path and kernel build `options` render with on this CPU, in words: `reference
@@ -110,7 +124,7 @@ pub fn kernels(options: &RenderOptions) -> &'static str {
     if options.reference {
         return "reference path";
     }
-    let isa = crate::simd::Isa::detect(!options.no_avx2, !options.no_avx512);
+    let isa = crate::simd::Isa::detect(options.kernels);
     match (isa.is_avx2(), isa.wide()) {
         (true, true) => "AVX2 kernels (AVX-512 registers)",
         (true, false) => "AVX2 kernels",
@@ -243,29 +257,18 @@ pub enum Rendered<'a> {
 /// The scene's and options' checks shared by both targets.
 fn check(scene: &Scene, options: &RenderOptions) -> Result<(), Error> {
     scene.image.check()?;
-    if let Some(n) = options.threads
-        && !(1..=phong_core::limits::MAX_THREADS).contains(&n)
-    {
-        return Err(Error::ThreadCount(n));
-    }
-    Ok(())
+    Pool::check(options.threads)
 }
 
 /// Runs `f` on `options.threads` threads (a pool of its own), or on the current pool.
 fn in_pool<T: Send>(options: &RenderOptions, f: impl FnOnce() -> Result<T, Error> + Send) -> Result<T, Error> {
-    match options.threads {
-        None => f(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|source| Error::Threads { threads: n, source })?
-            .install(f),
-    }
+    Pool::new(options.threads)?.install(f)
 }
 
 /// What phong-raster's unit tests share.
 #[cfg(test)]
 pub(crate) mod testkit {
+    use crate::Kernels;
     use crate::simd::Isa;
 
     /// A xorshift64 generator: the tests' reproducible random numbers.
@@ -281,7 +284,7 @@ pub(crate) mod testkit {
     /// The AVX2 build, or `None` (the test skips, saying so) on a CPU without it; with
     /// `PHONG_REQUIRE_AVX2=1` a CPU without it fails the test instead.
     pub fn avx2() -> Option<Isa> {
-        let isa = Isa::detect(true, true);
+        let isa = Isa::detect(Kernels::Auto);
         if isa.is_avx2() {
             return Some(isa);
         }

@@ -31,16 +31,8 @@ pub(crate) struct FastVertex {
 /// [0, 1] and `1/w`.
 #[inline]
 pub(crate) fn project(c: Vec4, w: u32, h: u32) -> Projected {
-    let (wf, hf) = (w as f32, h as f32);
-    let iw = 1.0 / c.w;
-    let sx = (c.x * iw * 0.5 + 0.5) * wf;
-    let sy = (0.5 - c.y * iw * 0.5) * hf;
-    Projected(
-        round_i64(sx * ONE) as i32,
-        round_i64(sy * ONE) as i32,
-        c.z * iw * 0.5 + 0.5,
-        iw,
-    )
+    let (p, iw) = phong_core::window_from_clip(c, w as f32, h as f32);
+    Projected(round_i64(p.x * ONE) as i32, round_i64(p.y * ONE) as i32, p.z, iw)
 }
 
 /// The fast setup's records of `positions` into `out`, for a `w × h` window: clip-space

@@ -7,7 +7,7 @@ use common::Rng;
 use glam::Vec3;
 use phong_core::*;
 use phong_raster::internals::{ClipVertex, Clipped, LANES, Prepared, Term, clip_triangle, light_vertices, shade8};
-use phong_raster::{RenderOptions, render};
+use phong_raster::{Kernels, RenderOptions, render};
 use std::path::Path;
 
 /// `shade8` against `shade`, lane by lane, on 20000 random points: every model, normalization,
@@ -192,7 +192,7 @@ fn fast_path_matches_reference_on_every_scene() {
             &scene,
             &RenderOptions {
                 threads: Some(2),
-                no_avx2: true,
+                kernels: Kernels::Portable,
                 ..Default::default()
             },
         )
@@ -388,21 +388,18 @@ fn assert_fast_matches_reference(scene: &Scene, what: &str) {
     )
     .unwrap();
     let a = reference.to_bytes(scene.image.encoding, false);
-    for no_avx2 in [false, true] {
+    for kernels in [Kernels::Auto, Kernels::Portable] {
         let fast = render(
             scene,
             &RenderOptions {
-                no_avx2,
+                kernels,
                 ..Default::default()
             },
         )
         .unwrap();
         let b = fast.to_bytes(scene.image.encoding, false);
         let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-        assert!(
-            worst <= 1,
-            "{what} (no_avx2 {no_avx2}): a channel differs by {worst}/255"
-        );
+        assert!(worst <= 1, "{what} ({kernels:?}): a channel differs by {worst}/255");
     }
 }
 
@@ -477,10 +474,14 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
         scene.image.height = [64, 100][i % 2];
         for encoding in [Encoding::Linear, Encoding::Srgb] {
             scene.image.encoding = encoding;
-            for (reference, no_avx2, threads) in [(false, false, 1), (false, true, 3), (true, false, 3)] {
+            for (reference, kernels, threads) in [
+                (false, Kernels::Auto, 1),
+                (false, Kernels::Portable, 3),
+                (true, Kernels::Auto, 3),
+            ] {
                 let options = RenderOptions {
                     reference,
-                    no_avx2,
+                    kernels,
                     threads: Some(threads),
                     ..Default::default()
                 };
@@ -495,7 +496,7 @@ fn eight_bit_frames_are_the_encoded_f32_frames() {
                 assert_eq!(
                     differ,
                     0,
-                    "{} {encoding:?} reference={reference} no_avx2={no_avx2} threads={threads}",
+                    "{} {encoding:?} reference={reference} {kernels:?} threads={threads}",
                     path.display()
                 );
             }
@@ -1261,18 +1262,18 @@ material = {{ base = "silver", alpha = 0.9, blend = true, diffuse_map = "assets/
     )
     .unwrap();
     let a = reference.to_bytes(scene.image.encoding, true);
-    for no_avx2 in [false, true] {
+    for kernels in [Kernels::Auto, Kernels::Portable] {
         let fast = render(
             &scene,
             &RenderOptions {
-                no_avx2,
+                kernels,
                 ..Default::default()
             },
         )
         .unwrap();
         let b = fast.to_bytes(scene.image.encoding, true);
         let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-        assert!(worst <= 1, "transparent background (no_avx2 {no_avx2}): {worst}/255");
+        assert!(worst <= 1, "transparent background ({kernels:?}): {worst}/255");
     }
 }
 

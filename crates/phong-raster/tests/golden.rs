@@ -18,7 +18,7 @@
 
 mod common;
 
-use phong_raster::{RenderOptions, Renderer};
+use phong_raster::{Kernels, RenderOptions, Renderer};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -76,19 +76,24 @@ fn example_scenes_match_their_golden_images() {
         let scene = phong_scene::load(path).unwrap().scene;
         let alpha = scene.image.background[3] < 1.0;
         // The paths: the reference, and the fast path in each build.
-        let mut paths = vec![("reference".to_string(), true, false)];
+        let mut paths = vec![("reference".to_string(), true, Kernels::Auto)];
         paths.extend(isas.iter().map(|isa| {
             let build = if isa.is_avx2() { "avx2" } else { "portable" };
-            (format!("fast-{build}"), false, !isa.is_avx2())
+            let kernels = if isa.is_avx2() {
+                Kernels::Auto
+            } else {
+                Kernels::Portable
+            };
+            (format!("fast-{build}"), false, kernels)
         }));
-        for (label, reference, no_avx2) in paths {
+        for (label, reference, kernels) in paths {
             let key = format!("{name}/{label}");
             let mut first: Option<Vec<u8>> = None;
             for threads in [1, 3] {
                 let options = RenderOptions {
                     threads: Some(threads),
                     reference,
-                    no_avx2,
+                    kernels,
                     ..Default::default()
                 };
                 let what = format!("{key}, {threads} threads");
@@ -167,7 +172,7 @@ fn example_scenes_match_their_golden_images() {
 /// so, on a CPU without AVX-512F, VL, BW and DQ.
 #[test]
 fn wide_registers_draw_the_avx2_images() {
-    if !phong_raster::internals::Isa::detect(true, true).wide() {
+    if !phong_raster::internals::Isa::detect(phong_raster::Kernels::Auto).wide() {
         eprintln!("skipped: this CPU has no AVX-512F, VL, BW and DQ");
         return;
     }
@@ -190,7 +195,7 @@ fn wide_registers_draw_the_avx2_images() {
             let image = |no_avx512| {
                 let options = RenderOptions {
                     threads: Some(threads),
-                    no_avx512,
+                    kernels: if no_avx512 { Kernels::Avx2 } else { Kernels::Auto },
                     ..Default::default()
                 };
                 assert_eq!(

@@ -9,48 +9,10 @@ use std::path::Path;
 /// The renderer a frame is drawn by.
 #[derive(Clone, Copy)]
 pub enum Backend<'a> {
-    /// The CPU rasterizer, with its options (threads are the pool's: see [`Pool`]).
+    /// The CPU rasterizer, with its options (threads are the pool's: see [`Pool`](crate::Pool)).
     Cpu(&'a RenderOptions<'a>),
     /// The GPU.
     Gpu(&'a phong_gpu::Gpu),
-}
-
-/// The threads CPU frames are drawn on: a pool of its own for a count, built once and kept
-/// (`phong batch`, a Python renderer), or the global pool (all cores).
-pub struct Pool(Option<rayon::ThreadPool>);
-
-impl Pool {
-    /// A pool of `threads` (1 to [`MAX_THREADS`](phong_core::limits::MAX_THREADS)), or the
-    /// global pool for `None`.
-    pub fn new(threads: Option<usize>) -> Result<Pool, Error> {
-        let Some(n) = threads else {
-            return Ok(Pool(None));
-        };
-        if !(1..=phong_core::limits::MAX_THREADS).contains(&n) {
-            return Err(phong_raster::Error::ThreadCount(n).into());
-        }
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|source| phong_raster::Error::Threads { threads: n, source })?;
-        Ok(Pool(Some(pool)))
-    }
-
-    /// Runs `f` on the pool's threads.
-    pub fn install<T: Send>(&self, f: impl FnOnce() -> T + Send) -> T {
-        match &self.0 {
-            Some(p) => p.install(f),
-            None => f(),
-        }
-    }
-
-    /// The number of threads frames are drawn on.
-    pub fn threads(&self) -> usize {
-        match &self.0 {
-            Some(p) => p.current_num_threads(),
-            None => rayon::current_num_threads(),
-        }
-    }
 }
 
 /// What a frame's renderer measured.

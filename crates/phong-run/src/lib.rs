@@ -15,6 +15,7 @@ mod request;
 
 pub use built::Built;
 pub use error::{Error, message};
-pub use frame::{Backend, Picture, Pool, Stats, draw, draw_linear};
+pub use frame::{Backend, Picture, Stats, draw, draw_linear};
 pub use models::Models;
+pub use phong_raster::Pool;
 pub use request::{Settings, Source, load, load_viewed, merge_tables, view_options};

@@ -22,7 +22,7 @@ pub struct TextureStore {
     /// The folder (made where missing).
     pub dir: PathBuf,
     /// Textures smaller than this (bytes, mipmaps included) are not kept: disk is spent only
-    /// where decoding costs about a frame or more (BENCHMARKS.md, "The texture cache").
+    /// where decoding costs about a frame or more (benches/HISTORY.md, "The texture cache").
     pub min_bytes: u64,
     /// The folder's files are kept under this many bytes in all.
     pub max_total: u64,
@@ -155,7 +155,7 @@ pub(crate) fn fetch(store: &TextureStore, key: Key) -> Option<Texture> {
 }
 
 /// `len` bytes from byte `start` of `f`, read into memory of their own that asks for huge
-/// pages (fewer page faults: BENCHMARKS.md, "The texture cache read into huge pages"), in
+/// pages (fewer page faults: benches/HISTORY.md, "The texture cache read into huge pages"), in
 /// pieces spread over the cores.
 fn read_levels(f: &File, start: u64, len: u64) -> Option<SharedBytes> {
     let mut map = memmap2::MmapMut::map_anon(usize::try_from(len).ok()?).ok()?;

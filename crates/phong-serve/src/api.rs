@@ -42,7 +42,7 @@ impl AppState {
     /// A server rendering with `backend`, opening the page on `initial`.
     pub fn new(backend: Backend, initial: Value, library: Library) -> AppState {
         let workers = match &backend {
-            Backend::Cpu { pool, .. } => pool.current_num_threads().clamp(1, 4),
+            Backend::Cpu { pool, .. } => pool.threads().clamp(1, 4),
             Backend::Gpu(_) => 1,
         };
         AppState {

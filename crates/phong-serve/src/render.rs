@@ -2,7 +2,7 @@
 //! renderer's own thread pool or on the GPU, never on the async threads.
 
 use phong_core::Scene;
-use phong_raster::{RenderOptions, Renderer};
+use phong_raster::{Pool, RenderOptions, Renderer};
 use std::sync::Mutex;
 
 /// Which renderer draws the frames.
@@ -11,7 +11,7 @@ pub enum Backend {
     /// between frames.
     Cpu {
         /// The rendering threads.
-        pool: rayon::ThreadPool,
+        pool: Pool,
         /// Idle renderers, one taken per frame.
         renderers: Mutex<Vec<Renderer>>,
     },
@@ -22,11 +22,7 @@ pub enum Backend {
 impl Backend {
     /// The CPU renderer on `threads` threads (all cores when `None`).
     pub fn cpu(threads: Option<usize>) -> Result<Backend, String> {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.unwrap_or(0))
-            .thread_name(|i| format!("phong-render-{i}"))
-            .build()
-            .map_err(|e| format!("could not start the rendering threads: {e}"))?;
+        let pool = Pool::own(threads, "phong-render").map_err(|e| e.to_string())?;
         Ok(Backend::Cpu {
             pool,
             renderers: Mutex::new(Vec::new()),
@@ -36,7 +32,7 @@ impl Backend {
     /// Words for the startup line: "cpu, 2 threads" or the GPU adapter.
     pub fn describe(&self) -> String {
         match self {
-            Backend::Cpu { pool, .. } => format!("cpu, {} threads", pool.current_num_threads()),
+            Backend::Cpu { pool, .. } => format!("cpu, {} threads", pool.threads()),
             Backend::Gpu(g) => format!("gpu, {}", g.lock().map(|g| g.adapter_name()).unwrap_or_default()),
         }
     }

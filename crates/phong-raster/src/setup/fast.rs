@@ -7,29 +7,25 @@
 //! (a sphere's back half is culled); the triangles wait as [`Pending`] until their colours
 //! exist.
 
+use super::Stage;
 use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, uv_planes};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
-use crate::frame::{Frame, Mode, lit_term};
+use crate::plan::{Mode, lit_term};
 use crate::simd::{Planes, Prepared};
 use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
-use glam::{Mat4, Vec3, Vec4};
-use phong_core::Object;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-impl Frame<'_> {
+impl Stage<'_> {
     /// Sets up object `oi` for the fast path, in chunks of [`SETUP_CHUNK`] input triangles,
     /// each binned.
-    pub(crate) fn setup_object_fast(
-        &self,
-        oi: usize,
-        obj: &Object,
-        clip_from_world: Mat4,
-        scratch: &mut Scratch,
-        spare: &Mutex<Vec<Chunk>>,
-    ) -> Vec<Chunk> {
+    pub(super) fn object_fast(&self, oi: usize, scratch: &mut Scratch, spare: &Mutex<Vec<Chunk>>) -> Vec<Chunk> {
+        let obj = &self.scene.objects[oi];
+        let plan = &self.plan.objects[oi];
+        let (isa, clip_from_world) = (self.plan.isa, self.plan.clip_from_world);
         let two_sided = obj.shading.options.two_sided;
         let mesh = &obj.mesh;
         let (positions, normals) = (mesh.positions(), mesh.normals());
@@ -40,10 +36,10 @@ impl Frame<'_> {
         vertices
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
-            .for_each(|(out, ps)| fast_vertices(self.isa, clip_from_world, (self.w, self.h), ps, out));
+            .for_each(|(out, ps)| fast_vertices(isa, clip_from_world, (self.plan.w, self.plan.h), ps, out));
         // Lit per vertex (Gouraud, textured or not), and textured.
-        let gouraud = matches!(self.modes[oi], Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
-        let textured = matches!(self.modes[oi], Mode::Textured { .. });
+        let gouraud = matches!(plan.mode, Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
+        let textured = matches!(plan.mode, Mode::Textured { .. });
         let uvs = mesh.uvs();
         let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
         let colors = mesh.colors();
@@ -52,16 +48,11 @@ impl Frame<'_> {
         let uv1_of = |i: u32| uvs1.get(i as usize).copied().unwrap_or_default();
         let tangents = mesh.tangents();
         let tangent_of = |i: u32| tangents.get(i as usize).copied().unwrap_or(Vec4::ZERO);
-        let extra = self.extras[oi];
+        let extra = plan.extra;
         let extra_of = |i: u32| extra.of(rgb_of(i), uv1_of(i), tangent_of(i));
         let lighting = gouraud.then(|| VertexLighting {
-            isa: self.isa,
-            prepared: Prepared::new(
-                &self.scene.lighting,
-                &obj.material,
-                &obj.shading.options,
-                self.views[oi],
-            ),
+            isa,
+            prepared: Prepared::new(&self.scene.lighting, &obj.material, &obj.shading.options, plan.view),
             term: lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
             two_sided,
             textured,

@@ -5,27 +5,29 @@
 //! colours, for the texels applied per pixel; on the fast path, flat triangles by the vector
 //! kernel, all at once), [`Corners`] and planes kept as asked.
 
+use super::Stage;
 use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
-use crate::frame::Frame;
-use crate::frame::lit_term;
+use crate::plan::lit_term;
 use crate::simd::Planes;
 use crate::simd::Prepared;
 use crate::vertex::{Projected, VertexLighting};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use phong_core::mesh::facet_normal;
-use phong_core::{Color, Interpolation, Object};
+use phong_core::{Color, Interpolation};
 use rayon::prelude::*;
 
-impl Frame<'_> {
+impl Stage<'_> {
     /// Sets up object `oi` with what `keep` asks for: [`Corners`] for scalar shading (or the
     /// alpha test), fast-path planes (a flat-shaded or alpha-tested object on the fast path),
     /// in chunks of [`SETUP_CHUNK`] input triangles, each binned.
-    pub(crate) fn setup_object_full(&self, oi: usize, obj: &Object, clip_from_world: Mat4, keep: Keep) -> Vec<Chunk> {
+    pub(super) fn object_full(&self, oi: usize, keep: Keep) -> Vec<Chunk> {
         let scene = self.scene;
+        let obj = &scene.objects[oi];
+        let clip_from_world = self.plan.clip_from_world;
         let interpolation = obj.shading.interpolation;
         let two_sided = obj.shading.options.two_sided;
-        let view = self.views[oi];
+        let view = self.plan.objects[oi].view;
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
         let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
@@ -42,7 +44,7 @@ impl Frame<'_> {
             .flatten()
             .map(|term| {
                 let lighting = VertexLighting {
-                    isa: self.isa,
+                    isa: self.plan.isa,
                     prepared: Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view),
                     term,
                     two_sided,

@@ -9,14 +9,15 @@
 mod fast;
 mod full;
 
+use crate::binning::{Binned, bin_entries};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, ONE};
-use crate::frame::{Frame, Mode};
+use crate::plan::{FramePlan, Mode, SetupKind};
 use crate::simd::Planes;
 use crate::vertex::{FastVertex, Projected, project};
 use glam::Vec3;
-use phong_core::Color;
 use phong_core::limits::SUBPIXEL_BITS;
+use phong_core::{Color, Scene};
 use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
 
@@ -93,7 +94,7 @@ pub(crate) struct Setup {
 /// colour), specular colour (textured objects only), facet normal.
 pub(crate) type Flat = (Color, Color, Vec3);
 
-/// What [`Frame::setup`] keeps of a triangle besides its [`Tri`].
+/// What [`Stage::setup`] keeps of a triangle besides its [`Tri`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Keep {
     /// Its [`Corners`].
@@ -133,7 +134,7 @@ pub(crate) struct Chunk {
     /// `v/w` in `attr[0]`, `attr[1]`), same index.
     pub uv: Vec<Planes>,
     /// `(tile, index)` for each tile each triangle is binned into, in triangle order (see
-    /// `Frame::bin_chunks`).
+    /// `Binned::bin_chunks`).
     pub binned: Vec<(u32, u32)>,
 }
 
@@ -277,7 +278,7 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
 }
 
 /// What a textured object's coordinates' planes carry beside its first set ([`uv_planes`]'s
-/// `extra`), decided per object and frame ([`crate::frame::Frame::extras`]).
+/// `extra`), decided per object and frame ([`crate::plan::ObjectPlan::extra`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Extra {
     /// Nothing: the first set alone (the mesh has no vertex colours, the maps read no second
@@ -352,24 +353,53 @@ pub(crate) fn plane_equations(
     }
 }
 
-impl Frame<'_> {
+/// Transforms, lights (Gouraud, flat), clips, sets up and bins every triangle of `scene` as
+/// `plan` says, in memory taken from `scratch` (given back by [`Binned::recycle`]).
+pub(crate) fn run(plan: &FramePlan, scene: &Scene, scratch: &mut Scratch) -> Binned {
+    let stage = Stage { plan, scene };
+    let mut binned = Binned::new(plan.tiles(), scratch);
+    let spare = Mutex::new(std::mem::take(&mut scratch.chunks));
+    // Opaque objects first, then blended ones back to front (the bins keep this order).
+    for oi in scene.draw_order() {
+        let chunks = match plan.objects[oi].setup {
+            SetupKind::Full(keep) => stage.object_full(oi, keep),
+            SetupKind::Fast => stage.object_fast(oi, scratch, &spare),
+        };
+        binned.bin_chunks(chunks);
+    }
+    scratch.chunks = spare.into_inner().unwrap_or_default();
+    binned
+}
+
+/// What the setup of one object reads: the frame's plan and the scene.
+struct Stage<'p> {
+    plan: &'p FramePlan<'p>,
+    scene: &'p Scene,
+}
+
+impl Stage<'_> {
     /// Clip-space `c` (`w > 0`) to this frame's window (see [`project`]).
     #[inline]
-    pub(crate) fn project(&self, c: glam::Vec4) -> Projected {
-        project(c, self.w, self.h)
+    fn project(&self, c: glam::Vec4) -> Projected {
+        project(c, self.plan.w, self.plan.h)
     }
 
     /// [`setup_edges`] in this frame's window and sample pattern.
     #[inline]
-    pub(crate) fn setup_edges(&self, proj: [Projected; 3], two_sided: bool) -> Option<Setup> {
-        setup_edges(proj, two_sided, self.w, self.h, self.span)
+    fn setup_edges(&self, proj: [Projected; 3], two_sided: bool) -> Option<Setup> {
+        setup_edges(proj, two_sided, self.plan.w, self.plan.h, self.plan.span)
+    }
+
+    /// Sorts a chunk's triangles into the tiles they meet ([`bin_entries`]).
+    fn bin_entries(&self, chunk: &mut Chunk) {
+        bin_entries(chunk, self.plan.tiles_x);
     }
 
     /// Projects (unless `proj` is given), snaps, culls and sets up one triangle of clip-space
     /// vertices, with what `keep` asks for: its [`Corners`] for scalar shading, its fast-path
     /// [`Planes`] (and a textured object's [`uv_planes`]). `flat`: a flat-shaded triangle's
     /// colours, front and back.
-    pub(crate) fn setup(
+    fn setup(
         &self,
         v: [ClipVertex; 3],
         proj: Option<[Projected; 3]>,
@@ -388,8 +418,8 @@ impl Frame<'_> {
         if !keep.planes {
             return Some((s.tri, Planes::default(), corners, None));
         }
-        let mode = &self.modes[object as usize];
-        let what = self.extras[object as usize];
+        let mode = &self.plan.objects[object as usize].mode;
+        let what = self.plan.objects[object as usize].extra;
         let extra = |v: &ClipVertex| what.of(v.rgb, v.uv1, v.tangent);
         let uv = matches!(mode, Mode::Textured { .. })
             .then(|| uv_planes(&s, v.map(|v| v.uv), v.each_ref().map(extra), what));

@@ -20,6 +20,7 @@ mod sampler;
 mod tile;
 mod vector;
 
+use crate::Kernels;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
 pub use project::WindowVertex;
@@ -67,15 +68,12 @@ impl Isa {
 
     /// AVX2 and FMA where the CPU has them and `allow_avx2`, else [`Isa::PORTABLE`]; with wide
     /// registers ([`Isa::wide`]) where the CPU has AVX-512 and `allow_avx512`.
-    pub fn detect(allow_avx2: bool, allow_avx512: bool) -> Isa {
-        let avx2 = allow_avx2 && avx2_available();
+    pub fn detect(kernels: Kernels) -> Isa {
+        let avx2 = kernels != Kernels::Portable && avx2_available();
         #[cfg(target_arch = "x86_64")]
-        let wide = avx2 && allow_avx512 && avx512_available();
+        let wide = avx2 && kernels == Kernels::Auto && avx512_available();
         #[cfg(not(target_arch = "x86_64"))]
-        let wide = {
-            let _ = allow_avx512;
-            false
-        };
+        let wide = false;
         Isa { avx2, wide }
     }
 
@@ -192,7 +190,7 @@ pub fn shade_batch_textured<'p>(
         unsafe {
             // The wide build for the common form only (diffuse and specular maps, light per
             // pixel): the general and Gouraud forms' wide builds made the release build 47 s
-            // longer (BENCHMARKS.md, "The shading kernels' wide-register build").
+            // longer (benches/HISTORY.md, "The shading kernels' wide-register build").
             match (maps.full(), maps.per_vertex()) {
                 (false, false) if isa.wide() => {
                     shade_batch_textured_wide::<false, false>(prep, maps, n, lane, out, unsampled)

@@ -90,7 +90,7 @@ pub(crate) fn project_avx2<O>(
                 _mm256_set1_epi32(i32::from(NOT_FINITE)),
             ),
         );
-        // `Frame::project`, in every lane (the caller keeps it only where the code allows).
+        // `Stage::project`, in every lane (the caller keeps it only where the code allows).
         let iw = _mm256_div_ps(s(1.0), cw);
         let sx = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(cx, iw), half), half), s(wf));
         let sy = _mm256_mul_ps(_mm256_sub_ps(half, _mm256_mul_ps(_mm256_mul_ps(cy, iw), half)), s(hf));

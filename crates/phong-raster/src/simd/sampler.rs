@@ -506,7 +506,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     };
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive, nor choose a set per map
-    // (BENCHMARKS.md, "Ambient, emission, occlusion and second-set maps").
+    // (benches/HISTORY.md, "Ambient, emission, occlusion and second-set maps").
     let split = FULL && maps.split();
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
     // Gouraud: the vertices' colours interpolated, clamped per vertex where the options clamp

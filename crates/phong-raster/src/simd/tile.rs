@@ -15,7 +15,7 @@
 //! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
 //! sign bit is exactly `E − bias < 0`.
 //!
-//! Why the caller chooses it per tile (`Frame::plan_tile`, BENCHMARKS.md C4): its cost per
+//! Why the caller chooses it per tile (`Tiles::plan_tile`, BENCHMARKS.md C4): its cost per
 //! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
 //! K1–K8).
 

@@ -5,9 +5,9 @@
 //! `f32` rows or straight into an 8-bit frame's.
 
 use super::Tile;
+use super::Tiles;
 use super::visible::{Forward, Scan, visible_single};
 use crate::fixed::each3;
-use crate::frame::Frame;
 use crate::simd::{GouraudTri, Planes, TilePixel, gouraud_tile};
 use crate::stats::Marks;
 use crate::target::resolve;
@@ -48,7 +48,7 @@ impl ColorPlanes {
     }
 }
 
-impl Frame<'_> {
+impl Tiles<'_> {
     /// Draws `tile` of an all-Gouraud, one-sample frame into `rows`, by the AVX2 kernel with
     /// `kernel` (an AVX2 frame), else by the scalar loop; returns the pixels covered. Not
     /// inlined into the tile's `match` (BENCHMARKS.md, C7).
@@ -70,20 +70,24 @@ impl Frame<'_> {
         let stride = if kernel { tw.next_multiple_of(4) } else { tw };
         depth.clear();
         depth.resize(stride * tile.height(), f32::INFINITY);
-        let background = T::from_linear(resolve(std::iter::once(self.bg), 1, self.bg));
+        let background = T::from_linear(resolve(std::iter::once(self.plan.bg), 1, self.plan.bg));
         for line in rows.iter_mut() {
             line.fill(background);
         }
-        let isa = if kernel { self.isa } else { crate::simd::Isa::PORTABLE };
+        let isa = if kernel {
+            self.plan.isa
+        } else {
+            crate::simd::Isa::PORTABLE
+        };
         let triangle = |k: usize| self.gouraud_tri(bin[k], (x0, y0, x1, y1));
         if let Some(covered) = gouraud_tile(isa, (x0, y0), stride, bin.len(), triangle, depth, rows) {
             tile.clock.add(marks);
             return covered;
         }
         for &ti in bin {
-            let scan = Scan::new(self.tri(ti), 0, self.pattern[0], (x0, x1));
+            let scan = Scan::new(self.binned.tri(ti), 0, self.plan.pattern[0], (x0, x1));
             let forward = Forward {
-                planes: ColorPlanes::new(self.planes(ti)),
+                planes: ColorPlanes::new(self.binned.planes(ti)),
                 rows: &mut *rows,
             };
             visible_single::<false, T>(scan, (x0, y0, tw, y1), depth, &mut [], Some(forward), |_, _| true);
@@ -95,8 +99,8 @@ impl Frame<'_> {
     /// Triangle `ti` as the Gouraud kernel draws it into the tile `(x0, y0, x1, y1)`.
     #[inline(always)]
     fn gouraud_tri(&self, ti: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> GouraudTri<'_> {
-        let (ox, oy) = self.pattern[0];
-        let t = self.tri(ti);
+        let (ox, oy) = self.plan.pattern[0];
+        let t = self.binned.tri(ti);
         let bb = t.bbox();
         let (bx0, by0) = (bb[0].max(x0), bb[1].max(y0));
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(by0) << SUBPIXEL_BITS);
@@ -109,7 +113,7 @@ impl Frame<'_> {
             z: t.z,
             cols: (bx0 - x0, bb[2].min(x1).max(bx0) - x0),
             rows: (by0 - y0, bb[3].min(y1).max(by0) - y0),
-            planes: self.planes(ti),
+            planes: self.binned.planes(ti),
         }
     }
 }
@@ -118,7 +122,7 @@ impl Frame<'_> {
 mod tests {
     use super::super::TilePlan;
     use super::*;
-    use crate::frame::Path;
+    use crate::plan::{FramePlan, Path};
     use crate::setup::Scratch;
     use crate::stats::StageClock;
     use crate::target::encode;
@@ -201,10 +205,16 @@ scale = 300.0
             object.mesh = mesh.clone();
         }
         for (name, scene) in [("shapes", &shapes), ("soup", &soup)] {
-            let frame = Frame::build(scene, Path::Fast, avx2, &mut Scratch::default());
+            let plan = FramePlan::new(scene, Path::Fast, avx2);
+            let binned = crate::setup::run(&plan, scene, &mut Scratch::default());
+            let frame = Tiles {
+                plan: &plan,
+                scene,
+                binned: &binned,
+            };
             let clock = StageClock::default();
             let (mut drawn, mut wide, mut chosen) = (0, 0, 0);
-            for index in 0..frame.bins.len() as u32 {
+            for index in 0..binned.bins.len() as u32 {
                 let tile = frame.tile(index, &clock);
                 chosen += usize::from(frame.plan_tile(&tile) == TilePlan::Gouraud { kernel: true });
                 let (tw, th) = (tile.width(), tile.height());

@@ -13,15 +13,16 @@ mod reference;
 mod shade;
 mod visible;
 
-use crate::frame::{Frame, Path, Visibility};
+use crate::binning::Binned;
+use crate::plan::{FramePlan, Path, Visibility};
 use crate::stats::StageClock;
 use crate::target::{Pixel, TileTarget};
-use phong_core::Encoding;
 use phong_core::limits::TILE_SIZE;
+use phong_core::{Encoding, Scene};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// How a tile is drawn, decided once per tile by [`Frame::plan_tile`].
+/// How a tile is drawn, decided once per tile by [`Tiles::plan_tile`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum TilePlan {
     /// No triangle: every pixel is the background.
@@ -84,16 +85,37 @@ pub(crate) struct Multi {
     pub samples: Vec<[f32; 4]>,
 }
 
-impl Frame<'_> {
+/// Draws every tile of `plan` from `binned` into `pixels` (the frame, row-major), in
+/// parallel, its stages added to `clock`; returns the pixel shadings done.
+pub(crate) fn draw<P: Pixel>(
+    plan: &FramePlan,
+    scene: &Scene,
+    binned: &Binned,
+    pixels: &mut [P],
+    encoding: Encoding,
+    clock: &StageClock,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> u64 {
+    Tiles { plan, scene, binned }.draw_tiles(pixels, encoding, clock, progress)
+}
+
+/// What the tiles read: the frame's plan, the scene, and the set-up triangles in their bins.
+pub(crate) struct Tiles<'p> {
+    pub plan: &'p FramePlan<'p>,
+    pub scene: &'p Scene,
+    pub binned: &'p Binned,
+}
+
+impl Tiles<'_> {
     /// Tile `index` (row-major) of this frame, its stages added to `clock`.
     pub fn tile<'f>(&'f self, index: u32, clock: &'f StageClock) -> Tile<'f> {
-        let (x0, y0, x1, y1) = self.tile_rect(index);
+        let (x0, y0, x1, y1) = self.plan.tile_rect(index);
         Tile {
             x0,
             y0,
             x1,
             y1,
-            bin: &self.bins[index as usize],
+            bin: &self.binned.bins[index as usize],
             clock,
         }
     }
@@ -103,19 +125,19 @@ impl Frame<'_> {
         let n = tile.bin.len();
         if n == 0 {
             TilePlan::Empty
-        } else if self.path == Path::Reference {
+        } else if self.plan.path == Path::Reference {
             TilePlan::Reference
-        } else if self.pattern.len() > 1 {
+        } else if self.plan.pattern.len() > 1 {
             TilePlan::Multi
         } else if n == 1
-            && self.visibility[self.object(tile.bin[0])] == Visibility::Opaque
+            && self.plan.objects[self.binned.object(tile.bin[0])].visibility == Visibility::Opaque
             && self.covers_rect(tile.bin[0], (tile.x0, tile.y0, tile.x1, tile.y1))
         {
             TilePlan::Covered
-        } else if self.gouraud_only {
+        } else if self.plan.gouraud_only {
             // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop:
             // where the tile has 8 pixels per triangle or more (BENCHMARKS.md, C4).
-            let kernel = self.isa.is_avx2() && tile.width() * tile.height() >= 8 * n;
+            let kernel = self.plan.isa.is_avx2() && tile.width() * tile.height() >= 8 * n;
             TilePlan::Gouraud { kernel }
         } else {
             TilePlan::Single
@@ -137,14 +159,15 @@ impl Frame<'_> {
             // (A blended triangle reads the pixels it is laid over: not from streamed memory.)
             direct: plan == TilePlan::Reference
                 || tile.bin.is_empty()
-                || (tile.bin.len() == 1 && self.visibility[self.object(tile.bin[0])] != Visibility::Blended),
+                || (tile.bin.len() == 1
+                    && self.plan.objects[self.binned.object(tile.bin[0])].visibility != Visibility::Blended),
         };
         let TileBuffers { local, multi } = buffers;
         let Multi { depth, ids, .. } = multi;
         match plan {
             TilePlan::Empty => {
                 let marks = crate::stats::Marks::start();
-                target.fill(self.background);
+                target.fill(self.plan.background);
                 tile.clock.add(marks);
                 0
             }
@@ -165,22 +188,22 @@ impl Frame<'_> {
     /// Draws every tile into `pixels` (the frame, row-major), in parallel; returns the pixel
     /// shadings done. Tasks write their tiles' rows of the frame directly (disjoint slices), a
     /// strip of 64 rows at a time, so that nothing frame-sized exists besides the frame.
-    pub fn draw_tiles<P: Pixel>(
+    fn draw_tiles<P: Pixel>(
         &self,
         pixels: &mut [P],
         encoding: Encoding,
         clock: &StageClock,
         progress: Option<&(dyn Fn(u64, u64) + Sync)>,
     ) -> u64 {
-        let row_len = self.w as usize;
-        debug_assert_eq!(pixels.len(), row_len * self.h as usize);
-        let total = u64::from(self.tiles_x * self.h.div_ceil(TILE_SIZE));
+        let row_len = self.plan.w as usize;
+        debug_assert_eq!(pixels.len(), row_len * self.plan.h as usize);
+        let total = u64::from(self.plan.tiles_x * self.plan.h.div_ceil(TILE_SIZE));
         let (done, shaded) = (AtomicU64::new(0), AtomicU64::new(0));
         pixels
             .par_chunks_mut(TILE_SIZE as usize * row_len)
             .enumerate()
             .for_each(|(ty, strip)| {
-                let mut tiles: Vec<Vec<&mut [P]>> = (0..self.tiles_x).map(|_| Vec::new()).collect();
+                let mut tiles: Vec<Vec<&mut [P]>> = (0..self.plan.tiles_x).map(|_| Vec::new()).collect();
                 for row in strip.chunks_mut(row_len) {
                     for (tx, piece) in row.chunks_mut(TILE_SIZE as usize).enumerate() {
                         tiles[tx].push(piece);
@@ -190,7 +213,7 @@ impl Frame<'_> {
                     .into_par_iter()
                     .enumerate()
                     .for_each_init(TileBuffers::default, |buffers, (tx, mut rows)| {
-                        let tile = self.tile(ty as u32 * self.tiles_x + tx as u32, clock);
+                        let tile = self.tile(ty as u32 * self.plan.tiles_x + tx as u32, clock);
                         let n = self.draw_tile(&tile, &mut rows, encoding, buffers);
                         shaded.fetch_add(n, Ordering::Relaxed);
                         let d = done.fetch_add(1, Ordering::Relaxed) + 1;

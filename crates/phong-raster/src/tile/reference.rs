@@ -5,34 +5,34 @@
 //! their alpha (`GL_ONE_MINUS_SRC_ALPHA`, in premultiplied form) without writing depth.
 
 use super::Tile;
+use super::Tiles;
 use crate::fixed::map3;
-use crate::frame::Frame;
 use crate::stats::Marks;
 use crate::target::resolve;
 use phong_core::limits::SUBPIXEL_BITS;
 
-impl Frame<'_> {
+impl Tiles<'_> {
     /// Draws and resolves `tile` into `rows`; returns the pixel shadings done (overdraw
     /// included). Rasterising and shading are interleaved, so both count as its `raster` stage.
     pub(super) fn tile_reference(&self, tile: &Tile, rows: &mut [&mut [[f32; 4]]]) -> u64 {
         let mut marks = Marks::start();
         let Tile { x0, y0, x1, y1, .. } = *tile;
         let (tw, th) = (tile.width(), tile.height());
-        let ns = self.pattern.len();
-        let mut color = vec![self.bg; tw * th * ns];
+        let ns = self.plan.pattern.len();
+        let mut color = vec![self.plan.bg; tw * th * ns];
         let mut depth = vec![f32::INFINITY; tw * th * ns];
         let mut shaded = 0u64;
         let mut zs = [0f32; 16];
         for &ti in tile.bin {
-            let t = self.tri(ti);
-            let blends = self.scene.objects[self.object(ti)].blends();
+            let t = self.binned.tri(ti);
+            let blends = self.scene.objects[self.binned.object(ti)].blends();
             let bb = t.bbox();
             let (bx0, by0, bx1, by1) = (bb[0].max(x0), bb[1].max(y0), bb[2].min(x1), bb[3].min(y1));
             for py in by0..by1 {
                 for px in bx0..bx1 {
                     let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
                     let mut mask = 0u32;
-                    for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
+                    for (s, &(ox, oy)) in self.plan.pattern.iter().enumerate() {
                         let sx = (i64::from(px) << SUBPIXEL_BITS) + ox;
                         let sy = (i64::from(py) << SUBPIXEL_BITS) + oy;
                         let Some(e) = t.covers(sx, sy) else {
@@ -69,7 +69,7 @@ impl Frame<'_> {
         marks.shading();
         marks.resolving();
         for (px, o) in color.chunks_exact(ns).zip(rows.iter_mut().flat_map(|r| r.iter_mut())) {
-            *o = resolve(px.iter().copied(), ns, self.bg);
+            *o = resolve(px.iter().copied(), ns, self.plan.bg);
         }
         tile.clock.add(marks);
         shaded

@@ -3,15 +3,16 @@
 //!
 //! Phong and Gouraud pixels are shaded by the vector kernels: with one sample, sorted by
 //! triangle so that each triangle's whole vectors share its plane coefficients
-//! ([`shade_group`]), the rest gathered lane by lane ([`Frame::shade_gathered`]); with
+//! ([`shade_group`]), the rest gathered lane by lane ([`Tiles::shade_gathered`]); with
 //! several, one job per visible (pixel, triangle), gathered, then the reference's resolve.
 
+use super::Tiles;
 use super::reference::over;
 use super::visible::{Bits, FORWARD};
 use super::{Multi, Tile};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, each3, map3};
-use crate::frame::{Frame, Mode, lit_term};
+use crate::plan::{Mode, lit_term};
 use crate::setup::{Corners, Tri};
 use crate::simd::kernel::pixel_centre;
 use crate::simd::{
@@ -49,7 +50,7 @@ pub(super) fn run_length(ids: &[u32], k: u32) -> usize {
 /// in the tile's jobs.
 type TexturedJobs = (Vec<(u32, u32)>, Vec<u32>);
 
-impl Frame<'_> {
+impl Tiles<'_> {
     /// Shades, by object, pixels whose triangles differ lane to lane (each lane gathers its
     /// triangle's planes): `batches[object]` are the items, `lane(item)` gives a pixel's centre
     /// and planes, `out(item, rgb)` takes its colour. Scalar-shaded objects are skipped.
@@ -60,11 +61,11 @@ impl Frame<'_> {
         mut out: impl FnMut(T, [f32; 3]),
     ) {
         for (object, batch) in batches.iter().enumerate() {
-            let Some(kind) = self.modes[object].batch() else {
+            let Some(kind) = self.plan.objects[object].mode.batch() else {
                 continue;
             };
             shade_batch(
-                self.isa,
+                self.plan.isa,
                 kind,
                 batch.len(),
                 |i| lane(batch[i]),
@@ -89,7 +90,7 @@ impl Frame<'_> {
     ) -> u64 {
         let (bin, x0, y0) = (tile.bin, tile.x0, tile.y0);
         let (tw, th) = (tile.width(), tile.height());
-        let background = resolve(std::iter::once(self.bg), 1, self.bg);
+        let background = resolve(std::iter::once(self.plan.bg), 1, self.plan.bg);
         // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
         // where its pixels end in `order`. Runs are `(row << 16 | first column, length, k)`.
         let mut starts = vec![0u32; bin.len() + 1];
@@ -133,22 +134,22 @@ impl Frame<'_> {
         let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
         let mut textured: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
-        let group = group_lanes(self.isa);
+        let group = group_lanes(self.plan.isa);
         let mut unsampled = Vec::new();
         for (k, &id) in bin.iter().enumerate() {
             let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
             if pixels.is_empty() {
                 continue;
             }
-            let object = self.object(id);
-            if let Mode::Textured { prep, .. } = &self.modes[object] {
+            let object = self.binned.object(id);
+            if let Mode::Textured { prep, .. } = &self.plan.objects[object].mode {
                 // Whole vectors of one triangle with its planes broadcast where the vector
                 // sampler covers the maps; the rest batched with the object's other pixels.
-                let done = match &self.vector_maps[object] {
+                let done = match &self.plan.objects[object].maps {
                     Some(maps) if pixels.len() >= group => shade_group_textured(
-                        self.isa,
+                        self.plan.isa,
                         (prep, maps),
-                        (self.planes(id), self.uv_planes(id)),
+                        (self.binned.planes(id), self.binned.uv_planes(id)),
                         (x0, y0),
                         pixels,
                         |p, rgb| {
@@ -168,12 +169,14 @@ impl Frame<'_> {
                 textured[object].extend(pixels[done..].iter().map(|&p| (p, id)));
                 continue;
             }
-            let Some(kind) = self.modes[object].batch() else {
+            let Some(kind) = self.plan.objects[object].mode.batch() else {
                 for &p in pixels {
                     let (r, c) = at(p);
                     // Frames with an alpha test are the reference path's: nothing is discarded here.
-                    let color = self.shade_pixel(id, x0 + c as u32, y0 + r as u32).unwrap_or(self.bg);
-                    out[r][c] = resolve(std::iter::once(color), 1, self.bg);
+                    let color = self
+                        .shade_pixel(id, x0 + c as u32, y0 + r as u32)
+                        .unwrap_or(self.plan.bg);
+                    out[r][c] = resolve(std::iter::once(color), 1, self.plan.bg);
                 }
                 continue;
             };
@@ -182,10 +185,17 @@ impl Frame<'_> {
             let done = if pixels.len() < group {
                 0
             } else {
-                shade_group(self.isa, kind, self.planes(id), (x0, y0), pixels, |p, rgb| {
-                    let (r, c) = at(p);
-                    out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
-                })
+                shade_group(
+                    self.plan.isa,
+                    kind,
+                    self.binned.planes(id),
+                    (x0, y0),
+                    pixels,
+                    |p, rgb| {
+                        let (r, c) = at(p);
+                        out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                    },
+                )
             };
             rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
         }
@@ -193,7 +203,7 @@ impl Frame<'_> {
             &rest,
             |(p, id)| {
                 let (x, y) = pixel_centre((x0, y0), p);
-                (x, y, self.planes(id))
+                (x, y, self.binned.planes(id))
             },
             |(p, _), rgb| {
                 let (r, c) = at(p);
@@ -201,7 +211,7 @@ impl Frame<'_> {
             },
         );
         for (object, items) in textured.iter().enumerate() {
-            let Mode::Textured { prep, .. } = &self.modes[object] else {
+            let Mode::Textured { prep, .. } = &self.plan.objects[object].mode else {
                 continue;
             };
             self.shade_textured_batch(object, prep, items, x0, y0, |i, rgb| {
@@ -215,7 +225,7 @@ impl Frame<'_> {
 
     /// Shades a textured object's pixels `items` (`(row << 16 | column, triangle id)` in the
     /// tile at `(x0, y0)`): by the vector sampler where it covers the maps, else their light by
-    /// the vector kernel and their maps sampled per pixel ([`Frame::textured_color`]).
+    /// the vector kernel and their maps sampled per pixel ([`Tiles::textured_color`]).
     /// `out(i, rgb)` takes item `i`'s colour.
     fn shade_textured_batch(
         &self,
@@ -227,17 +237,17 @@ impl Frame<'_> {
         mut out: impl FnMut(usize, [f32; 3]),
     ) {
         let tinted = !self.scene.objects[object].mesh.colors().is_empty();
-        if let Some(maps) = &self.vector_maps[object] {
+        if let Some(maps) = &self.plan.objects[object].maps {
             let mut unsampled = Vec::new();
             shade_batch_textured(
-                self.isa,
+                self.plan.isa,
                 prep,
                 maps,
                 items.len(),
                 |i| {
                     let (p, id) = items[i];
                     let (x, y) = pixel_centre((x0, y0), p);
-                    (x, y, self.planes(id), self.uv_planes(id))
+                    (x, y, self.binned.planes(id), self.binned.uv_planes(id))
                 },
                 &mut out,
                 &mut unsampled,
@@ -248,13 +258,13 @@ impl Frame<'_> {
             return;
         }
         shade_batch_lit(
-            self.isa,
+            self.plan.isa,
             prep,
             items.len(),
             |i| {
                 let (p, id) = items[i];
                 let (x, y) = pixel_centre((x0, y0), p);
-                (x, y, self.planes(id))
+                (x, y, self.binned.planes(id))
             },
             |i, primary, specular| {
                 out(
@@ -280,8 +290,8 @@ impl Frame<'_> {
     ) -> [f32; 3] {
         let obj = &self.scene.objects[object];
         let (x, y) = pixel_centre(origin, p);
-        let ([first, second], rgb) = uv_from_planes(self.uv_planes(id), x, y);
-        let mut texels = if self.second_sets[object] {
+        let ([first, second], rgb) = uv_from_planes(self.binned.uv_planes(id), x, y);
+        let mut texels = if self.plan.objects[object].second_set {
             obj.maps.sample_sets(&[first, second])
         } else {
             obj.maps.sample(first[0], first[1], first[2])
@@ -292,7 +302,7 @@ impl Frame<'_> {
         // As `phong_core::light` splits them: the emission and the ambient terms apart where
         // maps of their own modulate them (the light was prepared so: `emission_apart`); never
         // for light made per vertex (Gouraud: only the diffuse and specular maps apply).
-        let per_vertex = matches!(self.modes[object], Mode::Textured { per_vertex: true, .. });
+        let per_vertex = matches!(self.plan.objects[object].mode, Mode::Textured { per_vertex: true, .. });
         let (emission_apart, ambient_apart) = if per_vertex { (false, false) } else { obj.maps.apart() };
         let lit = Lit {
             primary: Color::new(primary[0], primary[1], primary[2]),
@@ -333,7 +343,7 @@ impl Frame<'_> {
         } = work;
         let (x0, y0) = (tile.x0, tile.y0);
         let (tw, th) = (tile.width(), tile.height());
-        let ns = self.pattern.len();
+        let ns = self.plan.pattern.len();
         // The pixel as `row << 16 | column` in the tile (no division to find it again); a
         // pixel's jobs are contiguous.
         jobs.clear();
@@ -359,17 +369,17 @@ impl Frame<'_> {
         // Per textured object, its jobs `(pixel, triangle)` and where each is in `jobs`.
         let mut textured: Vec<TexturedJobs> = vec![Default::default(); self.scene.objects.len()];
         for (k, &(pixel, ti)) in jobs.iter().enumerate() {
-            match self.modes[self.object(ti)] {
+            match self.plan.objects[self.binned.object(ti)].mode {
                 Mode::Scalar => {
                     let (px, py) = at(pixel);
-                    colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.bg);
+                    colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.plan.bg);
                 }
                 Mode::Textured { .. } => {
-                    let (items, at) = &mut textured[self.object(ti)];
+                    let (items, at) = &mut textured[self.binned.object(ti)];
                     items.push((pixel, ti));
                     at.push(k as u32);
                 }
-                _ => batches[self.object(ti)].push(k as u32),
+                _ => batches[self.binned.object(ti)].push(k as u32),
             }
         }
         self.shade_gathered(
@@ -377,12 +387,12 @@ impl Frame<'_> {
             |k| {
                 let (pixel, ti) = jobs[k as usize];
                 let (x, y) = pixel_centre((x0, y0), pixel);
-                (x, y, self.planes(ti))
+                (x, y, self.binned.planes(ti))
             },
             |k, rgb| colors[k as usize] = [rgb[0], rgb[1], rgb[2], 1.0],
         );
         for (object, (items, at)) in textured.iter().enumerate() {
-            if let Mode::Textured { prep, .. } = &self.modes[object] {
+            if let Mode::Textured { prep, .. } = &self.plan.objects[object].mode {
                 self.shade_textured_batch(object, prep, items, x0, y0, |i, rgb| {
                     colors[at[i] as usize] = [rgb[0], rgb[1], rgb[2], 1.0];
                 });
@@ -397,18 +407,18 @@ impl Frame<'_> {
             let mine = &jobs[starts[pixel]..starts[pixel + 1]];
             let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
                 if id == u32::MAX {
-                    self.bg
+                    self.plan.bg
                 } else {
                     colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
                 }
             });
-            *o = resolve(samples, ns, self.bg);
+            *o = resolve(samples, ns, self.plan.bg);
         }
         tile.clock.add(marks);
         jobs.len() as u64
     }
 
-    /// [`Frame::shade_multi`]'s end where the tile has `blended` triangles (blended objects', in
+    /// [`Tiles::shade_multi`]'s end where the tile has `blended` triangles (blended objects', in
     /// drawing order): each sample's colour, the blended triangles laid over the samples they
     /// cover nearer than the opaque depth (as the reference path lays them), then the resolve.
     /// Returns the shadings done. (Apart, so that the opaque tiles' code stays as it was.)
@@ -429,13 +439,13 @@ impl Frame<'_> {
             colors,
             samples,
         } = work;
-        let ns = self.pattern.len();
+        let ns = self.plan.pattern.len();
         samples.clear();
         for (pixel, ids) in ids.chunks_exact(ns).enumerate() {
             let mine = &jobs[starts[pixel]..starts[pixel + 1]];
             samples.extend(ids.iter().map(|&id| {
                 if id == u32::MAX {
-                    self.bg
+                    self.plan.bg
                 } else {
                     colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
                 }
@@ -443,7 +453,7 @@ impl Frame<'_> {
         }
         let mut shaded = jobs.len() as u64;
         for &ti in blended {
-            self.covered_multi(self.tri(ti), tile, |px, py, base, zs, covered| {
+            self.covered_multi(self.binned.tri(ti), tile, |px, py, base, zs, covered| {
                 let mut mask = 0u32;
                 for s in Bits(covered) {
                     mask |= u32::from(zs[s] < depth[base + s]) << s;
@@ -462,7 +472,7 @@ impl Frame<'_> {
         marks.resolving();
         let out = rows.iter_mut().flat_map(|r| r.iter_mut());
         for (px, o) in samples.chunks_exact(ns).zip(out) {
-            *o = resolve(px.iter().copied(), ns, self.bg);
+            *o = resolve(px.iter().copied(), ns, self.plan.bg);
         }
         tile.clock.add(marks);
         shaded
@@ -506,8 +516,8 @@ impl Frame<'_> {
     /// a textured object its texels applied as `shade_textured` does; `None` where the alpha
     /// test discards the point.
     pub(crate) fn shade_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
-        let (t, corners) = (self.tri(id), self.corners(id));
-        let obj = &self.scene.objects[self.object(id)];
+        let (t, corners) = (self.binned.tri(id), self.binned.corners(id));
+        let obj = &self.scene.objects[self.binned.object(id)];
         if obj.textured() && lit_term(obj.shading.output).is_some() {
             return self.shade_textured_pixel(id, px, py);
         }
@@ -515,7 +525,7 @@ impl Frame<'_> {
         let v = &corners.v;
         let lerp3 = |f: fn(&ClipVertex) -> Vec3| f(&v[0]) * q[0] + f(&v[1]) * q[1] + f(&v[2]) * q[2];
         let scene = self.scene;
-        let obj = &scene.objects[self.object(id)];
+        let obj = &scene.objects[self.binned.object(id)];
         let output = obj.shading.output;
         let c = match output {
             Output::Normal => {
@@ -540,7 +550,7 @@ impl Frame<'_> {
                 _ => {
                     let n = lerp3(|v| v.normal);
                     let n = if t.back { -n } else { n };
-                    let view = &self.views[self.object(id)];
+                    let view = &self.plan.objects[self.binned.object(id)].view;
                     output.term(&obj.shade(&scene.lighting, view, lerp3(|v| v.world), n))
                 }
             },
@@ -549,19 +559,19 @@ impl Frame<'_> {
     }
 
     /// Whether triangle `id` (an alpha-tested object's) passes the alpha test at the centre of
-    /// pixel `(px, py)`: the alpha [`Frame::shade_pixel`] tests, from the same coordinates.
+    /// pixel `(px, py)`: the alpha [`Tiles::shade_pixel`] tests, from the same coordinates.
     pub(crate) fn alpha_passes(&self, id: u32, px: u32, py: u32) -> bool {
-        let obj = &self.scene.objects[self.object(id)];
+        let obj = &self.scene.objects[self.binned.object(id)];
         !obj.maps
             .discards(obj.maps.alpha_sets(&obj.material, &self.uv_sets(id, px, py)))
     }
 
     /// Triangle `id`'s two sets of texture coordinates (the first twice where no map reads the
-    /// second) at the centre of pixel `(px, py)`, as [`Frame::uv_at`] gives them.
+    /// second) at the centre of pixel `(px, py)`, as [`Tiles::uv_at`] gives them.
     fn uv_sets(&self, id: u32, px: u32, py: u32) -> [[Vec2; 3]; 2] {
-        let (t, corners) = (self.tri(id), self.corners(id));
+        let (t, corners) = (self.binned.tri(id), self.binned.corners(id));
         let first = Self::uv_at(t, corners, px, py, |v| v.uv);
-        let second = if self.second_sets[self.object(id)] {
+        let second = if self.plan.objects[self.binned.object(id)].second_set {
             Self::uv_at(t, corners, px, py, |v| v.uv1)
         } else {
             first
@@ -569,13 +579,13 @@ impl Frame<'_> {
         [first, second]
     }
 
-    /// [`Frame::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
+    /// [`Tiles::shade_pixel`] for a textured object's lit outputs: its maps sampled at the
     /// pixel's texture coordinates with their exact derivatives, then applied to the light per
     /// pixel (Phong: `shade_textured`) or to the primary and specular colours made per vertex
     /// or triangle (Gouraud, flat: OpenGL's `GL_MODULATE` with a separate specular colour).
     fn shade_textured_pixel(&self, id: u32, px: u32, py: u32) -> Option<[f32; 4]> {
-        let (t, corners) = (self.tri(id), self.corners(id));
-        let object = self.object(id);
+        let (t, corners) = (self.binned.tri(id), self.binned.corners(id));
+        let object = self.binned.object(id);
         let obj = &self.scene.objects[object];
         let sets = self.uv_sets(id, px, py);
         let q = Self::weights(t, corners, px, py);
@@ -632,7 +642,7 @@ impl Frame<'_> {
                     two_sided: false,
                     ..obj.shading.options
                 };
-                let view = &self.views[self.object(id)];
+                let view = &self.plan.objects[self.binned.object(id)].view;
                 let s = shade_textured(&point, view, &obj.material, &texels, &self.scene.lighting, &options);
                 obj.shading.output.term(&s)
             }

@@ -2,15 +2,16 @@
 //! coverage and depth arithmetic (exact integer edge functions stepped incrementally, the same
 //! barycentrics and depths), so the same triangle wins every sample.
 //!
-//! With one sample ([`Frame::tile_single`]) wide rows first find their covered span exactly,
+//! With one sample ([`Tiles::tile_single`]) wide rows first find their covered span exactly,
 //! and Gouraud triangles colour their pixels as they pass (see [`Forward`]); with several
-//! ([`Frame::tile_multi`]) each sample is tested in turn.
+//! ([`Tiles::tile_multi`]) each sample is tested in turn.
 
+use super::Tiles;
 use super::gouraud::ColorPlanes;
 use super::reference::over;
 use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
-use crate::frame::{Frame, Mode, Visibility};
+use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
 use crate::simd::{TilePixel, covered_span};
 use crate::stats::Marks;
@@ -55,12 +56,12 @@ impl<'t> Scan<'t> {
     }
 }
 
-impl Frame<'_> {
+impl Tiles<'_> {
     /// Whether triangle `id` covers the centre of every pixel of the rectangle `(x0, y0, x1, y1)`
     /// (exclusive max) by the top-left rule: the four corner pixels are covered, and the
     /// triangle is convex.
     pub(crate) fn covers_rect(&self, id: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> bool {
-        let t = self.tri(id);
+        let t = self.binned.tri(id);
         let centre = |p: u32| (i64::from(p) << SUBPIXEL_BITS) + HALF;
         [(x0, y0), (x1 - 1, y0), (x0, y1 - 1), (x1 - 1, y1 - 1)]
             .iter()
@@ -86,7 +87,7 @@ impl Frame<'_> {
 
     /// [`TilePlan::Single`](super::TilePlan::Single): one sample a pixel. `ids` gets, per
     /// pixel, the index in the bin of its visible triangle, or [`FORWARD`] where a Gouraud
-    /// triangle coloured it, or `u32::MAX` (background); then [`Frame::shade_single`].
+    /// triangle coloured it, or `u32::MAX` (background); then [`Tiles::shade_single`].
     pub(super) fn tile_single(
         &self,
         tile: &Tile,
@@ -105,8 +106,8 @@ impl Frame<'_> {
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque image.
         let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
-            let scan = Scan::new(self.tri(ti), k as u32, self.pattern[0], (tile.x0, tile.x1));
-            match self.visibility[self.object(ti)] {
+            let scan = Scan::new(self.binned.tri(ti), k as u32, self.plan.pattern[0], (tile.x0, tile.x1));
+            match self.plan.objects[self.binned.object(ti)].visibility {
                 Visibility::Blended => {
                     blended = k;
                     break;
@@ -115,9 +116,9 @@ impl Frame<'_> {
                     let passes = |px, py| self.alpha_passes(ti, px, py);
                     visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, passes);
                 }
-                Visibility::Opaque if matches!(self.modes[self.object(ti)], Mode::Gouraud) => {
+                Visibility::Opaque if matches!(self.plan.objects[self.binned.object(ti)].mode, Mode::Gouraud) => {
                     let forward = Forward {
-                        planes: ColorPlanes::new(self.planes(ti)),
+                        planes: ColorPlanes::new(self.binned.planes(ti)),
                         rows: &mut *rows,
                     };
                     visible_single::<true, _>(scan, span, depth, ids, Some(forward), |_, _| true);
@@ -132,21 +133,21 @@ impl Frame<'_> {
 
     /// Blends `bin`'s triangles (blended objects', in drawing order) over the shaded tile
     /// `rows`, where nearer than `depth` (the opaque triangles'), as the reference path does:
-    /// each point shaded by [`Frame::shade_pixel`] and laid `over` the pixel, depth unchanged.
+    /// each point shaded by [`Tiles::shade_pixel`] and laid `over` the pixel, depth unchanged.
     /// Returns the shadings done.
     fn blend_single(&self, tile: &Tile, bin: &[u32], depth: &[f32], rows: &mut [&mut [[f32; 4]]]) -> u64 {
         let mut shaded = 0;
         let tw = tile.width();
         for &ti in bin {
-            let t = self.tri(ti);
-            let scan = Scan::new(t, 0, self.pattern[0], (tile.x0, tile.x1));
+            let t = self.binned.tri(ti);
+            let scan = Scan::new(t, 0, self.plan.pattern[0], (tile.x0, tile.x1));
             covered_single(scan, (tile.x0, tile.y0, tw, tile.y1), |px, py, zz| {
                 let at = (py - tile.y0) as usize * tw + (px - tile.x0) as usize;
                 if zz < depth[at] {
                     shaded += 1;
                     if let Some(c) = self.shade_pixel(ti, px, py) {
                         let o = &mut rows[(py - tile.y0) as usize][(px - tile.x0) as usize];
-                        *o = resolve(std::iter::once(over(c, *o)), 1, self.bg);
+                        *o = resolve(std::iter::once(over(c, *o)), 1, self.plan.bg);
                     }
                 }
             });
@@ -156,13 +157,13 @@ impl Frame<'_> {
 
     /// [`TilePlan::Multi`](super::TilePlan::Multi): several samples a pixel. `ids` gets, per
     /// sample, the packed id of its visible triangle or `u32::MAX`; then
-    /// [`Frame::shade_multi`].
+    /// [`Tiles::shade_multi`].
     pub(super) fn tile_multi(&self, tile: &Tile, rows: &mut [&mut [[f32; 4]]], work: &mut Multi) -> u64 {
         let Multi { depth, ids, .. } = work;
         let mut marks = Marks::start();
         let Tile { x0, y0, x1, y1, .. } = *tile;
         let tw = tile.width();
-        let ns = self.pattern.len();
+        let ns = self.plan.pattern.len();
         depth.clear();
         depth.resize(tw * tile.height() * ns, f32::INFINITY);
         ids.clear();
@@ -171,8 +172,8 @@ impl Frame<'_> {
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque samples.
         let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
-            let t = self.tri(ti);
-            match self.visibility[self.object(ti)] {
+            let t = self.binned.tri(ti);
+            match self.plan.objects[self.binned.object(ti)].visibility {
                 Visibility::Blended => {
                     blended = k;
                     break;
@@ -198,7 +199,7 @@ impl Frame<'_> {
             }
             // Per sample an offset from the pixel corner, per pixel a step of `a·256`: exact
             // integer adds, the reference's values.
-            for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
+            for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.plan.pattern) {
                 *o = each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
             }
             let step = each3(|i| t.a(i) << SUBPIXEL_BITS);
@@ -236,13 +237,13 @@ impl Frame<'_> {
     /// Each pixel of `tile` with a sample that triangle `t` covers, handed to
     /// `pixel(px, py, base, depths, covered)`: `base` indexes its first sample in the tile's
     /// buffers, `covered` has bit `s` set for each covered sample and `depths[s]` its depth
-    /// ([`Frame::tile_multi`]'s arithmetic, without the depth test).
+    /// ([`Tiles::tile_multi`]'s arithmetic, without the depth test).
     #[inline(never)]
     pub(super) fn covered_multi(&self, t: &Tri, tile: &Tile, mut pixel: impl FnMut(u32, u32, usize, &[f32; 16], u32)) {
         let Tile { x0, y0, x1, y1, .. } = *tile;
-        let (tw, ns) = (tile.width(), self.pattern.len());
+        let (tw, ns) = (tile.width(), self.plan.pattern.len());
         let mut offsets = [[0i64; 3]; 16];
-        for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.pattern) {
+        for (o, &(ox, oy)) in offsets.iter_mut().zip(&self.plan.pattern) {
             *o = each3(|i| t.a(i) * ox + t.b(i) * oy - t.bias(i));
         }
         let step = each3(|i| t.a(i) << SUBPIXEL_BITS);

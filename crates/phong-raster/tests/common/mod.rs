@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 use phong_core::Color;
+use phong_raster::Kernels;
 
 /// A small deterministic generator (a 64-bit LCG): the tests' random scenes are reproducible.
 pub struct Rng(pub u64);
@@ -35,7 +36,7 @@ impl Rng {
 #[allow(dead_code)] // each test file uses part of it
 pub fn isas() -> Vec<phong_raster::internals::Isa> {
     use phong_raster::internals::Isa;
-    let avx2 = Isa::detect(true, true);
+    let avx2 = Isa::detect(phong_raster::Kernels::Auto);
     if !avx2.is_avx2() {
         assert!(
             std::env::var_os("PHONG_REQUIRE_AVX2").is_none_or(|v| v != "1"),
@@ -76,26 +77,26 @@ impl CpuPath {
 /// AVX2 build, the last with 3 threads (images do not depend on the thread count).
 #[allow(dead_code)]
 pub fn paths() -> Vec<CpuPath> {
-    let options = |reference, no_avx2, threads| phong_raster::RenderOptions {
+    let options = |reference, kernels, threads| phong_raster::RenderOptions {
         reference,
-        no_avx2,
+        kernels,
         threads: Some(threads),
         ..Default::default()
     };
     let mut v = vec![
         CpuPath {
             name: "reference",
-            options: options(true, false, 1),
+            options: options(true, Kernels::Auto, 1),
         },
         CpuPath {
             name: "fast, portable",
-            options: options(false, true, 1),
+            options: options(false, Kernels::Portable, 1),
         },
     ];
     if isas().len() > 1 {
         v.push(CpuPath {
             name: "fast, AVX2",
-            options: options(false, false, 3),
+            options: options(false, Kernels::Auto, 3),
         });
     }
     v
