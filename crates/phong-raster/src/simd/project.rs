@@ -3,6 +3,9 @@
 //! multiply-adds, exact divisions), so the same bits (tested against `vertex`'s scalar loop,
 //! edge cases included). Why it exists: BENCHMARKS.md, C8.
 
+// Elsewhere than x86-64 only the scalar fallback of this module is compiled.
+#![cfg_attr(not(target_arch = "x86_64"), allow(dead_code, unused_imports))]
+
 use crate::clip::{NOT_FINITE, OUTSIDE_CLIP};
 use glam::{Mat4, Vec3};
 use phong_core::limits::GUARD_BAND;

@@ -19,6 +19,9 @@
 //! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
 //! K1–K8).
 
+// Elsewhere than x86-64 only the scalar fallback of this module is compiled.
+#![cfg_attr(not(target_arch = "x86_64"), allow(dead_code, unused_imports))]
+
 use super::Isa;
 use super::kernel::Planes;
 
