@@ -892,7 +892,8 @@ fn loading_an_obj_renders_it() {
             s.idle().await?;
             s.js("window.phong.probe = null; return true;").await?;
             let frame = s.client.find(Locator::Id("frame")).await?;
-            s.gesture(frame, (0.0, 0.0), &[], 0).await?;
+            // Beside the centre, where the headlight's marker is.
+            s.gesture(frame, (25.0, 20.0), &[], 0).await?;
             let t0 = Instant::now();
             loop {
                 let p = s.js("return window.phong.probe || null;").await?;

@@ -201,7 +201,7 @@ fn view_flags() {
     for (i, extra) in [
         &["--view", "top"][..],
         &["--view", "back"],
-        &["--up", "z"],
+        &["--up", "x"],
         &["--camera", "3,3,3,0,0,0"],
     ]
     .iter()

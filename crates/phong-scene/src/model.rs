@@ -167,12 +167,15 @@ pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(DVec3, f64)> {
 }
 
 /// The lights of a model alone, `(direction, grey level)` in the default view's camera frame
-/// (x right, y up, z toward the viewer): key, fill and back. They turn with the camera, so
-/// every view is lit alike.
-const MODEL_LIGHTS: [([f32; 3], f32); 3] = [
+/// (x right, y up, z toward the viewer): key, fill, back and a headlight. They turn with the
+/// camera, so every view is lit alike.
+const MODEL_LIGHTS: [([f32; 3], f32); 4] = [
     ([1.0, -1.0, -1.0], 0.8),
     ([-1.0, -0.3, -0.5], 0.35),
     ([0.0, -0.5, 1.0], 0.3),
+    // A headlight, from the camera along its axis: every face the camera sees is lit by it,
+    // so none is lost in the background (as most model viewers light).
+    ([-DEFAULT_VIEW.x, -DEFAULT_VIEW.y, -DEFAULT_VIEW.z], 0.2),
 ];
 
 /// The background of a model alone.
@@ -231,11 +234,11 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         Some(a) => a,
         None if gltf => Axis::Y,
         None => {
-            let a = detect_up(parts);
+            let (a, why) = detect_up(parts);
             notes.push(format!(
                 "up axis {} (detected{}; --up to choose)",
                 a.name(),
-                if a == Axis::Z { ": a flat base facing -z" } else { "" }
+                why.map(|w| format!(": {w}")).unwrap_or_default()
             ));
             a
         }
@@ -506,16 +509,19 @@ fn detect_front(parts: &[ObjPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(
     (n > 0 && depth > 0.0 && sum / n as f64 - middle < -0.1 * depth).then_some((-f, "its top, a head, leans that way"))
 }
 
-/// The up axis: z where the model stands on a flat base facing −z (faces within 18° of −z in
-/// the lowest 2% of its height hold at least 2% of its area, and 3 times the area that faces
-/// −y in its lowest 2% along y), else y.
-fn detect_up(parts: &[ObjPart]) -> Axis {
+/// The up axis, and why where it is not y. Long along y and round across (y at least twice
+/// the other two extents, which are within a factor of 2 of each other): y. Long along z and
+/// round across (a bottle, a figure, a column scanned z up; taken y up, it would be seen
+/// end-on): z. Standing on a flat base facing −z (faces within 18° of −z in the lowest 2% of
+/// its height hold at least 2% of its area, and 3 times the area that faces −y in its lowest
+/// 2% along y): z. Else y.
+fn detect_up(parts: &[ObjPart]) -> (Axis, Option<&'static str>) {
     let Some((lo, hi)) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
     else {
-        return Axis::Y;
+        return (Axis::Y, None);
     };
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let ext = hi - lo;
@@ -540,10 +546,17 @@ fn detect_up(parts: &[ObjPart]) -> Axis {
             }
         }
     }
-    if total > 0.0 && base_z >= 0.02 * total && base_z > 3.0 * base_y {
-        Axis::Z
+    // Long along `along`, round across the other two.
+    let long = |along: f64, a: f64, b: f64| along >= 2.0 * a.max(b) && a.min(b) >= 0.5 * a.max(b);
+    if long(ext.y, ext.x, ext.z) {
+        // Standing y up as the convention has it (a lying one's side may be a flat facet).
+        (Axis::Y, None)
+    } else if long(ext.z, ext.x, ext.y) {
+        (Axis::Z, Some("long along z, round across"))
+    } else if total > 0.0 && base_z >= 0.02 * total && base_z > 3.0 * base_y {
+        (Axis::Z, Some("a flat base facing -z"))
     } else {
-        Axis::Y
+        (Axis::Y, None)
     }
 }
 

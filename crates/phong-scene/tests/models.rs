@@ -1107,3 +1107,198 @@ fn mtl_values_exporters_write() {
     assert_eq!(m.shininess(), 10.0);
     assert!(!w.iter().any(|w| w.contains("highlight")), "{w:?}");
 }
+
+/// A bottle as a scanner gives it: a surface of revolution `length` long and 0.07 wide, with a
+/// rounded bottom (no flat base) and a neck, its axis along `axis` (0 x, 1 y, 2 z); positions
+/// and triangles.
+fn bottle(axis: usize, length: f32) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let (rings, around) = (24, 16);
+    // Radius along the axis: a hemisphere, the body, a shoulder, the neck.
+    let radius = |t: f32| {
+        let r = 0.035;
+        let z = t * length;
+        if z < r {
+            (r * r - (r - z) * (r - z)).max(0.0).sqrt()
+        } else if t < 0.7 {
+            r
+        } else if t < 0.85 {
+            r - (t - 0.7) / 0.15 * 0.02
+        } else {
+            0.015
+        }
+    };
+    let mut positions = Vec::new();
+    for i in 0..=rings {
+        let t = i as f32 / rings as f32;
+        for j in 0..around {
+            let a = j as f32 / around as f32 * std::f32::consts::TAU;
+            let (u, v, w) = (radius(t) * a.cos(), radius(t) * a.sin(), t * length);
+            // The axis coordinate `w`, the other two in order (a right-handed frame).
+            let mut p = [0.0; 3];
+            p[axis] = w;
+            p[(axis + 1) % 3] = u;
+            p[(axis + 2) % 3] = v;
+            positions.push(Vec3::from_array(p));
+        }
+    }
+    let mut tris = Vec::new();
+    for i in 0..rings {
+        for j in 0..around {
+            let (a, b) = (i * around + j, i * around + (j + 1) % around);
+            let (c, d) = (a + around, b + around);
+            tris.push([a, b, d]);
+            tris.push([a, d, c]);
+        }
+    }
+    (positions, tris)
+}
+
+/// A long, thin model scanned z up (a bottle 0.22 long and 0.07 wide, no flat base) is seen z
+/// up, and the same model y up is seen y up, from OBJ, PLY (ASCII and binary) and STL (ASCII
+/// and binary) files alike; a model long along y or x, or a flat one, is not taken as z up.
+#[test]
+fn long_thin_models_stand_on_their_long_axis() {
+    let d = dir("bottle");
+    let files = |name: &str, (positions, tris): &(Vec<Vec3>, Vec<[usize; 3]>)| -> Vec<PathBuf> {
+        let mut obj = String::new();
+        for p in positions {
+            obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+        for t in tris {
+            obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        let header = |format: &str| {
+            format!(
+                "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+                positions.len(),
+                tris.len()
+            )
+        };
+        let mut ascii_ply = header("ascii");
+        for p in positions {
+            ascii_ply += &format!("{} {} {}\n", p.x, p.y, p.z);
+        }
+        for t in tris {
+            ascii_ply += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+        }
+        let mut binary_ply = header("binary_little_endian").into_bytes();
+        for p in positions {
+            for c in p.to_array() {
+                binary_ply.extend(c.to_le_bytes());
+            }
+        }
+        for t in tris {
+            binary_ply.push(3);
+            for &i in t {
+                binary_ply.extend((i as i32).to_le_bytes());
+            }
+        }
+        let mut ascii_stl = String::from("solid bottle\n");
+        let mut binary_stl = vec![0u8; 80];
+        binary_stl.extend((tris.len() as u32).to_le_bytes());
+        for t in tris {
+            let [a, b, c] = t.map(|i| positions[i]);
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            ascii_stl += &format!("facet normal {} {} {}\nouter loop\n", n.x, n.y, n.z);
+            for v in [a, b, c] {
+                ascii_stl += &format!("vertex {} {} {}\n", v.x, v.y, v.z);
+            }
+            ascii_stl += "endloop\nendfacet\n";
+            for v in [n, a, b, c] {
+                for x in v.to_array() {
+                    binary_stl.extend(x.to_le_bytes());
+                }
+            }
+            binary_stl.extend([0, 0]);
+        }
+        ascii_stl += "endsolid bottle\n";
+        vec![
+            write(&d, &format!("{name}.obj"), obj.as_bytes()),
+            write(&d, &format!("{name}.ply"), ascii_ply.as_bytes()),
+            write(&d, &format!("{name}_bin.ply"), &binary_ply),
+            write(&d, &format!("{name}.stl"), ascii_stl.as_bytes()),
+            write(&d, &format!("{name}_bin.stl"), &binary_stl),
+        ]
+    };
+    let up_of = |path: &Path| {
+        let loaded = load_with(path, &ModelOptions::default()).unwrap();
+        let note = loaded.notes.iter().find(|n| n.starts_with("up axis")).cloned();
+        let up = loaded.scene.camera.view_from_world().row(1).truncate();
+        (note.unwrap_or_default(), up)
+    };
+    for (name, axis, length, want) in [
+        ("z_up", 2, 0.22, Vec3::Z),
+        ("y_up", 1, 0.22, Vec3::Y),
+        // Long along x: lying, seen y up.
+        ("x_long", 0, 0.22, Vec3::Y),
+        // Not long: a squat jar z up has no flat base either, and stays y up.
+        ("squat", 2, 0.1, Vec3::Y),
+    ] {
+        for path in files(name, &bottle(axis, length)) {
+            let (note, up) = up_of(&path);
+            assert!(up.dot(want) > 0.9, "{}: up {up}, want {want} ({note})", path.display());
+            if want == Vec3::Z {
+                assert!(note.contains("long along z"), "{}: {note}", path.display());
+            }
+        }
+    }
+}
+
+/// The default rig of a model alone lights every face the camera sees: for every unit normal
+/// facing the camera (more than 5° from edge-on), some light falls on it with `N·L` times its
+/// diffuse level above 0.015 (at least 4/255 of a diffuse 1), in every named view. (A single triangle facing away from the three fixed
+/// lights was drawn at the background's colour.)
+#[test]
+fn every_face_the_camera_sees_is_lit() {
+    let d = dir("rig");
+    let path = write(
+        &d,
+        "tri.obj",
+        b"v 1.080975 0.465248 0.784243\nv -0.896898 0.761929 0.784243\nv -0.138058 -0.920383 -1.176365\nf 1 2 3\n",
+    );
+    let views = [
+        None,
+        Some(ViewName::Front),
+        Some(ViewName::Top),
+        Some(ViewName::Left),
+        Some(ViewName::Iso),
+    ];
+    for view in views {
+        let scene = load_with(
+            &path,
+            &ModelOptions {
+                view,
+                ..ModelOptions::default()
+            },
+        )
+        .unwrap()
+        .scene;
+        let v = (scene.camera.eye() - scene.camera.target()).normalize();
+        // Each light's direction to it, scaled by its diffuse grey level.
+        let to_lights: Vec<Vec3> = scene
+            .lighting
+            .lights()
+            .iter()
+            .filter_map(|l| Some(l.to_light()? * l.color().diffuse().to_array()[1]))
+            .collect();
+        assert_eq!(to_lights.len(), scene.lighting.lights().len(), "directional lights");
+        // Normals on a fine grid of the sphere (azimuth × height).
+        let mut worst = f32::INFINITY;
+        for i in 0..180 {
+            for j in 1..90 {
+                let (a, z) = (i as f32 * 2.0f32.to_radians(), -1.0 + j as f32 / 45.0);
+                let r = (1.0 - z * z).sqrt();
+                let n = Vec3::new(r * a.cos(), r * a.sin(), z);
+                if n.dot(v) > 0.0872 {
+                    let best = to_lights.iter().map(|l| n.dot(*l)).fold(f32::MIN, f32::max);
+                    worst = worst.min(best);
+                }
+            }
+        }
+        assert!(
+            worst > 0.015,
+            "{view:?}: a visible face gets N·L·level = {worst} at most"
+        );
+    }
+}

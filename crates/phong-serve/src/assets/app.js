@@ -1037,7 +1037,7 @@ async function loadFiles(files) {
   document.querySelector('.err[data-for="load-model"]').textContent = '';
   if (!objInfo) { $('status').textContent = 'uploaded ' + files.map((f) => f.name).join(', '); return; }
   if (!S.models.includes(objInfo.name)) S.models.push(objInfo.name);
-  // As `phong render MODEL.obj`: the model alone, framed, with its materials and three lights.
+  // As `phong render MODEL.obj`: the model alone, framed, with its materials and lights.
   S.scene = objInfo.scene;
   S.original = clone(objInfo.scene);
   S.sel = 0;
