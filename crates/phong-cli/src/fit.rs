@@ -193,6 +193,9 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
         "  rmse {:.5} (linear colour, fitted pixels), psnr {:.2} dB",
         fit.rmse, fit.psnr
     );
+    for n in &fit.notes {
+        println!("  note: {n}");
+    }
     println!(
         "  nearest classic material: {} (rmse {:.5})",
         fit.nearest.0, fit.nearest.1
@@ -201,6 +204,18 @@ fn fit_image(a: &FitArgs, scene_path: &std::path::Path) -> Result<(Material, Str
         println!("  undetermined: {u}");
     }
     if let Some(dir) = report_dir(a)? {
+        // The yardstick: the model's best material by brute force over the exponent.
+        let options = RenderOptions {
+            threads: a.threads,
+            ..RenderOptions::default()
+        };
+        let best = phong_fit::image::best_by_search(&scene, object, &target, free, mask.as_deref(), options)?;
+        println!(
+            "  brute-force best of this model: psnr {:.2} dB at s = {:.1} (400 exponents, exact colours); the fit is {:+.2} dB from it",
+            best.psnr,
+            best.shininess,
+            fit.psnr - best.psnr
+        );
         phong_fit::report::write(
             &dir.join("comparison.png"),
             &phong_fit::report::comparison(&target, &fit.image, &fit.used),

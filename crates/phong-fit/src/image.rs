@@ -7,12 +7,19 @@
 //! box-constrained linear least-squares solve ([`crate::lsq`]), and `s` alone is searched:
 //! a grid on `log s`, then golden-section search between the best grid point's neighbours.
 //!
-//! Where the model clamps, linearity breaks: a pixel whose sum passed 1 is 255 in the target,
-//! and pixels the target clipped (0 or 255 in a channel) are left out of that channel's solve,
-//! so the clamp never enters the fit. Colours are bounded by 1 under a clamping model, and only
-//! by 0 under an unclamped one. Pixels partly covered by the object (antialiased edges)
-//! or covered by something in front are left out too: the `E` image tells them (exactly 1 on
-//! the object's own pixels).
+//! A channel the target clipped (0 or its largest value) is a censored observation: 255 says
+//! the true value is at least 254.5/255, 0 that it is at most 0.5/255. Such a channel is a
+//! one-sided constraint of the solve (a squared penalty only where the model breaks it), not
+//! data, and not left out: leaving it out moves the exponent (a clipped highlight's peak is
+//! where `s` shows most). The colours are bounded by 0 only: under the scene's lights a
+//! material may need colours past 1 (a conductor's highlight, brighter than lights of 1 make
+//! it), and the fit says so ([`ImageFit::notes`]). Pixels partly covered by the object
+//! (antialiased edges) or covered by something in front are left out: the `E` image tells
+//! them (exactly 1 on the object's own pixels).
+//!
+//! [`best_by_search`] is the check of the method: the same model's best material by brute
+//! force (exact least squares for the colours at each of many exponents, every covered pixel
+//! as data).
 
 use crate::FitError;
 use phong_core::{Color, Encoding, Image, Material, Output, Scene, named_materials};
@@ -29,6 +36,9 @@ pub struct Target {
     pub rgb: Vec<[f32; 3]>,
     /// Per pixel and channel: 0 or the largest value (clipped).
     pub clipped: Vec<[bool; 3]>,
+    /// In linear colour: the most a channel at 0 can be, and the least a channel at the
+    /// largest value can be (half a step from each end, decoded).
+    pub censor: (f32, f32),
 }
 
 impl Target {
@@ -95,6 +105,7 @@ impl Target {
             height: h,
             rgb,
             clipped,
+            censor: (decode(0.5 / max, encoding), decode(1.0 - 0.5 / max, encoding)),
         })
     }
 }
@@ -194,6 +205,8 @@ pub struct ImageFit {
     pub pixels: usize,
     /// What the target does not determine, in words.
     pub undetermined: Vec<String>,
+    /// What the user should know of the fitted values, in words (colours past 1).
+    pub notes: Vec<String>,
     /// `(s, rmse of the linear fit)` for every exponent tried, in order of `s`.
     pub curve: Vec<(f32, f64)>,
     /// The scene rendered with the fitted material.
@@ -261,33 +274,80 @@ impl<'a> Basis<'a> {
     }
 }
 
-/// The per-channel normal equations at one exponent, over the used pixels.
-fn normals(
+/// One channel's observations at one exponent: the uncensored rows' normal equations, and the
+/// censored rows apart (free terms' basis values, the bound less the fixed terms, whether the
+/// model must reach at least the bound).
+#[derive(Default)]
+struct Channel {
+    n: crate::lsq::Normal<4>,
+    censored: Vec<([f64; 4], f64, bool)>,
+}
+
+impl Channel {
+    /// The least squares over `x ≥ 0` with each censored row a one-sided constraint (a squared
+    /// penalty where broken): the rows broken at the last solution join as equalities at their
+    /// bound, and the solve is repeated until that set stops changing (a few rounds: the
+    /// objective is convex and piecewise quadratic). The solution and its objective.
+    fn solve(&self, free: &[bool; 4], fixed: &[f64; 4]) -> ([f64; 4], f64) {
+        let broken = |x: &[f64; 4]| -> Vec<bool> {
+            self.censored
+                .iter()
+                .map(|(b, bound, high)| {
+                    let v: f64 = (0..4).map(|k| b[k] * x[k]).sum();
+                    if *high { v < *bound } else { v > *bound }
+                })
+                .collect()
+        };
+        let with = |active: &[bool]| {
+            let mut n = self.n;
+            for ((b, bound, _), on) in self.censored.iter().zip(active) {
+                if *on {
+                    n.add(b, *bound);
+                }
+            }
+            n
+        };
+        let mut active = vec![false; self.censored.len()];
+        let mut x = self.n.solve(free, fixed, 0.0, f64::INFINITY).0;
+        for _ in 0..50 {
+            let now = broken(&x);
+            if now == active {
+                break;
+            }
+            active = now;
+            x = with(&active).solve(free, fixed, 0.0, f64::INFINITY).0;
+        }
+        // The objective: every broken constraint's squared distance at the solution.
+        let objective = with(&broken(&x)).residual(&x);
+        (x, objective)
+    }
+}
+
+/// The observations at one exponent, per channel, over the used pixels: terms that are not
+/// free are moved to the target's side; with `censor`, clipped channels are constraints,
+/// else plain data at their value.
+fn observations(
     b: &Basis,
     s_img: &Image,
     target: &Target,
     used: &[bool],
     fixed: &[[f64; 4]; 3],
     free: &[bool; 4],
-) -> [crate::lsq::Normal<4>; 3] {
-    let mut n = [crate::lsq::Normal::<4>::default(); 3];
+    censor: bool,
+) -> [Channel; 3] {
+    let mut ch: [Channel; 3] = Default::default();
     let (e, a, d, sp) = (b.e.pixels(), b.a.pixels(), b.d.pixels(), s_img.pixels());
     for (p, &u) in used.iter().enumerate() {
         if !u {
             continue;
         }
         for c in 0..3 {
-            if target.clipped[p][c] {
-                continue;
-            }
-            let row = [
-                f64::from(e[p][c]),
-                f64::from(a[p][c]),
-                f64::from(d[p][c]),
-                f64::from(sp[p][c]),
-            ];
-            // Terms that are not free are moved to the target's side.
+            let row = [e[p][c], a[p][c], d[p][c], sp[p][c]].map(f64::from);
             let mut t = f64::from(target.rgb[p][c]);
+            let high = t >= 0.5;
+            if censor && target.clipped[p][c] {
+                t = f64::from(if high { target.censor.1 } else { target.censor.0 });
+            }
             let mut r = [0.0; 4];
             for k in 0..4 {
                 if free[k] {
@@ -296,20 +356,22 @@ fn normals(
                     t -= row[k] * fixed[c][k];
                 }
             }
-            n[c].add(&r, t);
+            if censor && target.clipped[p][c] {
+                ch[c].censored.push((r, t, high));
+            } else {
+                ch[c].n.add(&r, t);
+            }
         }
     }
-    n
+    ch
 }
 
-/// Solves the colours at one exponent: per channel `[e, a, d, k]` and the summed residual.
-/// Colours are bounded by 1 where the model clamps (a clamped sum cannot tell more), else only
-/// by 0: an unclamped model may need values past 1 (a brighter exposure).
-fn solve(n: &[crate::lsq::Normal<4>; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3], hi: f64) -> ([[f64; 4]; 3], f64) {
+/// Solves the colours at one exponent: per channel `[e, a, d, k]` and the summed objective.
+fn solve(ch: &[Channel; 3], free: &[bool; 4], fixed: &[[f64; 4]; 3]) -> ([[f64; 4]; 3], f64) {
     let mut x = [[0.0; 4]; 3];
     let mut r = 0.0;
     for c in 0..3 {
-        let (xc, rc) = n[c].solve(free, &[0.0; 4], 0.0, hi);
+        let (xc, rc) = ch[c].solve(free, &fixed[c]);
         for k in 0..4 {
             x[c][k] = if free[k] { xc[k] } else { fixed[c][k] };
         }
@@ -428,15 +490,16 @@ pub fn fit_image(
     let mut undetermined = Vec::new();
     // Emission and ambient are one unknown where the ambient light is the same everywhere.
     if free_c[0] && free_c[1] {
-        let n = normals(
+        let ch = observations(
             &basis,
             &basis.d.clone(),
             target,
             &used,
             &fixed,
             &[true, true, false, false],
+            false,
         );
-        let g = n[0].g;
+        let g = ch[0].n.g;
         if g[0][0] * g[1][1] - g[0][1] * g[1][0] <= 1e-9 * g[0][0] * g[1][1] {
             free_c[0] = false;
             undetermined.push(
@@ -445,17 +508,12 @@ pub fn fit_image(
             );
         }
     }
-    let hi = if scene.objects[object].shading.options.clamp {
-        1.0
-    } else {
-        f64::INFINITY
-    };
     let mut curve: Vec<(f32, f64)> = Vec::new();
     let mut eval = |s: f32, basis: &mut Basis| -> Result<([[f64; 4]; 3], f64), FitError> {
         let si = basis.specular(s)?;
-        let n = normals(basis, &si, target, &used, &fixed, &free_c);
-        let (x, r) = solve(&n, &free_c, &fixed, hi);
-        let count: usize = n.iter().map(|n| n.rows).sum::<usize>().max(1);
+        let ch = observations(basis, &si, target, &used, &fixed, &free_c, true);
+        let (x, r) = solve(&ch, &free_c, &fixed);
+        let count: usize = ch.iter().map(|c| c.n.rows + c.censored.len()).sum::<usize>().max(1);
         curve.push((s, (r / count as f64).sqrt()));
         Ok((x, r))
     };
@@ -499,8 +557,8 @@ pub fn fit_image(
             [g(mm.emission()), g(mm.ambient()), g(mm.diffuse()), g(mm.specular())]
         });
         let si = basis.specular(mm.shininess())?;
-        let n = normals(&basis, &si, target, &used, &[[0.0; 4]; 3], &[true; 4]);
-        let (r, count) = (0..3).fold((0.0, 0), |(r, k), c| (r + n[c].residual(&xs[c]), k + n[c].rows));
+        let ch = observations(&basis, &si, target, &used, &[[0.0; 4]; 3], &[true; 4], false);
+        let (r, count) = (0..3).fold((0.0, 0), |(r, k), c| (r + ch[c].n.residual(&xs[c]), k + ch[c].n.rows));
         let e = (r / count.max(1) as f64).sqrt();
         if e < nearest.1 {
             nearest = (m.name, e);
@@ -512,6 +570,7 @@ pub fn fit_image(
         psnr: 20.0 * (1.0 / rmse.max(1e-12)).log10(),
         pixels,
         undetermined,
+        notes: past_one(&x, &free_c),
         curve,
         image,
         nearest,
@@ -519,8 +578,26 @@ pub fn fit_image(
     })
 }
 
+/// The fitted colours past 1, in words: the largest term's value and the light scale that
+/// would bring it into [0, 1].
+fn past_one(x: &[[f64; 4]; 3], free: &[bool; 4]) -> Vec<String> {
+    let names = ["emission", "ambient", "diffuse", "specular"];
+    (0..4)
+        .filter(|&k| free[k])
+        .filter_map(|k| {
+            let top = (0..3).map(|c| x[c][k]).fold(0.0, f64::max);
+            (top > 1.0).then(|| {
+                format!(
+                    "{} {top:.2}: brighter than these lights allow in [0, 1]; scale the lights by {top:.2} to keep it in range",
+                    names[k]
+                )
+            })
+        })
+        .collect()
+}
+
 /// RMSE of `image` (as the PNG would store it, decoded to linear) against the target over the
-/// used, unclipped pixel channels.
+/// used pixels' channels, clipped ones included (the image is clipped alike).
 fn rmse_of(image: &Image, target: &Target, used: &[bool], encoding: Encoding) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
     for (p, px) in image.pixels().iter().enumerate() {
@@ -528,9 +605,6 @@ fn rmse_of(image: &Image, target: &Target, used: &[bool], encoding: Encoding) ->
             continue;
         }
         for c in 0..3 {
-            if target.clipped[p][c] {
-                continue;
-            }
             let v = decode(f32::from(encoding.encode(px[c])) / 255.0, encoding);
             let d = f64::from(v - target.rgb[p][c]);
             sum += d * d;
@@ -538,4 +612,78 @@ fn rmse_of(image: &Image, target: &Target, used: &[bool], encoding: Encoding) ->
         }
     }
     (sum / n.max(1) as f64).sqrt()
+}
+
+/// The best material of the scene's model by brute force, the yardstick of [`fit_image`]: at
+/// each of 400 exponents from 1 to 2000 (evenly in `log s`), the exact least-squares colours
+/// (at least 0, no upper bound; the free terms of `free`, the others the scene's) over every
+/// pixel the object covers whole, clipped channels as data; the best of those by the PSNR of
+/// the image they make (the term images summed, clamped where the scene clamps, stored in 8
+/// bits as the PNG would be).
+pub struct Search {
+    /// The best exponent on the grid.
+    pub shininess: f32,
+    /// Its image's PSNR against the target, in dB.
+    pub psnr: f64,
+}
+
+/// See [`Search`].
+pub fn best_by_search(
+    scene: &Scene,
+    object: usize,
+    target: &Target,
+    free: Free,
+    mask: Option<&[bool]>,
+    options: RenderOptions,
+) -> Result<Search, FitError> {
+    let start = scene.objects[object].material;
+    let mut basis = Basis::new(scene, object, options)?;
+    let used: Vec<bool> = basis
+        .e
+        .pixels()
+        .iter()
+        .enumerate()
+        .map(|(p, px)| px[0] >= 0.999 && mask.is_none_or(|m| m[p]))
+        .collect();
+    let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
+    let (se, sa, sd, ss) = (
+        c3(start.emission()),
+        c3(start.ambient()),
+        c3(start.diffuse()),
+        c3(start.specular()),
+    );
+    let fixed: [[f64; 4]; 3] = [0, 1, 2].map(|c| [se[c], sa[c], sd[c], ss[c]]);
+    let free_c = free.colours();
+    let clamp = scene.objects[object].shading.options.clamp;
+    let encoding = scene.image.encoding;
+    let mut best = Search {
+        shininess: start.shininess(),
+        psnr: f64::NEG_INFINITY,
+    };
+    for k in 0..400 {
+        let s = 2000f32.powf(k as f32 / 399.0);
+        let si = basis.specular(s)?;
+        let ch = observations(&basis, &si, target, &used, &fixed, &free_c, false);
+        let x: [[f64; 4]; 3] = [0, 1, 2].map(|c| {
+            let xc = ch[c].n.solve(&free_c, &fixed[c], 0.0, f64::INFINITY).0;
+            [0, 1, 2, 3].map(|t| if free_c[t] { xc[t] } else { fixed[c][t] })
+        });
+        let (e, a, d, sp) = (basis.e.pixels(), basis.a.pixels(), basis.d.pixels(), si.pixels());
+        let (mut sum, mut n) = (0.0, 0usize);
+        for (p, _) in used.iter().enumerate().filter(|(_, u)| **u) {
+            for c in 0..3 {
+                let row = [e[p][c], a[p][c], d[p][c], sp[p][c]].map(f64::from);
+                let v = (0..4).map(|t| row[t] * x[c][t]).sum::<f64>();
+                let v = if clamp { v.clamp(0.0, 1.0) } else { v } as f32;
+                let stored = decode(f32::from(encoding.encode(v)) / 255.0, encoding);
+                sum += f64::from(stored - target.rgb[p][c]).powi(2);
+                n += 1;
+            }
+        }
+        let psnr = 20.0 * (1.0 / (sum / n.max(1) as f64).sqrt().max(1e-12)).log10();
+        if psnr > best.psnr {
+            best = Search { shininess: s, psnr };
+        }
+    }
+    Ok(best)
 }
