@@ -82,10 +82,13 @@ pub(crate) struct VertexLighting {
     pub textured: bool,
 }
 
+/// A numbered piece of the front colours, with the same piece of the back, front specular and
+/// back specular colours.
+type Piece<'a> = (usize, (&'a mut [Vec3], [&'a mut [Vec3]; 3]));
+
 /// The four outputs of [`VertexLighting::light`] cut into pieces of [`LIGHT_CHUNK`] points,
 /// numbered: the front colours' piece with the others' (empty where they are).
-#[allow(clippy::type_complexity)]
-fn pieces(colors: &mut [Vec<Vec3>; 4]) -> Vec<(usize, (&mut [Vec3], [&mut [Vec3]; 3]))> {
+fn pieces(colors: &mut [Vec<Vec3>; 4]) -> Vec<Piece<'_>> {
     let [front, back, front_specular, back_specular] = colors;
     let mut others = [back, front_specular, back_specular].map(|c| c.chunks_mut(LIGHT_CHUNK));
     front

@@ -228,6 +228,18 @@ impl<'a> VectorMaps<'a> {
 // No closures below: a closure is not compiled with its caller's AVX2, and its intrinsics
 // become calls.
 
+/// A vector's sampled colour, or (`Err`) its light where a lane could not be sampled: the
+/// primary, specular and ambient colours, finished per pixel.
+pub(crate) type Lanes<V> = Result<[V; 3], [[V; 3]; 3]>;
+
+/// A vector's texture coordinates (see [`coordinates`]): the first set and the second, each
+/// `[u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y, ∂v/∂y]`, and `(dx, dy, w)`.
+type Coords<V> = ([V; 6], [V; 6], (V, V, V));
+
+/// A vector's shininess from a map (or from the metallic-roughness map, with its diffuse and
+/// specular factors).
+type ShininessLanes<V> = (Option<V>, Option<[V; 3]>);
+
 /// How each build calls its largest steps, [`Sampling::bilinear`] and [`Sampling::textured`]:
 /// inlined where the lanes are AVX2 registers (a call is compiled without the caller's AVX2,
 /// and its intrinsics become calls), called in the portable build, whose lane loops inlined
@@ -236,14 +248,13 @@ pub(crate) trait Sampling: Vf32 {
     /// [`bilinear_lanes`].
     fn bilinear(map: &VectorMap, level: Option<Self>, u: Self, v: Self) -> [Self; 3];
     /// [`textured_lanes`].
-    #[allow(clippy::type_complexity)]
     fn textured<const FULL: bool, const PER_VERTEX: bool>(
         prep: &Prepared,
         maps: &VectorMaps,
         q: [Self; 6],
         at: (Self, Self, Self),
         k: &[Self; 24],
-    ) -> Result<[Self; 3], [[Self; 3]; 3]>;
+    ) -> Lanes<Self>;
 }
 
 /// `Sampling` for the build `$v`, its two steps with the attribute `$inline`.
@@ -261,7 +272,7 @@ macro_rules! sampling {
                 q: [Self; 6],
                 at: (Self, Self, Self),
                 k: &[Self; 24],
-            ) -> Result<[Self; 3], [[Self; 3]; 3]> {
+            ) -> Lanes<Self> {
                 textured_lanes::<Self, FULL, PER_VERTEX>(prep, maps, q, at, k)
             }
         }
@@ -286,12 +297,7 @@ fn mapped_set<V: Sampling, const FULL: bool>(map: &VectorMap, uv: [V; 6], uv1: [
 /// `FULL` is off), and `(dx, dy, w)`. With `q = 1/w`, `u = (u/w)·w` and `∂u/∂x = (∂(u/w)/∂x −
 /// u·∂q/∂x)·w`.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
-fn coordinates<V: Vf32, const FULL: bool>(
-    maps: &VectorMaps,
-    k: &[V; 24],
-    (dx, dy, w): (V, V, V),
-) -> ([V; 6], [V; 6], (V, V, V)) {
+fn coordinates<V: Vf32, const FULL: bool>(maps: &VectorMaps, k: &[V; 24], (dx, dy, w): (V, V, V)) -> Coords<V> {
     let uv = coordinate_set(k, 5, (dx, dy, w));
     // The second set, where a map reads it, from the planes at 11 and 14 (in the vertex
     // colours' place: such objects have none).
@@ -342,12 +348,11 @@ fn folded<V: Vf32>(maps: &VectorMaps, k: [V; 24]) -> [V; 24] {
 /// The normal `nrm` tilted by the normal map of `maps` (if any) in the frame of the tangent
 /// interpolated from its planes at 11, 14, 17 and 20 (over `w` as the coordinates `c`).
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn tilted<V: Sampling, const FULL: bool>(
     maps: &VectorMaps,
     nrm: V3<V>,
     k: &[V; 24],
-    (uv, uv1, (dx, dy, rq)): ([V; 6], [V; 6], (V, V, V)),
+    (uv, uv1, (dx, dy, rq)): Coords<V>,
 ) -> V3<V> {
     let Some((map, source)) = &maps.normal else {
         return nrm;
@@ -383,12 +388,11 @@ fn texels_or_per_lane<V: Sampling, const FULL: bool>(
 /// roughness overriding a shininess map's. With the metallic-roughness map's texel, which
 /// also sets the diffuse and specular texels.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn shininess_lanes<V: Sampling, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     (uv, uv1): ([V; 6], [V; 6]),
-) -> (Option<V>, Option<[V; 3]>) {
+) -> ShininessLanes<V> {
     let zero = V::splat(0.0);
     if let Some((map, source)) = &maps.metal_rough {
         let t = texels_or_per_lane::<V, FULL>(map, &source.map, uv, uv1);
@@ -446,14 +450,13 @@ pub type Unsampled<I> = (I, [[f32; 3]; 3]);
 /// ([`coefficients`]): lit, textured and combined; `Err` with the light where the sampler
 /// cannot wrap the coordinates exactly.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
     q: [V; 6],
     at: (V, V, V),
     k: &[V; 24],
-) -> Result<[V; 3], [[V; 3]; 3]> {
+) -> Lanes<V> {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let (pos, nrm) = position_normal(q);
     // The coordinates, then the maps that change the light (a normal map tilts the normal, a
@@ -628,9 +631,8 @@ fn q3<V: Copy>(q: [V; 6], k: usize) -> [V; 3] {
 /// Hands the first `m` lanes of a [`Sampling::textured`] result to `out(lane, rgb)`, or their light to
 /// `unsampled` with their index `at(lane)`.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn emit<V: Vf32, I>(
-    r: Result<[V; 3], [[V; 3]; 3]>,
+    r: Lanes<V>,
     m: usize,
     at: impl Fn(usize) -> I,
     mut out: impl FnMut(I, [f32; 3]),
