@@ -194,9 +194,9 @@ const FILL: f32 = 0.92;
 /// The scene of a model alone, as JSON with the scene file's schema, and notes on what was
 /// decided (for `-v`):
 /// - the model with `fit = true` and its MTL materials (or OpenGL's default);
-/// - up: `options.up`, else detected: z where the model stands on a flat base facing −z (at
-///   least 2% of its area, and 3 times what faces −y at its lowest y: a scan of a statue or
-///   bust, like Nefertiti's), else y;
+/// - up: `options.up`, else detected ([`detect_up`]): y for a model long along y, z for one
+///   long along z or standing on a flat base facing −z (a scan of a statue or bust, like
+///   Nefertiti's), else y;
 /// - front: +z for a y-up model, −y for a z-up one (Blender's front view), the convention's
 ///   axis turned likewise for other ups;
 /// - faces: `options.sides`, else as the file says (glTF's `doubleSided`), else culled where
@@ -230,78 +230,14 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
             origin.x, origin.y, origin.z
         ));
     }
-    let up = match options.up {
-        Some(a) => a,
-        None if gltf => Axis::Y,
-        None => {
-            let (a, why) = detect_up(parts);
-            notes.push(format!(
-                "up axis {} (detected{}; --up to choose)",
-                a.name(),
-                why.map(|w| format!(": {w}")).unwrap_or_default()
-            ));
-            a
-        }
-    };
+    let up = up_axis(parts, gltf, options, &mut notes);
     let u = up.vector();
-    // The front: the convention's axis for this up (+z for y up, -y for z up).
-    let f = match up {
-        Axis::Y => Vec3::Z,
-        Axis::NegY => Vec3::NEG_Z,
-        Axis::Z => Vec3::NEG_Y,
-        Axis::NegZ => Vec3::Y,
-        Axis::X => Vec3::Z,
-        Axis::NegX => Vec3::Z,
-    };
     // A glTF says its front and its faces: its edges are not examined.
     // Computed once per model read: its views all ask.
     let closed = (!gltf).then(|| *model.closed.get_or_init(|| closedness(parts)));
-    let detected = closed.and_then(|c| detect_front(parts, u, f, c));
-    let f = match detected {
-        Some((front, why)) => {
-            if options.camera.is_none() {
-                notes.push(format!("front {} ({why})", axis_name(front)));
-            }
-            front
-        }
-        None => f,
-    };
+    let f = front(parts, up, closed, options, &mut notes);
     let r = u.cross(f);
-    let two_sided = match (options.sides, model.double_sided) {
-        (Some(s), _) => s == Sides::TwoSided,
-        (None, Some(d)) => {
-            notes.push(if d {
-                "two-sided lighting, no culling: the file's materials are double-sided (--cull to cull)".into()
-            } else {
-                "back faces culled: the file's materials are single-sided (--two-sided to draw them)".into()
-            });
-            d
-        }
-        (None, None) => {
-            let c = closed.unwrap_or(Closed::Unchecked);
-            let two = !c.closed_outward();
-            notes.push(match (two, c) {
-                (false, _) => {
-                    "back faces culled: the model is closed and wound outward (--two-sided to draw them)".into()
-                }
-                (
-                    true,
-                    Closed::Open {
-                        open_edges,
-                        inconsistent,
-                    },
-                ) => format!(
-                    "two-sided lighting, no culling: the model is not closed ({open_edges} open edges, \
-                     {inconsistent} edges wound alike; --cull to cull)"
-                ),
-                (true, Closed::Inward) => {
-                    "two-sided lighting, no culling: the model is closed but wound inward (--cull to cull)".into()
-                }
-                (true, _) => "two-sided lighting, no culling: the model was not checked (too large)".into(),
-            });
-            two
-        }
-    };
+    let two_sided = two_sided(model, closed, options, &mut notes);
     let aspect = options
         .aspect
         .filter(|a| a.is_finite() && *a > 0.0)
@@ -341,59 +277,19 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
             (p, t, cu)
         }
         None => {
-            let (dir, cu) = match options.view {
-                None => (
-                    (r * DEFAULT_VIEW.x + u * DEFAULT_VIEW.y + f * DEFAULT_VIEW.z).normalize(),
-                    u,
-                ),
-                Some(ViewName::Front) => (f, u),
-                Some(ViewName::Back) => (-f, u),
-                Some(ViewName::Right) => (r, u),
-                Some(ViewName::Left) => (-r, u),
-                Some(ViewName::Top) => (u, -f),
-                Some(ViewName::Bottom) => (-u, f),
-                Some(ViewName::Iso) => ((r + u + f).normalize(), u),
-            };
+            let (dir, cu) = view_direction(options.view, (r, u, f));
             let dist = framing_distance(parts, &fitted, dir, cu, aspect);
             (dir * dist, Vec3::ZERO, cu)
         }
     };
     let (near, far) = depth_range(parts, &fitted, position, target);
-    // Lights: the default view's camera frame carried to this camera's.
-    let d0 = DEFAULT_VIEW.normalize();
-    let r0 = Vec3::Y.cross(d0).normalize();
-    let u0 = d0.cross(r0);
-    let dc = (position - target).normalize_or(Vec3::Z);
-    let rc = cam_up.cross(dc).normalize_or(Vec3::X);
-    let uc = dc.cross(rc);
-    let mut lights: Vec<_> = MODEL_LIGHTS
-        .iter()
-        .map(|(d, c)| {
-            let l = Vec3::from_array(*d);
-            let (x, y, z) = (l.dot(r0), l.dot(u0), l.dot(d0));
-            let w = rc * x + uc * y + dc * z;
-            serde_json::json!({"type": "directional", "direction": round6(w), "color": [short(*c), short(*c), short(*c)]})
-        })
-        .collect();
-    let brightest = model.lights.iter().flat_map(|l| l.color).fold(0.0f32, f32::max);
-    if brightest > 0.0 && brightest.is_finite() {
-        notes.push(format!("the file's {} lights", model.lights.len()));
-        lights = model
-            .lights
-            .iter()
-            .filter_map(|l| {
-                let color = l.color.map(|c| short(c / brightest));
-                let dir = round6(l.direction.as_vec3());
-                let pos = round6(fitted(to_parts(l.position)));
-                (dir != [0.0; 3] || l.kind == "point").then(|| match l.kind {
-                    "directional" => serde_json::json!({"type": "directional", "direction": dir, "color": color}),
-                    "point" => serde_json::json!({"type": "point", "position": pos, "color": color}),
-                    _ => serde_json::json!({"type": "spot", "position": pos, "direction": dir, "color": color,
-                                            "cutoff": l.cutoff_deg, "exponent": 0.0}),
-                })
-            })
-            .collect();
-    }
+    let lights = match file_lights(model, &|x| fitted(to_parts(x))) {
+        Some(l) => {
+            notes.push(format!("the file's {} lights", model.lights.len()));
+            l
+        }
+        None => rig_lights(position, target, cam_up),
+    };
     let bg = MODEL_BACKGROUND;
     let json = serde_json::json!({
         "image": {"background": [short(bg[0]), short(bg[1]), short(bg[2])], "antialias": 4},
@@ -404,6 +300,149 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
         "object": [{"mesh": name, "fit": true}],
     });
     (json, notes)
+}
+
+/// The up axis: `options.up`, y for a glTF, else detected (said in `notes`).
+fn up_axis(parts: &[ObjPart], gltf: bool, options: &ModelOptions, notes: &mut Vec<String>) -> Axis {
+    match options.up {
+        Some(a) => a,
+        None if gltf => Axis::Y,
+        None => {
+            let (a, why) = detect_up(parts);
+            notes.push(format!(
+                "up axis {} (detected{}; --up to choose)",
+                a.name(),
+                why.map(|w| format!(": {w}")).unwrap_or_default()
+            ));
+            a
+        }
+    }
+}
+
+/// The front: where the model tells it ([`detect_front`], said in `notes` unless the camera is
+/// given), else the convention's axis for `up` (+z for y up, −y for z up).
+fn front(parts: &[ObjPart], up: Axis, closed: Option<Closed>, options: &ModelOptions, notes: &mut Vec<String>) -> Vec3 {
+    let f = match up {
+        Axis::Y => Vec3::Z,
+        Axis::NegY => Vec3::NEG_Z,
+        Axis::Z => Vec3::NEG_Y,
+        Axis::NegZ => Vec3::Y,
+        Axis::X => Vec3::Z,
+        Axis::NegX => Vec3::Z,
+    };
+    match closed.and_then(|c| detect_front(parts, up.vector(), f, c)) {
+        Some((front, why)) => {
+            if options.camera.is_none() {
+                notes.push(format!("front {} ({why})", axis_name(front)));
+            }
+            front
+        }
+        None => f,
+    }
+}
+
+/// Whether the model is lit two-sided and not culled: `options.sides`, else the file's
+/// materials (glTF), else two-sided unless it is closed and wound outward (said in `notes`).
+fn two_sided(model: &LoadedModel, closed: Option<Closed>, options: &ModelOptions, notes: &mut Vec<String>) -> bool {
+    match (options.sides, model.double_sided) {
+        (Some(s), _) => s == Sides::TwoSided,
+        (None, Some(d)) => {
+            notes.push(if d {
+                "two-sided lighting, no culling: the file's materials are double-sided (--cull to cull)".into()
+            } else {
+                "back faces culled: the file's materials are single-sided (--two-sided to draw them)".into()
+            });
+            d
+        }
+        (None, None) => {
+            let c = closed.unwrap_or(Closed::Unchecked);
+            let two = !c.closed_outward();
+            notes.push(match (two, c) {
+                (false, _) => {
+                    "back faces culled: the model is closed and wound outward (--two-sided to draw them)".into()
+                }
+                (
+                    true,
+                    Closed::Open {
+                        open_edges,
+                        inconsistent,
+                    },
+                ) => format!(
+                    "two-sided lighting, no culling: the model is not closed ({open_edges} open edges, \
+                     {inconsistent} edges wound alike; --cull to cull)"
+                ),
+                (true, Closed::Inward) => {
+                    "two-sided lighting, no culling: the model is closed but wound inward (--cull to cull)".into()
+                }
+                (true, _) => "two-sided lighting, no culling: the model was not checked (too large)".into(),
+            });
+            two
+        }
+    }
+}
+
+/// The direction from the target to the camera, and the camera's up, for a named view (the
+/// default: from the front, a little right and above) in the model's frame `(r, u, f)`.
+fn view_direction(view: Option<ViewName>, (r, u, f): (Vec3, Vec3, Vec3)) -> (Vec3, Vec3) {
+    match view {
+        None => (
+            (r * DEFAULT_VIEW.x + u * DEFAULT_VIEW.y + f * DEFAULT_VIEW.z).normalize(),
+            u,
+        ),
+        Some(ViewName::Front) => (f, u),
+        Some(ViewName::Back) => (-f, u),
+        Some(ViewName::Right) => (r, u),
+        Some(ViewName::Left) => (-r, u),
+        Some(ViewName::Top) => (u, -f),
+        Some(ViewName::Bottom) => (-u, f),
+        Some(ViewName::Iso) => ((r + u + f).normalize(), u),
+    }
+}
+
+/// The rig of [`MODEL_LIGHTS`], carried from the default view's camera frame to this camera's.
+fn rig_lights(position: Vec3, target: Vec3, cam_up: Vec3) -> Vec<serde_json::Value> {
+    let d0 = DEFAULT_VIEW.normalize();
+    let r0 = Vec3::Y.cross(d0).normalize();
+    let u0 = d0.cross(r0);
+    let dc = (position - target).normalize_or(Vec3::Z);
+    let rc = cam_up.cross(dc).normalize_or(Vec3::X);
+    let uc = dc.cross(rc);
+    MODEL_LIGHTS
+        .iter()
+        .map(|(d, c)| {
+            let l = Vec3::from_array(*d);
+            let (x, y, z) = (l.dot(r0), l.dot(u0), l.dot(d0));
+            let w = rc * x + uc * y + dc * z;
+            serde_json::json!({"type": "directional", "direction": round6(w), "color": [short(*c), short(*c), short(*c)]})
+        })
+        .collect()
+}
+
+/// The file's own lights (glTF's KHR_lights_punctual), their colours scaled so that the
+/// brightest is 1, positions carried into the fitted frame by `fitted`; `None` where it has
+/// none that shine.
+fn file_lights(model: &LoadedModel, fitted: &dyn Fn(DVec3) -> Vec3) -> Option<Vec<serde_json::Value>> {
+    let brightest = model.lights.iter().flat_map(|l| l.color).fold(0.0f32, f32::max);
+    if !(brightest > 0.0 && brightest.is_finite()) {
+        return None;
+    }
+    Some(
+        model
+            .lights
+            .iter()
+            .filter_map(|l| {
+                let color = l.color.map(|c| short(c / brightest));
+                let dir = round6(l.direction.as_vec3());
+                let pos = round6(fitted(l.position));
+                (dir != [0.0; 3] || l.kind == "point").then(|| match l.kind {
+                    "directional" => serde_json::json!({"type": "directional", "direction": dir, "color": color}),
+                    "point" => serde_json::json!({"type": "point", "position": pos, "color": color}),
+                    _ => serde_json::json!({"type": "spot", "position": pos, "direction": dir, "color": color,
+                                            "cutoff": l.cutoff_deg, "exponent": 0.0}),
+                })
+            })
+            .collect(),
+    )
 }
 
 /// `x` with 6 decimals, so that the scene's text (and the explorer's "Download TOML") is
