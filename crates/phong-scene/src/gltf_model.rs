@@ -95,326 +95,51 @@ pub fn read_gltf(
         path: path.to_path_buf(),
         message: format!("glTF: {m}"),
     };
-    // Required extensions first (the crate's validation refuses them without saying why).
-    let unchecked = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
-    for ext in unchecked.document.extensions_required() {
-        if !SUPPORTED.contains(&ext) {
-            return Err(fail(format!(
-                "the file requires the extension {ext}, which phong does not read{}",
-                if ext.contains("draco") || ext.contains("meshopt") {
-                    " (compressed geometry: decompress it first, e.g. with gltf-transform)"
-                } else {
-                    ""
-                }
-            )));
-        }
-    }
-    // gltf-json's validation indexes the POSITION accessor unchecked (a panic on an index out
-    // of range, found by the `gltf` fuzz target): every primitive's accessors are checked first.
-    let json = unchecked.document.as_json();
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, prim) in mesh.primitives.iter().enumerate() {
-            let refs = prim.attributes.values().chain(prim.indices.as_ref());
-            if let Some(bad) = refs.map(|i| i.value()).find(|&i| i >= json.accessors.len()) {
-                return Err(fail(format!(
-                    "mesh {m} primitive {p} names accessor {bad}, but the file has {}",
-                    json.accessors.len()
-                )));
-            }
-        }
-    }
+    check_before_validation(bytes, &fail)?;
     let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
     let doc = &file.document;
     let buffers = load_buffers(&file, resource, &fail)?;
     let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut colours) = (0usize, 0usize);
-    let mut cache = TextureCache::default();
-    // The white emission map below, one for the file (uploaded once by the GPU).
-    let white = std::sync::LazyLock::new(|| {
-        std::sync::Arc::new(phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture"))
-    });
+    let mut textures = Textures {
+        path,
+        resource,
+        cache: TextureCache::default(),
+        white: None,
+    };
     // Positions in f64 world space for all parts, re-centred together below.
     let mut pending: Vec<Pending> = Vec::new();
     let mut triangles_total: u64 = 0;
     for (node, world) in &instances {
-        if model.camera.is_none()
-            && let Some(cam) = node.camera()
-        {
-            let fov_deg = match cam.projection() {
-                ::gltf::camera::Projection::Perspective(p) => Some(p.yfov().to_degrees()),
-                ::gltf::camera::Projection::Orthographic(_) => None,
-            };
-            model.camera = Some(FileCamera {
-                position: world.transform_point3(DVec3::ZERO),
-                forward: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
-                up: world.transform_vector3(DVec3::Y).normalize_or(DVec3::Y),
-                fov_deg,
-            });
+        if model.camera.is_none() {
+            model.camera = file_camera(node, world);
         }
-        if let Some(light) = node.light() {
-            let c = light.color().map(|c| c * light.intensity());
-            let (kind, cutoff_deg) = match light.kind() {
-                ::gltf::khr_lights_punctual::Kind::Directional => ("directional", 0.0),
-                ::gltf::khr_lights_punctual::Kind::Point => ("point", 0.0),
-                ::gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => {
-                    ("spot", outer_cone_angle.to_degrees().clamp(0.0, 90.0))
-                }
-            };
-            model.lights.push(FileLight {
-                kind,
-                position: world.transform_point3(DVec3::ZERO),
-                direction: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
-                color: c,
-                cutoff_deg,
-            });
-        }
+        model.lights.extend(file_light(node, world));
         let Some(mesh) = node.mesh() else { continue };
-        let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
-        let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
         for prim in mesh.primitives() {
-            let mode = prim.mode();
             if !matches!(
-                mode,
+                prim.mode(),
                 ::gltf::mesh::Mode::Triangles | ::gltf::mesh::Mode::TriangleStrip | ::gltf::mesh::Mode::TriangleFan
             ) {
                 skipped_modes += 1;
                 continue;
             }
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            let pos_acc = prim
-                .get(&::gltf::Semantic::Positions)
-                .ok_or_else(|| fail(format!("{what} has no POSITION")))?;
-            check_accessor(&pos_acc, &buffers, &[::gltf::accessor::Dimensions::Vec3], true)
-                .map_err(|m| fail(format!("{what}: POSITION (accessor {}): {m}", pos_acc.index())))?;
-            let normal_acc = prim.get(&::gltf::Semantic::Normals);
-            if let Some(a) = &normal_acc {
-                check_accessor(a, &buffers, &[::gltf::accessor::Dimensions::Vec3], true)
-                    .map_err(|m| fail(format!("{what}: NORMAL (accessor {}): {m}", a.index())))?;
-            }
-            if let Some(a) = prim.indices() {
-                check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Scalar], false)
-                    .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
-                // Unsigned integers only, as the specification says (the crate's reader treats any
-                // other component type as unreachable: found by the `gltf` fuzz target).
-                use ::gltf::accessor::DataType;
-                if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) || a.normalized() {
-                    return Err(fail(format!(
-                        "{what}: indices (accessor {}) are not unsigned integers",
-                        a.index()
-                    )));
-                }
-            }
-            // The texture coordinate sets the material's textures use (checked like the others).
-            let mat = prim.material();
-            let sets: BTreeSet<u32> = texture_infos(&mat).iter().map(|t| t.set).collect();
-            for &set in &sets {
-                if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
-                    check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Vec2], false)
-                        .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
-                }
-            }
-            if let Some(a) = prim.get(&::gltf::Semantic::Colors(0)) {
-                use ::gltf::accessor::Dimensions;
-                check_accessor(&a, &buffers, &[Dimensions::Vec3, Dimensions::Vec4], false)
-                    .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let positions = packed_positions(&prim, &buffers)
-                .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
-                .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
-            if let Some((i, p)) = positions
-                .iter()
-                .enumerate()
-                .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
-            {
-                return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
-            }
-            let n = positions.len();
-            // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
-            let colors: Vec<Color> = match reader.read_colors(0) {
-                Some(c) => {
-                    let c: Vec<Color> = c
-                        .into_rgb_f32()
-                        .map(|[r, g, b]| Color::new(r.max(0.0), g.max(0.0), b.max(0.0)))
-                        .collect();
-                    if c.len() == n && c.iter().all(|c| c.is_finite()) {
-                        c
-                    } else {
-                        colours += 1;
-                        Vec::new()
-                    }
-                }
-                None => Vec::new(),
-            };
-            let indices: Vec<u32> = match (packed_indices(&prim, &buffers), reader.read_indices()) {
-                (Some(i), _) => i,
-                (None, Some(i)) => i.into_u32().collect(),
-                (None, None) => (0..n as u32).collect(),
-            };
-            if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
-                return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
-            }
-            let mut tris: Vec<[u32; 3]> = match mode {
-                ::gltf::mesh::Mode::TriangleStrip => (2..indices.len())
-                    .map(|k| {
-                        let t = [indices[k - 2], indices[k - 1], indices[k]];
-                        // Every other triangle of a strip is wound the other way.
-                        if k % 2 == 1 { [t[1], t[0], t[2]] } else { t }
-                    })
-                    .collect(),
-                ::gltf::mesh::Mode::TriangleFan => (2..indices.len())
-                    .map(|k| [indices[0], indices[k - 1], indices[k]])
-                    .collect(),
-                _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
-            };
-            if mirrored {
-                tris.iter_mut().for_each(|t| t.swap(1, 2));
-            }
-            triangles_total += tris.len() as u64;
+            let has_normal_accessor = check_primitive(&prim, &buffers, &what, &fail)?;
+            let g = geometry(&prim, &buffers, world, has_normal_accessor, &what, &fail)?;
+            colours += usize::from(g.colours_dropped);
+            triangles_total += g.tris.len() as u64;
             if triangles_total > phong_core::limits::MAX_SCENE_TRIANGLES {
                 return Err(fail(format!(
                     "more than {} triangles (MAX_SCENE_TRIANGLES)",
                     phong_core::limits::MAX_SCENE_TRIANGLES
                 )));
             }
-            let world_pos: Vec<DVec3> = positions
-                .iter()
-                .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
-                .collect();
-            let (normals, has_normals) = match normal_acc.as_ref().and_then(|_| reader.read_normals()) {
-                Some(ns) => {
-                    let ns: Vec<Vec3> = ns
-                        .map(|v| {
-                            (normal_matrix * DVec3::from_array(v.map(f64::from)))
-                                .normalize_or_zero()
-                                .as_vec3()
-                        })
-                        .collect();
-                    let ok = ns.len() == n;
-                    (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
-                }
-                None => (vec![Vec3::ZERO; n], false),
-            };
-            // TANGENT (read with normals, as the format pairs them): a direction in the surface,
-            // by the node's matrix itself; a mirror flips the bitangent's sign.
-            let tangents: Vec<Vec4> = match prim.get(&::gltf::Semantic::Tangents) {
-                Some(a) if has_normals => {
-                    check_accessor(&a, &buffers, &[::gltf::accessor::Dimensions::Vec4], true)
-                        .map_err(|m| fail(format!("{what}: TANGENT (accessor {}): {m}", a.index())))?;
-                    let linear = DMat3::from_mat4(*world);
-                    let t: Vec<Vec4> = reader
-                        .read_tangents()
-                        .into_iter()
-                        .flatten()
-                        .map(|[x, y, z, w]| {
-                            let d = (linear * DVec3::new(x.into(), y.into(), z.into())).normalize_or_zero();
-                            d.as_vec3().extend(if mirrored { -w } else { w })
-                        })
-                        .collect();
-                    if t.len() == n && t.iter().all(|t| t.is_finite()) {
-                        t
-                    } else {
-                        Vec::new()
-                    }
-                }
-                _ => Vec::new(),
-            };
+            let mat = prim.material();
             model.double_sided |= mat.double_sided();
             let mut material = mat.index().map(|_| phong_material(&mat));
-            // The textures' coordinates, v flipped to OpenGL's: the mesh's first set is the
-            // normal texture's (its tangents are made from it), else the base colour's (else
-            // the first used); its second, the other of TEXCOORD_0 and TEXCOORD_1 used, if
-            // any. A third set is not read.
-            let mut infos = texture_infos(&mat);
-            let first = infos
-                .iter()
-                .find(|t| t.slot == Slot::Normal)
-                .or(infos.first())
-                .map(|t| t.set);
-            let second = infos.iter().map(|t| t.set).find(|&s| Some(s) != first && s <= 1);
-            let read_set = |set: Option<u32>| -> Vec<Vec2> {
-                match set.and_then(|s| reader.read_tex_coords(s)) {
-                    Some(t) => {
-                        let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
-                        if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
-                            uv
-                        } else {
-                            Vec::new()
-                        }
-                    }
-                    None => Vec::new(),
-                }
-            };
-            let (uvs, uvs1) = (read_set(first), read_set(second));
-            let beyond = infos
-                .iter()
-                .filter(|t| Some(t.set) != first && Some(t.set) != second)
-                .count();
-            if beyond > 0 {
-                warnings.push(format!(
-                    "{}: {what}: {beyond} textures not used: they read a third texture coordinate set (phong reads two)",
-                    path.display()
-                ));
-            }
-            if second.is_some() && uvs1.is_empty() && !uvs.is_empty() {
-                warnings.push(format!(
-                    "{}: {what}: textures on TEXCOORD_{} not used: the primitive has no usable TEXCOORD_{0}",
-                    path.display(),
-                    second.unwrap_or(1)
-                ));
-            }
-            // Each texture's set as the mesh's: 0 the first, 1 the second.
-            infos.retain(|t| Some(t.set) == first || (Some(t.set) == second && !uvs1.is_empty()));
-            for t in &mut infos {
-                t.set = u32::from(Some(t.set) != first);
-            }
-            let maps = if mat.index().is_some() && !uvs.is_empty() {
-                let requests: Vec<MapRequest> = infos
-                    .iter()
-                    .filter_map(|t| texture_request(t, &buffers, &what))
-                    .collect();
-                let mut maps = resolve(
-                    &requests,
-                    mat.name().unwrap_or("(unnamed)"),
-                    resource,
-                    &mut cache,
-                    warnings,
-                );
-                if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
-                    maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
-                }
-                // The factors go with the map, and the material becomes the one it scales.
-                if let (Some(mr), Some(m)) = (&mut maps.metal_rough, &mut material) {
-                    let pbr = mat.pbr_metallic_roughness();
-                    let b = pbr.base_color_factor();
-                    mr.base_factor = Color::new(b[0], b[1], b[2]).clamp01();
-                    mr.metallic = pbr.metallic_factor().clamp(0.0, 1.0);
-                    mr.roughness = pbr.roughness_factor().clamp(0.0, 1.0);
-                    *m = mr.material(m.emission(), m.alpha());
-                }
-                // glTF's emission is not the base colour's to modulate (GL_MODULATE's would be):
-                // a white emission map keeps it apart.
-                let modulated = maps.diffuse.is_some() || maps.metal_rough.is_some();
-                if maps.emission.is_none() && modulated && material.is_some_and(|m| m.emission() != Color::BLACK) {
-                    maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::clone(&white)));
-                }
-                maps
-            } else {
-                if !infos.is_empty() {
-                    warnings.push(format!(
-                        "{}: {what}: textures not used: the primitive has no usable TEXCOORD_{}",
-                        path.display(),
-                        first.unwrap_or(0)
-                    ));
-                }
-                Maps::default()
-            };
-            // `alphaMode: BLEND`: blended by the base colour's alpha (and its texture's).
-            let maps = Maps {
-                blend: mat.alpha_mode() == ::gltf::material::AlphaMode::Blend,
-                ..maps
-            };
+            let (maps, uvs, uvs1) = textures.maps(&prim, g.world_pos.len(), &buffers, &what, &mut material, warnings);
             let name = format!(
                 "{}:{}",
                 path.file_name()
@@ -424,18 +149,18 @@ pub fn read_gltf(
                     .map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
             );
             // The file's tangents serve a normal map; without one they are not kept.
-            let tangents = if maps.normal.is_some() { tangents } else { Vec::new() };
+            let tangents = if maps.normal.is_some() { g.tangents } else { Vec::new() };
             pending.push(Pending {
                 name,
                 tangents,
-                world_pos,
-                normals,
-                tris,
+                world_pos: g.world_pos,
+                normals: g.normals,
+                tris: g.tris,
                 material,
-                has_normals,
+                has_normals: g.has_normals,
                 uvs,
                 uvs1,
-                colors,
+                colors: g.colors,
                 maps,
             });
         }
@@ -461,39 +186,395 @@ pub fn read_gltf(
             "{file}: vertex colours (COLOR_0, {colours} primitives) are not used: not one finite colour per vertex"
         ));
     }
-    // Re-centre the whole model together (one origin for every part).
-    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
-    for Pending {
-        name,
-        tangents,
+    model.parts = into_parts(pending, &fail)?;
+    Ok(model)
+}
+
+/// What the `gltf` crate's own validation would not say, or would panic on: a required
+/// extension phong does not read (the crate refuses it without saying why), and a primitive's
+/// accessor index out of range (gltf-json's validation indexes the POSITION accessor
+/// unchecked: found by the `gltf` fuzz target).
+fn check_before_validation(bytes: &[u8], fail: &dyn Fn(String) -> Error) -> Result<(), Error> {
+    let unchecked = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    for ext in unchecked.document.extensions_required() {
+        if !SUPPORTED.contains(&ext) {
+            return Err(fail(format!(
+                "the file requires the extension {ext}, which phong does not read{}",
+                if ext.contains("draco") || ext.contains("meshopt") {
+                    " (compressed geometry: decompress it first, e.g. with gltf-transform)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let refs = prim.attributes.values().chain(prim.indices.as_ref());
+            if let Some(bad) = refs.map(|i| i.value()).find(|&i| i >= json.accessors.len()) {
+                return Err(fail(format!(
+                    "mesh {m} primitive {p} names accessor {bad}, but the file has {}",
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The camera of `node` placed by `world`, if it has one.
+fn file_camera(node: &::gltf::Node, world: &DMat4) -> Option<FileCamera> {
+    let cam = node.camera()?;
+    let fov_deg = match cam.projection() {
+        ::gltf::camera::Projection::Perspective(p) => Some(p.yfov().to_degrees()),
+        ::gltf::camera::Projection::Orthographic(_) => None,
+    };
+    Some(FileCamera {
+        position: world.transform_point3(DVec3::ZERO),
+        forward: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+        up: world.transform_vector3(DVec3::Y).normalize_or(DVec3::Y),
+        fov_deg,
+    })
+}
+
+/// The KHR_lights_punctual light of `node` placed by `world`, if it has one.
+fn file_light(node: &::gltf::Node, world: &DMat4) -> Option<FileLight> {
+    let light = node.light()?;
+    let (kind, cutoff_deg) = match light.kind() {
+        ::gltf::khr_lights_punctual::Kind::Directional => ("directional", 0.0),
+        ::gltf::khr_lights_punctual::Kind::Point => ("point", 0.0),
+        ::gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => {
+            ("spot", outer_cone_angle.to_degrees().clamp(0.0, 90.0))
+        }
+    };
+    Some(FileLight {
+        kind,
+        position: world.transform_point3(DVec3::ZERO),
+        direction: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+        color: light.color().map(|c| c * light.intensity()),
+        cutoff_deg,
+    })
+}
+
+/// Checks every accessor a primitive's reading will use (counts, types, bounds within the
+/// buffers), so that the crate's reader cannot fail or panic on them; whether it has normals.
+fn check_primitive(
+    prim: &::gltf::Primitive,
+    buffers: &[Vec<u8>],
+    what: &str,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<bool, Error> {
+    use ::gltf::accessor::{DataType, Dimensions};
+    let pos = prim
+        .get(&::gltf::Semantic::Positions)
+        .ok_or_else(|| fail(format!("{what} has no POSITION")))?;
+    check_accessor(&pos, buffers, &[Dimensions::Vec3], true)
+        .map_err(|m| fail(format!("{what}: POSITION (accessor {}): {m}", pos.index())))?;
+    let normal = prim.get(&::gltf::Semantic::Normals);
+    if let Some(a) = &normal {
+        check_accessor(a, buffers, &[Dimensions::Vec3], true)
+            .map_err(|m| fail(format!("{what}: NORMAL (accessor {}): {m}", a.index())))?;
+    }
+    if let Some(a) = prim.indices() {
+        check_accessor(&a, buffers, &[Dimensions::Scalar], false)
+            .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
+        // Unsigned integers only, as the specification says (the crate's reader treats any
+        // other component type as unreachable: found by the `gltf` fuzz target).
+        if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) || a.normalized() {
+            return Err(fail(format!(
+                "{what}: indices (accessor {}) are not unsigned integers",
+                a.index()
+            )));
+        }
+    }
+    // The texture coordinate sets the material's textures use (checked like the others).
+    let sets: BTreeSet<u32> = texture_infos(&prim.material()).iter().map(|t| t.set).collect();
+    for &set in &sets {
+        if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
+            check_accessor(&a, buffers, &[Dimensions::Vec2], false)
+                .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
+        }
+    }
+    if let Some(a) = prim.get(&::gltf::Semantic::Colors(0)) {
+        check_accessor(&a, buffers, &[Dimensions::Vec3, Dimensions::Vec4], false)
+            .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
+    }
+    Ok(normal.is_some())
+}
+
+/// A primitive's geometry in world space.
+struct Geometry {
+    world_pos: Vec<DVec3>,
+    normals: Vec<Vec3>,
+    has_normals: bool,
+    tris: Vec<[u32; 3]>,
+    colors: Vec<Color>,
+    /// COLOR_0 was there but not one finite colour a vertex: dropped.
+    colours_dropped: bool,
+    tangents: Vec<Vec4>,
+}
+
+/// Reads a checked primitive's positions, vertex colours, triangles (strips and fans
+/// unrolled, wound back where `world` mirrors), normals and tangents, placed by `world`.
+fn geometry(
+    prim: &::gltf::Primitive,
+    buffers: &[Vec<u8>],
+    world: &DMat4,
+    has_normal_accessor: bool,
+    what: &str,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Geometry, Error> {
+    let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
+    let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions = packed_positions(prim, buffers)
+        .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
+        .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
+    if let Some((i, p)) = positions
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+    {
+        return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
+    }
+    let n = positions.len();
+    // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
+    let (colors, colours_dropped) = match reader.read_colors(0) {
+        Some(c) => {
+            let c: Vec<Color> = c
+                .into_rgb_f32()
+                .map(|[r, g, b]| Color::new(r.max(0.0), g.max(0.0), b.max(0.0)))
+                .collect();
+            if c.len() == n && c.iter().all(|c| c.is_finite()) {
+                (c, false)
+            } else {
+                (Vec::new(), true)
+            }
+        }
+        None => (Vec::new(), false),
+    };
+    let indices: Vec<u32> = match (packed_indices(prim, buffers), reader.read_indices()) {
+        (Some(i), _) => i,
+        (None, Some(i)) => i.into_u32().collect(),
+        (None, None) => (0..n as u32).collect(),
+    };
+    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
+    }
+    let mut tris: Vec<[u32; 3]> = match prim.mode() {
+        ::gltf::mesh::Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                let t = [indices[k - 2], indices[k - 1], indices[k]];
+                // Every other triangle of a strip is wound the other way.
+                if k % 2 == 1 { [t[1], t[0], t[2]] } else { t }
+            })
+            .collect(),
+        ::gltf::mesh::Mode::TriangleFan => (2..indices.len())
+            .map(|k| [indices[0], indices[k - 1], indices[k]])
+            .collect(),
+        _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    };
+    if mirrored {
+        tris.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    let world_pos: Vec<DVec3> = positions
+        .iter()
+        .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
+        .collect();
+    let (normals, has_normals) = match reader.read_normals().filter(|_| has_normal_accessor) {
+        Some(ns) => {
+            let ns: Vec<Vec3> = ns
+                .map(|v| {
+                    (normal_matrix * DVec3::from_array(v.map(f64::from)))
+                        .normalize_or_zero()
+                        .as_vec3()
+                })
+                .collect();
+            let ok = ns.len() == n;
+            (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
+        }
+        None => (vec![Vec3::ZERO; n], false),
+    };
+    // TANGENT (read with normals, as the format pairs them): a direction in the surface,
+    // by the node's matrix itself; a mirror flips the bitangent's sign.
+    let tangents: Vec<Vec4> = match prim.get(&::gltf::Semantic::Tangents) {
+        Some(a) if has_normals => {
+            check_accessor(&a, buffers, &[::gltf::accessor::Dimensions::Vec4], true)
+                .map_err(|m| fail(format!("{what}: TANGENT (accessor {}): {m}", a.index())))?;
+            let linear = DMat3::from_mat4(*world);
+            let t: Vec<Vec4> = reader
+                .read_tangents()
+                .into_iter()
+                .flatten()
+                .map(|[x, y, z, w]| {
+                    let d = (linear * DVec3::new(x.into(), y.into(), z.into())).normalize_or_zero();
+                    d.as_vec3().extend(if mirrored { -w } else { w })
+                })
+                .collect();
+            if t.len() == n && t.iter().all(|t| t.is_finite()) {
+                t
+            } else {
+                Vec::new()
+            }
+        }
+        _ => Vec::new(),
+    };
+    Ok(Geometry {
         world_pos,
         normals,
-        tris,
-        material,
         has_normals,
-        uvs,
-        uvs1,
+        tris,
         colors,
-        maps,
-    } in pending
-    {
-        let positions: Vec<Vec3> = world_pos.iter().map(|p| (*p - origin).as_vec3()).collect();
-        let mesh = Mesh::new(positions, normals, tris)
-            .and_then(|m| m.with_uvs(uvs))
-            .and_then(|m| m.with_uvs1(uvs1))
-            .and_then(|m| m.with_colors(colors))
-            .and_then(|m| m.with_tangents(tangents))
-            .map_err(|e| fail(format!("{name}: {e}")))?;
-        model.parts.push(ObjPart {
-            name,
-            mesh,
-            material,
-            maps,
-            has_normals,
-            origin,
-        });
+        colours_dropped,
+        tangents,
+    })
+}
+
+/// The file's textures as they are read: where from, the images decoded so far, and the white
+/// emission map (one for the file, uploaded once by the GPU).
+struct Textures<'a> {
+    path: &'a Path,
+    resource: &'a dyn Fn(&str) -> Result<Vec<u8>, String>,
+    cache: TextureCache,
+    white: Option<std::sync::Arc<phong_core::Texture>>,
+}
+
+impl Textures<'_> {
+    /// A primitive's maps and its two sets of texture coordinates (`v` flipped to OpenGL's),
+    /// for its `n` vertices; `material` becomes the one a metallic-roughness map scales.
+    fn maps(
+        &mut self,
+        prim: &::gltf::Primitive,
+        n: usize,
+        buffers: &[Vec<u8>],
+        what: &str,
+        material: &mut Option<Material>,
+        warnings: &mut Vec<String>,
+    ) -> (Maps, Vec<Vec2>, Vec<Vec2>) {
+        let path = self.path;
+        let mat = &prim.material();
+        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        // The mesh's first set is the normal texture's (its tangents are made from it), else
+        // the base colour's (else the first used); its second, the other of TEXCOORD_0 and
+        // TEXCOORD_1 used, if any. A third set is not read.
+        let mut infos = texture_infos(mat);
+        let first = infos
+            .iter()
+            .find(|t| t.slot == Slot::Normal)
+            .or(infos.first())
+            .map(|t| t.set);
+        let second = infos.iter().map(|t| t.set).find(|&s| Some(s) != first && s <= 1);
+        let read_set = |set: Option<u32>| -> Vec<Vec2> {
+            match set.and_then(|s| reader.read_tex_coords(s)) {
+                Some(t) => {
+                    let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
+                    if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
+                        uv
+                    } else {
+                        Vec::new()
+                    }
+                }
+                None => Vec::new(),
+            }
+        };
+        let (uvs, uvs1) = (read_set(first), read_set(second));
+        let beyond = infos
+            .iter()
+            .filter(|t| Some(t.set) != first && Some(t.set) != second)
+            .count();
+        if beyond > 0 {
+            warnings.push(format!(
+                "{}: {what}: {beyond} textures not used: they read a third texture coordinate set (phong reads two)",
+                path.display()
+            ));
+        }
+        if second.is_some() && uvs1.is_empty() && !uvs.is_empty() {
+            warnings.push(format!(
+                "{}: {what}: textures on TEXCOORD_{} not used: the primitive has no usable TEXCOORD_{0}",
+                path.display(),
+                second.unwrap_or(1)
+            ));
+        }
+        // Each texture's set as the mesh's: 0 the first, 1 the second.
+        infos.retain(|t| Some(t.set) == first || (Some(t.set) == second && !uvs1.is_empty()));
+        for t in &mut infos {
+            t.set = u32::from(Some(t.set) != first);
+        }
+        let maps = if mat.index().is_some() && !uvs.is_empty() {
+            let requests: Vec<MapRequest> = infos.iter().filter_map(|t| texture_request(t, buffers, what)).collect();
+            let mut maps = resolve(
+                &requests,
+                mat.name().unwrap_or("(unnamed)"),
+                self.resource,
+                &mut self.cache,
+                warnings,
+            );
+            if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
+                maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
+            }
+            // The factors go with the map, and the material becomes the one it scales.
+            if let (Some(mr), Some(m)) = (&mut maps.metal_rough, &mut *material) {
+                let pbr = mat.pbr_metallic_roughness();
+                let b = pbr.base_color_factor();
+                mr.base_factor = Color::new(b[0], b[1], b[2]).clamp01();
+                mr.metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+                mr.roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+                *m = mr.material(m.emission(), m.alpha());
+            }
+            // glTF's emission is not the base colour's to modulate (GL_MODULATE's would be):
+            // a white emission map keeps it apart.
+            let modulated = maps.diffuse.is_some() || maps.metal_rough.is_some();
+            if maps.emission.is_none() && modulated && material.is_some_and(|m| m.emission() != Color::BLACK) {
+                let white = self.white.get_or_insert_with(|| {
+                    std::sync::Arc::new(phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture"))
+                });
+                maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::clone(white)));
+            }
+            maps
+        } else {
+            if !infos.is_empty() {
+                warnings.push(format!(
+                    "{}: {what}: textures not used: the primitive has no usable TEXCOORD_{}",
+                    path.display(),
+                    first.unwrap_or(0)
+                ));
+            }
+            Maps::default()
+        };
+        // `alphaMode: BLEND`: blended by the base colour's alpha (and its texture's).
+        let maps = Maps {
+            blend: mat.alpha_mode() == ::gltf::material::AlphaMode::Blend,
+            ..maps
+        };
+        (maps, uvs, uvs1)
     }
-    Ok(model)
+}
+
+/// The parts of the read primitives, the whole model re-centred together (one origin for
+/// every part).
+fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<Vec<ObjPart>, Error> {
+    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
+    pending
+        .into_iter()
+        .map(|p| {
+            let positions: Vec<Vec3> = p.world_pos.iter().map(|w| (*w - origin).as_vec3()).collect();
+            let mesh = Mesh::new(positions, p.normals, p.tris)
+                .and_then(|m| m.with_uvs(p.uvs))
+                .and_then(|m| m.with_uvs1(p.uvs1))
+                .and_then(|m| m.with_colors(p.colors))
+                .and_then(|m| m.with_tangents(p.tangents))
+                .map_err(|e| fail(format!("{}: {e}", p.name)))?;
+            Ok(ObjPart {
+                name: p.name,
+                mesh,
+                material: p.material,
+                maps: p.maps,
+                has_normals: p.has_normals,
+                origin,
+            })
+        })
+        .collect()
 }
 
 /// The file's buffers: the GLB's binary chunk, base64 data URIs, and files read by `resource`;
