@@ -25,52 +25,89 @@ pub(super) fn object(
         None => None,
         Some(m) => Some(match m.get_ref() {
             MaterialRef::Name(n) => lookup_material(ctx, &Spanned::new(m.span(), n.clone()), named)?,
-            MaterialRef::Inline(p) => {
-                let sp = |v: &Option<Vec<f32>>| v.clone().map(|v| Spanned::new(m.span(), v));
-                let spf = |v: Option<f32>| v.map(|v| Spanned::new(m.span(), v));
-                fn at<T>(span: std::ops::Range<usize>, v: Option<T>) -> Option<S<T>> {
-                    v.map(|v| Spanned::new(span, v))
-                }
-                let raw = RawMaterial {
-                    base: p.base.clone().map(|b| Spanned::new(m.span(), b)),
-                    paint: sp(&p.paint),
-                    ambient: sp(&p.ambient),
-                    diffuse: sp(&p.diffuse),
-                    specular: sp(&p.specular),
-                    emission: sp(&p.emission),
-                    shininess: spf(p.shininess),
-                    alpha: spf(p.alpha),
-                    diffuse_map: at(m.span(), p.diffuse_map.clone()),
-                    ambient_map: at(m.span(), p.ambient_map.clone()),
-                    specular_map: at(m.span(), p.specular_map.clone()),
-                    emission_map: at(m.span(), p.emission_map.clone()),
-                    shininess_map: at(m.span(), p.shininess_map.clone()),
-                    alpha_map: at(m.span(), p.alpha_map.clone()),
-                    normal_map: at(m.span(), p.normal_map.clone()),
-                    bump_map: at(m.span(), p.bump_map.clone()),
-                    bump_scale: at(m.span(), p.bump_scale),
-                    uv_scale: at(m.span(), p.uv_scale.clone()),
-                    uv_offset: at(m.span(), p.uv_offset.clone()),
-                    wrap: at(m.span(), p.wrap.clone()),
-                    filter: at(m.span(), p.filter.clone()),
-                    encoding: at(m.span(), p.encoding.clone()),
-                    alpha_cutoff: at(m.span(), p.alpha_cutoff),
-                    blend: at(m.span(), p.blend),
-                    normal_scale: at(m.span(), p.normal_scale),
-                    normal_green: at(m.span(), p.normal_green.clone()),
-                };
-                material(ctx, &raw, "material", named)?
-            }
+            MaterialRef::Inline(p) => inline_material(ctx, m, p, named)?,
         }),
     };
     let world_from_object = transform(ctx, o)?;
-    let normals_choice = o.normals.as_ref();
-    let crease = match &o.crease {
-        Some(c) => ctx.num(c, "crease", |x| (0.0..=180.0).contains(&x), "in [0, 180] degrees")?,
-        None => 60.0,
+    match (&o.shape, &o.mesh) {
+        (Some(_), Some(m)) => ctx.err(&m.span(), "mesh", "an object has either `shape` or `mesh`, not both"),
+        (Some(shape), None) => shape_object(ctx, o, span, shape, world_from_object, material, shading),
+        (None, Some(m)) => mesh_objects(ctx, o, m, world_from_object, material, shading),
+        (None, None) => ctx.err(
+            &span,
+            "object",
+            "an object needs `shape` (sphere, torus, ...) or `mesh` (a file)",
+        ),
+    }
+}
+
+/// The object's `crease` (degrees, for `normals = "angle"`; 60 by default).
+fn crease(ctx: &mut Ctx, o: &RawObject) -> Result<f32, Error> {
+    match &o.crease {
+        Some(c) => ctx.num(c, "crease", |x| (0.0..=180.0).contains(&x), "in [0, 180] degrees"),
+        None => Ok(60.0),
+    }
+}
+
+/// An inline material table (`material = { ... }`) as the scene's `[materials]` reader reads
+/// one, every key at the table's place in the file (an inline table's keys keep no spans of
+/// their own).
+fn inline_material(
+    ctx: &mut Ctx,
+    m: &S<MaterialRef>,
+    p: &super::raw::PlainMaterial,
+    named: &BTreeMap<String, Mat>,
+) -> Result<Mat, Error> {
+    let sp = |v: &Option<Vec<f32>>| v.clone().map(|v| Spanned::new(m.span(), v));
+    let spf = |v: Option<f32>| v.map(|v| Spanned::new(m.span(), v));
+    fn at<T>(span: std::ops::Range<usize>, v: Option<T>) -> Option<S<T>> {
+        v.map(|v| Spanned::new(span, v))
+    }
+    let raw = RawMaterial {
+        base: p.base.clone().map(|b| Spanned::new(m.span(), b)),
+        paint: sp(&p.paint),
+        ambient: sp(&p.ambient),
+        diffuse: sp(&p.diffuse),
+        specular: sp(&p.specular),
+        emission: sp(&p.emission),
+        shininess: spf(p.shininess),
+        alpha: spf(p.alpha),
+        diffuse_map: at(m.span(), p.diffuse_map.clone()),
+        ambient_map: at(m.span(), p.ambient_map.clone()),
+        specular_map: at(m.span(), p.specular_map.clone()),
+        emission_map: at(m.span(), p.emission_map.clone()),
+        shininess_map: at(m.span(), p.shininess_map.clone()),
+        alpha_map: at(m.span(), p.alpha_map.clone()),
+        normal_map: at(m.span(), p.normal_map.clone()),
+        bump_map: at(m.span(), p.bump_map.clone()),
+        bump_scale: at(m.span(), p.bump_scale),
+        uv_scale: at(m.span(), p.uv_scale.clone()),
+        uv_offset: at(m.span(), p.uv_offset.clone()),
+        wrap: at(m.span(), p.wrap.clone()),
+        filter: at(m.span(), p.filter.clone()),
+        encoding: at(m.span(), p.encoding.clone()),
+        alpha_cutoff: at(m.span(), p.alpha_cutoff),
+        blend: at(m.span(), p.blend),
+        normal_scale: at(m.span(), p.normal_scale),
+        normal_green: at(m.span(), p.normal_green.clone()),
     };
+    material(ctx, &raw, "material", named)
+}
+
+/// A `shape` object: the primitive with its segments checked against the limits, its normals
+/// as asked, its material and maps.
+fn shape_object(
+    ctx: &mut Ctx,
+    o: &RawObject,
+    span: std::ops::Range<usize>,
+    shape: &S<String>,
+    world_from_object: Mat4,
+    material: Option<Mat>,
+    shading: ShadingSettings,
+) -> Result<Vec<Object>, Error> {
+    let crease = crease(ctx, o)?;
     let apply_normals = |mesh: Mesh, default: &str, allowed: &[&str]| -> Result<Mesh, Error> {
-        let choice = match normals_choice {
+        let choice = match o.normals.as_ref() {
             Some(n) => ctx.name(n, "normals", allowed)?,
             None => default,
         };
@@ -84,209 +121,209 @@ pub(super) fn object(
             },
         ))
     };
-    match (&o.shape, &o.mesh) {
-        (Some(_), Some(m)) | (None, Some(m)) if o.shape.is_some() => {
-            ctx.err(&m.span(), "mesh", "an object has either `shape` or `mesh`, not both")
-        }
-        (Some(shape), None) => {
-            let kind = ctx.name(shape, "shape", SHAPES)?;
-            let default_segments = match kind {
-                "plane" => 1,
-                "teapot" => 10,
-                _ => 64,
-            };
-            let min = if matches!(kind, "plane" | "teapot") { 1 } else { 3 };
-            let segments = match &o.segments {
-                Some(s) => ctx.int(s, "segments", min, i64::from(MAX_SEGMENTS))? as u32,
-                None => default_segments,
-            };
-            let n = u64::from(segments);
-            let triangles = match kind {
-                "teapot" => 64 * n * n,
-                "plane" => 2 * n * n,
-                "cube" => 12,
-                _ => n * n + 4 * n,
-            };
-            if triangles > phong_core::limits::MAX_PRIMITIVE_TRIANGLES {
-                let span = o.segments.as_ref().map_or(span.clone(), |s| s.span());
-                return ctx.err(
-                    &span,
-                    "segments",
-                    format!(
-                        "a {kind} with {segments} segments has about {triangles} triangles; the limit is {}",
-                        phong_core::limits::MAX_PRIMITIVE_TRIANGLES
-                    ),
-                );
-            }
-            ctx.add_triangles(
-                triangles,
-                &o.segments.as_ref().map_or(span.clone(), |s| s.span()),
-                "segments",
-            )?;
-            if kind != "torus" {
-                for (v, key) in [(&o.radius, "radius"), (&o.tube, "tube")] {
-                    if let Some(v) = v {
-                        return ctx.err(&v.span(), key, format!("only a torus has `{key}`; use `scale`"));
-                    }
-                }
-            }
-            let mesh = match kind {
-                "sphere" => primitives::sphere(segments),
-                "torus" => {
-                    let r = match &o.radius {
-                        Some(r) => ctx.num(r, "radius", |x| x > 0.0, "> 0")?,
-                        None => 1.0,
-                    };
-                    let t = match &o.tube {
-                        Some(t) => ctx.num(t, "tube", |x| x > 0.0, "> 0")?,
-                        None => 0.25,
-                    };
-                    primitives::torus(segments, r, t)
-                }
-                "cylinder" => primitives::cylinder(segments),
-                "cone" => primitives::cone(segments),
-                "cube" => primitives::cube(),
-                "plane" => primitives::plane(segments),
-                _ => primitives::teapot(segments),
-            };
-            if let Some(f) = &o.fit {
-                return ctx.err(&f.span(), "fit", "only a mesh has `fit`; a shape is already unit-sized");
-            }
-            let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
-            let (material, maps) = material.unwrap_or_default();
-            let mesh = tangents_for(mesh, &maps);
-            Ok(vec![Object {
-                name: kind.to_string(),
-                mesh: mesh.transformed(&world_from_object),
-                material,
-                shading,
-                maps,
-            }])
-        }
-        (None, Some(m)) => {
-            if let Some(s) = &o.segments {
-                return ctx.err(&s.span(), "segments", "a mesh has no `segments`");
-            }
-            let mut warnings = Vec::new();
-            let mut sources = Vec::new();
-            let fit = o.fit.as_ref().is_some_and(|f| *f.get_ref());
-            let parts = match ctx.meshes {
-                Some(lookup) => match lookup(m.get_ref()) {
-                    Ok(parts) => parts,
-                    Err(msg) => return ctx.err(&m.span(), "mesh", msg),
-                },
-                None => {
-                    let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
-                    if !file.exists() {
-                        return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
-                    }
-                    // A file in no format phong reads is reported at the scene's `mesh` key.
-                    match load_model_sources(&file, &mut warnings, &mut sources) {
-                        Err(e @ Error::Model { .. }) => return ctx.err(&m.span(), "mesh", e.to_string()),
-                        r => r?,
-                    }
-                }
-            };
-            // The file's coordinates (the re-centred model moved back to where the file puts
-            // it), or with `fit` the model centred at the origin with a bounding sphere of
-            // radius 1, before the object's own transform. A fitted model is fitted before its
-            // normals are computed (at 1e30, f32 cross products overflow).
-            let (fit_frame, world_from_file) = match crate::model::fit_of(&parts) {
-                Some(frame) if fit => (Some(frame), world_from_object),
-                _ => match parts.first() {
-                    Some(p) if p.origin != glam::DVec3::ZERO => {
-                        (None, world_from_object * Mat4::from_translation(p.origin.as_vec3()))
-                    }
-                    _ => (None, world_from_object),
-                },
-            };
-            let mut out = Vec::new();
-            for mut p in parts {
-                if let Some((centre, radius)) = fit_frame {
-                    // In f64 (coordinates near f32's largest, a radius whose inverse is below its
-                    // smallest normal number). A uniform scale and a move: the file's normals keep
-                    // their directions.
-                    let positions = p
-                        .mesh
-                        .positions()
-                        .iter()
-                        .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
-                        .collect();
-                    p.mesh = std::mem::take(&mut p.mesh)
-                        .with_positions(positions)
-                        .map_err(|e| Error::Model {
-                            path: ctx.path.to_path_buf(),
-                            message: format!("{}: {e}", p.name),
-                        })?;
-                }
-                // File normals where every vertex has a usable one; else, or where `"file"`
-                // is asked of a model without them, normals by angle, with a warning.
-                let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
-                let usable = p.has_normals && bad == 0;
-                let asked = normals_choice
-                    .map(|n| ctx.name(n, "normals", &["file", "flat", "smooth", "angle"]))
-                    .transpose()?;
-                if p.has_normals && bad > 0 && asked.is_none_or(|a| a == "file") {
-                    warnings.push(format!(
-                        "{}: {bad} of its {} file normals are zero or not finite: normals computed by angle instead",
-                        p.name,
-                        p.mesh.normals().len()
-                    ));
-                } else if !p.has_normals && asked == Some("file") {
-                    warnings.push(format!(
-                        "{}: `normals = \"file\"` but the file has no normals for it: normals computed by angle",
-                        p.name
-                    ));
-                }
-                let choice = match asked {
-                    Some("file") | None if !usable => "angle",
-                    Some(a) => a,
-                    None => "file",
-                };
-                let mesh = crate::timing::timed(
-                    |t| &mut t.normals,
-                    || match choice {
-                        "flat" => p.mesh.with_flat_normals(),
-                        "smooth" => p.mesh.with_smooth_normals(),
-                        "angle" => p.mesh.with_crease_normals(crease),
-                        _ => p.mesh,
-                    },
-                );
-                // The scene's material replaces the file's, maps and all.
-                let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
-                let maps = if !maps.is_empty() && !mesh.has_uvs() {
-                    warnings.push(format!(
-                        "{}: its material has texture maps but the model has no texture coordinates: maps not used",
-                        p.name
-                    ));
-                    Maps {
-                        blend: maps.blend,
-                        ..Maps::default()
-                    }
-                } else {
-                    maps
-                };
-                let mesh = tangents_for(mesh, &maps);
-                out.push(Object {
-                    name: p.name,
-                    mesh: mesh.transformed(&world_from_file),
-                    material,
-                    shading,
-                    maps,
-                });
-            }
-            let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();
-            ctx.warnings.extend(warnings);
-            ctx.sources.extend(sources);
-            ctx.add_triangles(tris, &m.span(), "mesh")?;
-            Ok(out)
-        }
-        _ => ctx.err(
+    let kind = ctx.name(shape, "shape", SHAPES)?;
+    let default_segments = match kind {
+        "plane" => 1,
+        "teapot" => 10,
+        _ => 64,
+    };
+    let min = if matches!(kind, "plane" | "teapot") { 1 } else { 3 };
+    let segments = match &o.segments {
+        Some(s) => ctx.int(s, "segments", min, i64::from(MAX_SEGMENTS))? as u32,
+        None => default_segments,
+    };
+    let n = u64::from(segments);
+    let triangles = match kind {
+        "teapot" => 64 * n * n,
+        "plane" => 2 * n * n,
+        "cube" => 12,
+        _ => n * n + 4 * n,
+    };
+    if triangles > phong_core::limits::MAX_PRIMITIVE_TRIANGLES {
+        let span = o.segments.as_ref().map_or(span.clone(), |s| s.span());
+        return ctx.err(
             &span,
-            "object",
-            "an object needs `shape` (sphere, torus, ...) or `mesh` (a file)",
-        ),
+            "segments",
+            format!(
+                "a {kind} with {segments} segments has about {triangles} triangles; the limit is {}",
+                phong_core::limits::MAX_PRIMITIVE_TRIANGLES
+            ),
+        );
     }
+    ctx.add_triangles(
+        triangles,
+        &o.segments.as_ref().map_or(span.clone(), |s| s.span()),
+        "segments",
+    )?;
+    if kind != "torus" {
+        for (v, key) in [(&o.radius, "radius"), (&o.tube, "tube")] {
+            if let Some(v) = v {
+                return ctx.err(&v.span(), key, format!("only a torus has `{key}`; use `scale`"));
+            }
+        }
+    }
+    let mesh = match kind {
+        "sphere" => primitives::sphere(segments),
+        "torus" => {
+            let r = match &o.radius {
+                Some(r) => ctx.num(r, "radius", |x| x > 0.0, "> 0")?,
+                None => 1.0,
+            };
+            let t = match &o.tube {
+                Some(t) => ctx.num(t, "tube", |x| x > 0.0, "> 0")?,
+                None => 0.25,
+            };
+            primitives::torus(segments, r, t)
+        }
+        "cylinder" => primitives::cylinder(segments),
+        "cone" => primitives::cone(segments),
+        "cube" => primitives::cube(),
+        "plane" => primitives::plane(segments),
+        _ => primitives::teapot(segments),
+    };
+    if let Some(f) = &o.fit {
+        return ctx.err(&f.span(), "fit", "only a mesh has `fit`; a shape is already unit-sized");
+    }
+    let mesh = apply_normals(mesh, "analytic", &["analytic", "flat", "smooth", "angle"])?;
+    let (material, maps) = material.unwrap_or_default();
+    let mesh = tangents_for(mesh, &maps);
+    Ok(vec![Object {
+        name: kind.to_string(),
+        mesh: mesh.transformed(&world_from_object),
+        material,
+        shading,
+        maps,
+    }])
+}
+
+/// A `mesh` object: one object a part of the model file, placed in the file's coordinates (or
+/// fitted), its normals as asked (the file's where usable), the scene's material or the file's.
+fn mesh_objects(
+    ctx: &mut Ctx,
+    o: &RawObject,
+    m: &S<String>,
+    world_from_object: Mat4,
+    material: Option<Mat>,
+    shading: ShadingSettings,
+) -> Result<Vec<Object>, Error> {
+    let crease = crease(ctx, o)?;
+    let normals_choice = o.normals.as_ref();
+    if let Some(s) = &o.segments {
+        return ctx.err(&s.span(), "segments", "a mesh has no `segments`");
+    }
+    let mut warnings = Vec::new();
+    let mut sources = Vec::new();
+    let fit = o.fit.as_ref().is_some_and(|f| *f.get_ref());
+    let parts = match ctx.meshes {
+        Some(lookup) => match lookup(m.get_ref()) {
+            Ok(parts) => parts,
+            Err(msg) => return ctx.err(&m.span(), "mesh", msg),
+        },
+        None => {
+            let file = ctx.path.parent().unwrap_or(Path::new("")).join(m.get_ref());
+            if !file.exists() {
+                return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
+            }
+            // A file in no format phong reads is reported at the scene's `mesh` key.
+            match load_model_sources(&file, &mut warnings, &mut sources) {
+                Err(e @ Error::Model { .. }) => return ctx.err(&m.span(), "mesh", e.to_string()),
+                r => r?,
+            }
+        }
+    };
+    // The file's coordinates (the re-centred model moved back to where the file puts
+    // it), or with `fit` the model centred at the origin with a bounding sphere of
+    // radius 1, before the object's own transform. A fitted model is fitted before its
+    // normals are computed (at 1e30, f32 cross products overflow).
+    let (fit_frame, world_from_file) = match crate::model::fit_of(&parts) {
+        Some(frame) if fit => (Some(frame), world_from_object),
+        _ => match parts.first() {
+            Some(p) if p.origin != glam::DVec3::ZERO => {
+                (None, world_from_object * Mat4::from_translation(p.origin.as_vec3()))
+            }
+            _ => (None, world_from_object),
+        },
+    };
+    let mut out = Vec::new();
+    for mut p in parts {
+        if let Some((centre, radius)) = fit_frame {
+            // In f64 (coordinates near f32's largest, a radius whose inverse is below its
+            // smallest normal number). A uniform scale and a move: the file's normals keep
+            // their directions.
+            let positions = p
+                .mesh
+                .positions()
+                .iter()
+                .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
+                .collect();
+            p.mesh = std::mem::take(&mut p.mesh)
+                .with_positions(positions)
+                .map_err(|e| Error::Model {
+                    path: ctx.path.to_path_buf(),
+                    message: format!("{}: {e}", p.name),
+                })?;
+        }
+        // File normals where every vertex has a usable one; else, or where `"file"`
+        // is asked of a model without them, normals by angle, with a warning.
+        let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
+        let usable = p.has_normals && bad == 0;
+        let asked = normals_choice
+            .map(|n| ctx.name(n, "normals", &["file", "flat", "smooth", "angle"]))
+            .transpose()?;
+        if p.has_normals && bad > 0 && asked.is_none_or(|a| a == "file") {
+            warnings.push(format!(
+                "{}: {bad} of its {} file normals are zero or not finite: normals computed by angle instead",
+                p.name,
+                p.mesh.normals().len()
+            ));
+        } else if !p.has_normals && asked == Some("file") {
+            warnings.push(format!(
+                "{}: `normals = \"file\"` but the file has no normals for it: normals computed by angle",
+                p.name
+            ));
+        }
+        let choice = match asked {
+            Some("file") | None if !usable => "angle",
+            Some(a) => a,
+            None => "file",
+        };
+        let mesh = crate::timing::timed(
+            |t| &mut t.normals,
+            || match choice {
+                "flat" => p.mesh.with_flat_normals(),
+                "smooth" => p.mesh.with_smooth_normals(),
+                "angle" => p.mesh.with_crease_normals(crease),
+                _ => p.mesh,
+            },
+        );
+        // The scene's material replaces the file's, maps and all.
+        let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
+        let maps = if !maps.is_empty() && !mesh.has_uvs() {
+            warnings.push(format!(
+                "{}: its material has texture maps but the model has no texture coordinates: maps not used",
+                p.name
+            ));
+            Maps {
+                blend: maps.blend,
+                ..Maps::default()
+            }
+        } else {
+            maps
+        };
+        let mesh = tangents_for(mesh, &maps);
+        out.push(Object {
+            name: p.name,
+            mesh: mesh.transformed(&world_from_file),
+            material,
+            shading,
+            maps,
+        });
+    }
+    let tris: u64 = out.iter().map(|o| o.mesh.triangles().len() as u64).sum();
+    ctx.warnings.extend(warnings);
+    ctx.sources.extend(sources);
+    ctx.add_triangles(tris, &m.span(), "mesh")?;
+    Ok(out)
 }
 
 /// The mesh with MikkTSpace tangents where a normal map needs them (after its normals, which
