@@ -322,10 +322,29 @@ pub fn load_obj_text(
     let tobj_materials: Vec<tobj::Material> = materials.unwrap_or_default();
     undefined_materials(path, &prepared.used, &tobj_materials, warnings);
     let materials = materials_of(path, &tobj_materials, warnings);
-    // Each material's maps, its images read once for the whole file.
-    let requests = map_requests.into_inner();
+    let maps = material_maps(&tobj_materials, map_requests.into_inner(), read_texture, warnings);
+    let mut parts = Vec::new();
+    for model in &models {
+        if let Some(part) = part_of(path, src, model, (&materials, &maps), prepared.origin, warnings)? {
+            parts.push(part);
+        }
+    }
+    if parts.is_empty() {
+        return Err(no_faces(path, src, &prepared.notes));
+    }
+    Ok(merge_parts(parts))
+}
+
+/// Each material's maps, from the requests its MTL statements made, the images read once for
+/// the whole file (decoded side by side, then resolved in order).
+fn material_maps(
+    materials: &[tobj::Material],
+    requests: Vec<(String, MapRequest)>,
+    read_texture: &ReadFile,
+    warnings: &mut Vec<String>,
+) -> Vec<Maps> {
     let mut cache = TextureCache::default();
-    let mine: Vec<Vec<MapRequest>> = tobj_materials
+    let mine: Vec<Vec<MapRequest>> = materials
         .iter()
         .map(|m| {
             requests
@@ -335,118 +354,133 @@ pub fn load_obj_text(
                 .collect()
         })
         .collect();
-    // Every material's images decoded side by side, then resolved in order.
     prefetch(&mine, read_texture, &mut cache);
-    let maps: Vec<Maps> = tobj_materials
+    materials
         .iter()
         .zip(&mine)
         .map(|(m, mine)| resolve(mine, &m.name, read_texture, &mut cache, warnings))
-        .collect();
+        .collect()
+}
+
+/// One group of the file as a part (with its material's index, for merging), or `None` where
+/// it has no faces: its polygons triangulated, its normals, texture coordinates and vertex
+/// colours where the file gives one a vertex, its material and maps.
+fn part_of(
+    path: &Path,
+    src: &str,
+    model: &tobj::Model,
+    (materials, maps): (&[Material], &[Maps]),
+    origin: glam::DVec3,
+    warnings: &mut Vec<String>,
+) -> Result<Option<(ObjPart, Option<usize>)>, Error> {
     let file = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut parts = Vec::new();
-    for model in models {
-        let m = &model.mesh;
-        if m.indices.is_empty() {
-            continue;
-        }
-        let positions: Vec<Vec3> = m
-            .positions
+    let m = &model.mesh;
+    if m.indices.is_empty() {
+        return Ok(None);
+    }
+    let positions: Vec<Vec3> = m
+        .positions
+        .chunks_exact(3)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    let has_normals = m.normals.len() == m.positions.len();
+    let normals = if has_normals {
+        m.normals
             .chunks_exact(3)
-            .map(|p| Vec3::new(p[0], p[1], p[2]))
-            .collect();
-        let has_normals = m.normals.len() == m.positions.len();
-        let normals = if has_normals {
-            m.normals
-                .chunks_exact(3)
-                .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
-                .collect()
-        } else {
-            vec![Vec3::ZERO; positions.len()]
-        };
-        let tris = polygons_to_triangles(&positions, &m.indices, &m.face_arities);
-        let n = positions.len();
-        // One texture coordinate per vertex where the file gives them (tobj's single index).
-        let uvs: Vec<Vec2> = if m.texcoords.len() == 2 * n {
-            m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])).collect()
-        } else {
-            Vec::new()
-        };
-        // Vertex colours, where the part has no material (they stand for its ambient and
-        // diffuse colours, as OpenGL's GL_COLOR_MATERIAL; a material's colours win).
-        let material = m.material_id.and_then(|i| materials.get(i).copied());
-        let colors: Vec<Color> = if m.vertex_color.len() == 3 * n && material.is_none() {
-            m.vertex_color
-                .chunks_exact(3)
-                .map(|c| Color::new(c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)))
-                .collect()
-        } else {
-            if m.vertex_color.len() == 3 * n {
-                warnings.push(format!(
-                    "{}: group {}: vertex colours not used: the group has a material",
-                    path.display(),
-                    model.name
-                ));
-            }
-            Vec::new()
-        };
-        let coloured = !colors.is_empty();
-        let mesh = Mesh::new(positions, normals, tris)
-            .and_then(|mesh| mesh.with_uvs(uvs))
-            .and_then(|mesh| mesh.with_colors(colors))
-            .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
-        parts.push((
-            ObjPart {
-                name: format!("{file}:{}", model.name),
-                mesh,
-                material: match material {
-                    None if coloured => Some(crate::formats::vertex_color_material()),
-                    other => other,
-                },
-                maps: m
-                    .material_id
-                    .and_then(|i| maps.get(i).cloned())
-                    .map(|mut maps| {
-                        // `d` or `Tr` below 1: blended, as the file means it.
-                        maps.blend = m
-                            .material_id
-                            .and_then(|i| materials.get(i))
-                            .is_some_and(|m| m.alpha() < 1.0);
-                        maps
-                    })
-                    .unwrap_or_default(),
-                has_normals,
-                origin: prepared.origin,
+            .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
+            .collect()
+    } else {
+        vec![Vec3::ZERO; positions.len()]
+    };
+    let tris = polygons_to_triangles(&positions, &m.indices, &m.face_arities);
+    let n = positions.len();
+    // One texture coordinate per vertex where the file gives them (tobj's single index).
+    let uvs: Vec<Vec2> = if m.texcoords.len() == 2 * n {
+        m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])).collect()
+    } else {
+        Vec::new()
+    };
+    // Vertex colours, where the part has no material (they stand for its ambient and
+    // diffuse colours, as OpenGL's GL_COLOR_MATERIAL; a material's colours win).
+    let material = m.material_id.and_then(|i| materials.get(i).copied());
+    let colors: Vec<Color> = if m.vertex_color.len() == 3 * n && material.is_none() {
+        m.vertex_color
+            .chunks_exact(3)
+            .map(|c| Color::new(c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)))
+            .collect()
+    } else {
+        if m.vertex_color.len() == 3 * n {
+            warnings.push(format!(
+                "{}: group {}: vertex colours not used: the group has a material",
+                path.display(),
+                model.name
+            ));
+        }
+        Vec::new()
+    };
+    let coloured = !colors.is_empty();
+    let mesh = Mesh::new(positions, normals, tris)
+        .and_then(|mesh| mesh.with_uvs(uvs))
+        .and_then(|mesh| mesh.with_colors(colors))
+        .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
+    Ok(Some((
+        ObjPart {
+            name: format!("{file}:{}", model.name),
+            mesh,
+            material: match material {
+                None if coloured => Some(crate::formats::vertex_color_material()),
+                other => other,
             },
-            m.material_id,
-        ));
-    }
-    if parts.is_empty() {
-        return Err(Error::at(
-            path,
-            src,
-            0,
-            None,
-            format!(
-                "no faces{} (`f` records with 3 or more vertices): nothing to render{}",
-                match src.lines().filter(|l| l.trim_start().starts_with("v ")).count() {
-                    0 => String::new(),
-                    n => format!(": a point cloud of {n} points"),
-                },
-                prepared
-                    .notes
-                    .iter()
-                    .map(|n| {
-                        let file = format!("{}: ", path.display());
-                        format!("; {}", n.strip_prefix(&file).unwrap_or(n))
-                    })
-                    .collect::<String>()
-            ),
-        ));
-    }
-    // Merge parts that share a material within the same group name.
+            maps: m
+                .material_id
+                .and_then(|i| maps.get(i).cloned())
+                .map(|mut maps| {
+                    // `d` or `Tr` below 1: blended, as the file means it.
+                    maps.blend = m
+                        .material_id
+                        .and_then(|i| materials.get(i))
+                        .is_some_and(|m| m.alpha() < 1.0);
+                    maps
+                })
+                .unwrap_or_default(),
+            has_normals,
+            origin,
+        },
+        m.material_id,
+    )))
+}
+
+/// The error of a file with no faces, saying what it is (points, or nothing) and why records
+/// were skipped (`notes`).
+fn no_faces(path: &Path, src: &str, notes: &[String]) -> Error {
+    Error::at(
+        path,
+        src,
+        0,
+        None,
+        format!(
+            "no faces{} (`f` records with 3 or more vertices): nothing to render{}",
+            match src.lines().filter(|l| l.trim_start().starts_with("v ")).count() {
+                0 => String::new(),
+                n => format!(": a point cloud of {n} points"),
+            },
+            notes
+                .iter()
+                .map(|n| {
+                    let file = format!("{}: ", path.display());
+                    format!("; {}", n.strip_prefix(&file).unwrap_or(n))
+                })
+                .collect::<String>()
+        ),
+    )
+}
+
+/// Parts that share a material within the same group name, merged (where they agree on
+/// having normals).
+fn merge_parts(parts: Vec<(ObjPart, Option<usize>)>) -> Vec<ObjPart> {
     let mut merged: Vec<ObjPart> = Vec::new();
     let mut index: HashMap<(String, Option<usize>), usize> = HashMap::new();
     for (p, id) in parts {
@@ -459,7 +493,7 @@ pub fn load_obj_text(
             }
         }
     }
-    Ok(merged)
+    merged
 }
 
 #[cfg(test)]
