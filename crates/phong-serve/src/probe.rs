@@ -304,37 +304,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         _ => (lerp(ps), lerp(ns) * flip),
     };
     let lit_output = !matches!(output, Output::Normal | Output::Depth);
-    let texture = (obj.textured() && lit_output).then(|| {
-        // Set `k`'s coordinates at barycentrics `b`.
-        let uv_at = |k: usize, b: [f64; 3]| {
-            let set = if k == 0 { mesh.uvs() } else { mesh.uvs1() };
-            let uvs = tri.map(|i| set.get(i as usize).copied().unwrap_or_default().as_dvec2());
-            uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
-        };
-        let corners = ps.map(|p| p.as_dvec3());
-        let (fx, fy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
-        // Each set's coordinates and their derivatives as the renderer's (exact at the centre),
-        // by central differences over 1/16 pixel on the triangle's plane.
-        let h = 1.0 / 16.0;
-        let set = |k: usize| {
-            let at = |dx: f64, dy: f64| plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| uv_at(k, b));
-            let derivative = |dx: f64, dy: f64| match (at(dx * h, dy * h), at(-dx * h, -dy * h)) {
-                (Some(a), Some(b)) => ((a - b) / (2.0 * h)).as_vec2(),
-                _ => Vec2::ZERO,
-            };
-            [uv_at(k, bary).as_vec2(), derivative(1.0, 0.0), derivative(0.0, 1.0)]
-        };
-        let first = set(0);
-        let second = if obj.maps.uses_second_set() { set(1) } else { first };
-        let [uv, d_dx, d_dy] = first;
-        let mut texels = obj.maps.sample_sets(&[first, second]);
-        if !mesh.colors().is_empty() {
-            let c = tri.map(|i| mesh.colors()[i as usize]);
-            let w = bary.map(|w| w as f32);
-            texels = texels.tinted(c[0] * w[0] + c[1] * w[1] + c[2] * w[2]);
-        }
-        (uv, d_dx, d_dy, texels)
-    });
+    let texture = (obj.textured() && lit_output).then(|| texels_at(scene, obj, tri, bary, (x, y)));
     let texels = texture.map(|t| t.3);
     let options = ShadingOptions {
         two_sided: false,
@@ -413,34 +383,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         ));
     }
     let hit = hit_terms(scene, obj, &view, position, normal, &at);
-    let texture = texture.map(|(uv, d_dx, d_dy, t)| {
-        let alpha = Maps::alpha(&obj.material, &t);
-        let discarded = obj.maps.discards(alpha);
-        notes.push(format!(
-            "textured: uv ({:.4}, {:.4}); diffuse texel ({:.3}, {:.3}, {:.3}), alpha {alpha:.3}{}",
-            uv.x,
-            uv.y,
-            t.diffuse[0],
-            t.diffuse[1],
-            t.diffuse[2],
-            if discarded {
-                ": discarded by the alpha test (the renderer shows what is behind)"
-            } else {
-                ""
-            }
-        ));
-        TextureValue {
-            uv: uv.to_array(),
-            uv_dx: d_dx.to_array(),
-            uv_dy: d_dy.to_array(),
-            diffuse: t.diffuse,
-            specular: c3(t.specular),
-            shininess: t.shininess,
-            occlusion: t.occlusion.unwrap_or(1.0),
-            alpha,
-            discarded,
-        }
-    });
+    let texture = texture.map(|(uv, d_dx, d_dy, t)| texture_value(obj, [uv, d_dx, d_dy], &t, &mut notes));
     Probe {
         x,
         y,
@@ -463,6 +406,80 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
         value,
         value8: value.map(|c| encoding.encode(c)),
         notes,
+    }
+}
+
+/// The texels of `obj` at barycentrics `bary` of triangle `tri` seen at pixel `(x, y)`: the
+/// first set's coordinates and their screen derivatives (by central differences over 1/16
+/// pixel on the triangle's plane: the renderer's, exact at the centre), and the texels.
+fn texels_at(
+    scene: &Scene,
+    obj: &Object,
+    tri: [u32; 3],
+    bary: [f64; 3],
+    (x, y): (u32, u32),
+) -> (Vec2, Vec2, Vec2, Texels) {
+    let mesh = &obj.mesh;
+    let ps = tri.map(|i| mesh.positions()[i as usize]);
+    // Set `k`'s coordinates at barycentrics `b`.
+    let uv_at = |k: usize, b: [f64; 3]| {
+        let set = if k == 0 { mesh.uvs() } else { mesh.uvs1() };
+        let uvs = tri.map(|i| set.get(i as usize).copied().unwrap_or_default().as_dvec2());
+        uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
+    };
+    let corners = ps.map(|p| p.as_dvec3());
+    let (fx, fy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+    // Each set's coordinates and their derivatives as the renderer's (exact at the centre),
+    // by central differences over 1/16 pixel on the triangle's plane.
+    let h = 1.0 / 16.0;
+    let set = |k: usize| {
+        let at = |dx: f64, dy: f64| plane_barycentrics(ray(scene, fx + dx, fy + dy), corners).map(|b| uv_at(k, b));
+        let derivative = |dx: f64, dy: f64| match (at(dx * h, dy * h), at(-dx * h, -dy * h)) {
+            (Some(a), Some(b)) => ((a - b) / (2.0 * h)).as_vec2(),
+            _ => Vec2::ZERO,
+        };
+        [uv_at(k, bary).as_vec2(), derivative(1.0, 0.0), derivative(0.0, 1.0)]
+    };
+    let first = set(0);
+    let second = if obj.maps.uses_second_set() { set(1) } else { first };
+    let [uv, d_dx, d_dy] = first;
+    let mut texels = obj.maps.sample_sets(&[first, second]);
+    if !mesh.colors().is_empty() {
+        let c = tri.map(|i| mesh.colors()[i as usize]);
+        let w = bary.map(|w| w as f32);
+        texels = texels.tinted(c[0] * w[0] + c[1] * w[1] + c[2] * w[2]);
+    }
+    (uv, d_dx, d_dy, texels)
+}
+
+/// What the probe says of a textured point: its coordinates and texels, and (in `notes`) the
+/// diffuse texel, the alpha and whether the alpha test discards it.
+fn texture_value(obj: &Object, [uv, d_dx, d_dy]: [Vec2; 3], t: &Texels, notes: &mut Vec<String>) -> TextureValue {
+    let alpha = Maps::alpha(&obj.material, t);
+    let discarded = obj.maps.discards(alpha);
+    notes.push(format!(
+        "textured: uv ({:.4}, {:.4}); diffuse texel ({:.3}, {:.3}, {:.3}), alpha {alpha:.3}{}",
+        uv.x,
+        uv.y,
+        t.diffuse[0],
+        t.diffuse[1],
+        t.diffuse[2],
+        if discarded {
+            ": discarded by the alpha test (the renderer shows what is behind)"
+        } else {
+            ""
+        }
+    ));
+    TextureValue {
+        uv: uv.to_array(),
+        uv_dx: d_dx.to_array(),
+        uv_dy: d_dy.to_array(),
+        diffuse: t.diffuse,
+        specular: c3(t.specular),
+        shininess: t.shininess,
+        occlusion: t.occlusion.unwrap_or(1.0),
+        alpha,
+        discarded,
     }
 }
 
