@@ -194,7 +194,7 @@ const FILL: f32 = 0.92;
 /// The scene of a model alone, as JSON with the scene file's schema, and notes on what was
 /// decided (for `-v`):
 /// - the model with `fit = true` and its MTL materials (or OpenGL's default);
-/// - up: `options.up`, else detected ([`detect_up`]): y for a model long along y, z for one
+/// - up: `options.up`, else detected: y for a model long along y, z for one
 ///   long along z or standing on a flat base facing −z (a scan of a statue or bust, like
 ///   Nefertiti's), else y;
 /// - front: +z for a y-up model, −y for a z-up one (Blender's front view), the convention's

@@ -1,0 +1,169 @@
+//! A glTF file's bytes: its buffers (the GLB's chunk, data URIs, files), accessors checked
+//! against them before the `gltf` crate reads them, and tightly packed arrays read as slices.
+
+use crate::Error;
+use base64::Engine;
+
+/// The file's buffers: the GLB's binary chunk, base64 data URIs, and files read by `resource`;
+/// each at least as long as the file says.
+pub(super) fn load_buffers(
+    file: &::gltf::Gltf,
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Vec<Vec<u8>>, Error> {
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in file.document.buffers() {
+        let data = match b.source() {
+            ::gltf::buffer::Source::Bin => file.blob.clone().ok_or_else(|| {
+                fail(format!(
+                    "buffer {} is the GLB's binary chunk, which is missing",
+                    b.index()
+                ))
+            })?,
+            ::gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, data) = rest
+                        .split_once(";base64,")
+                        .ok_or_else(|| fail(format!("buffer {}: a data URI that is not base64", b.index())))?;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(data)
+                        .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?
+                } else {
+                    resource(&percent_decode(uri)).map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?
+                }
+            }
+        };
+        if data.len() < b.length() {
+            return Err(fail(format!(
+                "buffer {} has {} bytes; the file says {}",
+                b.index(),
+                data.len(),
+                b.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// Checks an accessor before the reader trusts it: its type, a float component type where
+/// `float`, at least one element, and every element inside its buffer view and buffer.
+/// A primitive's positions read as a slice, where they are packed 32-bit floats.
+pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<[f32; 3]>> {
+    let (bytes, kind) = packed(&prim.get(&::gltf::Semantic::Positions)?, buffers)?;
+    (kind == ::gltf::accessor::DataType::F32).then(|| {
+        bytes
+            .chunks_exact(12)
+            .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
+            .collect()
+    })
+}
+
+/// A primitive's indices read as a slice, where they are packed 16- or 32-bit integers.
+pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<u32>> {
+    let (b, kind) = packed(&prim.indices()?, buffers)?;
+    match kind {
+        ::gltf::accessor::DataType::U32 => Some(
+            b.chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect(),
+        ),
+        ::gltf::accessor::DataType::U16 => Some(
+            b.chunks_exact(2)
+                .map(|c| u32::from(u16::from_le_bytes([c[0], c[1]])))
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+/// An accessor's elements as one run of bytes, and their component type, where they are
+/// tightly packed (no stride between them, nothing sparse) and lie inside their buffer: read
+/// as a slice rather than element by element.
+pub(super) fn packed<'b>(
+    a: &::gltf::Accessor,
+    buffers: &'b [Vec<u8>],
+) -> Option<(&'b [u8], ::gltf::accessor::DataType)> {
+    let view = a.view()?;
+    let size = a.size();
+    if a.sparse().is_some() || a.normalized() || view.stride().is_some_and(|s| s != size) {
+        return None;
+    }
+    let start = view.offset().checked_add(a.offset())?;
+    let end = start.checked_add(a.count().checked_mul(size)?)?;
+    if a.offset().checked_add(a.count().checked_mul(size)?)? > view.length() {
+        return None;
+    }
+    let bytes = buffers.get(view.buffer().index())?.get(start..end)?;
+    Some((bytes, a.data_type()))
+}
+
+pub(super) fn check_accessor(
+    a: &::gltf::Accessor,
+    buffers: &[Vec<u8>],
+    dims: &[::gltf::accessor::Dimensions],
+    float: bool,
+) -> Result<(), String> {
+    if !dims.contains(&a.dimensions()) {
+        return Err(format!("type {:?}, expected {:?}", a.dimensions(), dims[0]));
+    }
+    if float && (a.data_type() != ::gltf::accessor::DataType::F32 || a.normalized()) {
+        return Err(format!(
+            "component type {:?}; phong reads 32-bit floats here (quantized meshes are not read)",
+            a.data_type()
+        ));
+    }
+    if a.count() == 0 {
+        return Err("it has no elements".into());
+    }
+    if a.sparse().is_some() {
+        return Err("sparse accessors are not read".into());
+    }
+    let Some(view) = a.view() else {
+        return Err("it has no buffer view".into());
+    };
+    let size = a.size();
+    let stride = view.stride().unwrap_or(size);
+    // A stride shorter than an element would make the reader split elements (the crate then
+    // panics: found by the `gltf` fuzz target).
+    if stride < size {
+        return Err(format!(
+            "its buffer view's byteStride {stride} is shorter than an element ({size} bytes)"
+        ));
+    }
+    let end = (a.count() as u64 - 1)
+        .checked_mul(stride as u64)
+        .and_then(|x| x.checked_add((a.offset() + size) as u64))
+        .ok_or("its size overflows")?;
+    if end > view.length() as u64 {
+        return Err(format!("it ends at byte {end} of a {}-byte buffer view", view.length()));
+    }
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
+    if view.offset() as u64 + view.length() as u64 > buffer_len {
+        return Err(format!(
+            "its buffer view ends at byte {} of a {buffer_len}-byte buffer",
+            view.offset() + view.length()
+        ));
+    }
+    Ok(())
+}
+
+/// `%20` and the like decoded (glTF URIs are percent-encoded).
+pub(super) fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let Ok(v) = u8::from_str_radix(std::str::from_utf8(&b[i + 1..i + 3]).unwrap_or("zz"), 16)
+        {
+            out.push(v);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
