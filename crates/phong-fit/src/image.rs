@@ -268,10 +268,28 @@ impl<'a> Basis<'a> {
         Ok(img.clone())
     }
 
+    /// The pixels the object covers whole (its coverage image is 1: no antialiased edge, nothing
+    /// in front), within `mask`.
+    fn whole_pixels(&self, mask: Option<&[bool]>) -> Vec<bool> {
+        self.e
+            .pixels()
+            .iter()
+            .enumerate()
+            .map(|(p, px)| px[0] >= 0.999 && mask.is_none_or(|m| m[p]))
+            .collect()
+    }
+
     fn specular(&mut self, s: f32) -> Result<Image, FitError> {
         let (w, z) = (Color::WHITE, Color::BLACK);
         self.term(Material::new(z, z, w, z, s).expect("valid"), Output::Specular)
     }
+}
+
+/// A material's colours per channel as the solve orders them: `[e, a, d, k]`.
+fn colours_of(m: &Material) -> [[f64; 4]; 3] {
+    let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
+    let (e, a, d, k) = (c3(m.emission()), c3(m.ambient()), c3(m.diffuse()), c3(m.specular()));
+    [0, 1, 2].map(|c| [e[c], a[c], d[c], k[c]])
 }
 
 /// One channel's observations at one exponent: the uncensored rows' normal equations, and the
@@ -453,13 +471,7 @@ pub fn fit_image(
     }
     let start = scene.objects[object].material;
     let mut basis = Basis::new(scene, object, options)?;
-    let used: Vec<bool> = basis
-        .e
-        .pixels()
-        .iter()
-        .enumerate()
-        .map(|(p, px)| px[0] >= 0.999 && mask.is_none_or(|m| m[p]))
-        .collect();
+    let used = basis.whole_pixels(mask);
     let pixels = used.iter().filter(|&&u| u).count();
     if pixels == 0 {
         return Err(FitError::Input(format!(
@@ -478,14 +490,7 @@ pub fn fit_image(
             "every one of the object's {pixels} pixels is clipped (0 or 255) in the target: nothing to fit"
         )));
     }
-    let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
-    let (se, sa, sd, ss) = (
-        c3(start.emission()),
-        c3(start.ambient()),
-        c3(start.diffuse()),
-        c3(start.specular()),
-    );
-    let fixed: [[f64; 4]; 3] = [0, 1, 2].map(|c| [se[c], sa[c], sd[c], ss[c]]);
+    let fixed = colours_of(&start);
     let mut free_c = free.colours();
     let mut undetermined = Vec::new();
     // Emission and ambient are one unknown where the ambient light is the same everywhere.
@@ -552,10 +557,7 @@ pub fn fit_image(
     let mut nearest = ("", f64::INFINITY);
     for m in named_materials() {
         let mm = m.material;
-        let xs: [[f64; 4]; 3] = [0, 1, 2].map(|c| {
-            let g = |col: Color| [col.r, col.g, col.b][c] as f64;
-            [g(mm.emission()), g(mm.ambient()), g(mm.diffuse()), g(mm.specular())]
-        });
+        let xs = colours_of(&mm);
         let si = basis.specular(mm.shininess())?;
         let ch = observations(&basis, &si, target, &used, &[[0.0; 4]; 3], &[true; 4], false);
         let (r, count) = (0..3).fold((0.0, 0), |(r, k), c| (r + ch[c].n.residual(&xs[c]), k + ch[c].n.rows));
@@ -638,21 +640,8 @@ pub fn best_by_search(
 ) -> Result<Search, FitError> {
     let start = scene.objects[object].material;
     let mut basis = Basis::new(scene, object, options)?;
-    let used: Vec<bool> = basis
-        .e
-        .pixels()
-        .iter()
-        .enumerate()
-        .map(|(p, px)| px[0] >= 0.999 && mask.is_none_or(|m| m[p]))
-        .collect();
-    let c3 = |c: Color| [c.r, c.g, c.b].map(f64::from);
-    let (se, sa, sd, ss) = (
-        c3(start.emission()),
-        c3(start.ambient()),
-        c3(start.diffuse()),
-        c3(start.specular()),
-    );
-    let fixed: [[f64; 4]; 3] = [0, 1, 2].map(|c| [se[c], sa[c], sd[c], ss[c]]);
+    let used = basis.whole_pixels(mask);
+    let fixed = colours_of(&start);
     let free_c = free.colours();
     let clamp = scene.objects[object].shading.options.clamp;
     let encoding = scene.image.encoding;
