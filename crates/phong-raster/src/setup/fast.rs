@@ -57,13 +57,10 @@ impl Stage<'_> {
             two_sided,
             textured,
         });
-        let used = &mut scratch.used;
         if gouraud {
-            used.truncate(positions.len());
-            used.par_iter().for_each(|u| u.store(false, Ordering::Relaxed));
-            used.resize_with(positions.len(), || AtomicBool::new(false));
+            unmark(&mut scratch.used, positions.len());
         }
-        let (vertices, used) = (&*vertices, &*used);
+        let (vertices, used) = (&*vertices, &*scratch.used);
         let mark = |idx: [u32; 3]| {
             for i in idx {
                 used[i as usize].store(true, Ordering::Relaxed);
@@ -171,49 +168,63 @@ impl Stage<'_> {
             // Lit straight into the colour arrays, which keep last frame's values: only the
             // used vertices' colours are read.
             lighting.light_used(positions, normals, used, &mut scratch.colors);
-            let colors = &scratch.colors;
-            chunks.par_iter_mut().for_each(|chunk| {
-                let Chunk {
-                    tris,
-                    planes,
-                    pending,
-                    clipped,
-                    ..
-                } = chunk;
-                // In slot order: the pending triangles' planes made here, the clipped ones'
-                // taken (no default planes written first: 96 bytes a triangle).
-                let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
-                planes.extend((0..tris.len() as u32).map(|slot| {
-                    if let Some(p) = pending.next_if(|p| p.slot == slot) {
-                        let t = &tris[slot as usize];
-                        let v = each3(|k| vertices[p.idx[k] as usize].p);
-                        // Twice the area: the cross product of edges 2 (vertex 0 to 1) and 1
-                        // (vertex 2 to 0), as `setup_edges` computed it up to the sign.
-                        let area = (t.a(1) * t.b(2) - t.a(2) * t.b(1)).unsigned_abs();
-                        let side = usize::from(t.back);
-                        let c = each3(|k| colors[side][p.idx[k] as usize]);
-                        // Textured: the specular colours too (`VertexLighting::light`).
-                        let s = if textured {
-                            each3(|k| colors[2 + side][p.idx[k] as usize])
-                        } else {
-                            [Vec3::ZERO; 3]
-                        };
-                        plane_equations(
-                            (i64::from(v[0].0), i64::from(v[0].1)),
-                            t,
-                            area,
-                            [v[0].3, v[1].3, v[2].3],
-                            [c, s],
-                            !textured,
-                        )
-                    } else {
-                        let c = clipped.next();
-                        debug_assert_eq!(c.map(|c| c.0), Some(slot), "every slot is pending or clipped");
-                        c.map(|c| c.1).unwrap_or_default()
-                    }
-                }));
-            });
+            gouraud_planes(&mut chunks, vertices, &scratch.colors, textured);
         }
         chunks
     }
+}
+
+/// The planes of the Gouraud triangles that waited for their vertices' colours
+/// ([`Pending`]), made from `colors` (front, back and, textured, their
+/// specular colours) once the used vertices are lit; each chunk's clipped triangles' planes,
+/// made at setup, are taken in slot order.
+fn gouraud_planes(chunks: &mut [Chunk], vertices: &[FastVertex], colors: &[Vec<Vec3>; 4], textured: bool) {
+    chunks.par_iter_mut().for_each(|chunk| {
+        let Chunk {
+            tris,
+            planes,
+            pending,
+            clipped,
+            ..
+        } = chunk;
+        // In slot order: the pending triangles' planes made here, the clipped ones'
+        // taken (no default planes written first: 96 bytes a triangle).
+        let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
+        planes.extend((0..tris.len() as u32).map(|slot| {
+            if let Some(p) = pending.next_if(|p| p.slot == slot) {
+                let t = &tris[slot as usize];
+                let v = each3(|k| vertices[p.idx[k] as usize].p);
+                // Twice the area: the cross product of edges 2 (vertex 0 to 1) and 1
+                // (vertex 2 to 0), as `setup_edges` computed it up to the sign.
+                let area = (t.a(1) * t.b(2) - t.a(2) * t.b(1)).unsigned_abs();
+                let side = usize::from(t.back);
+                let c = each3(|k| colors[side][p.idx[k] as usize]);
+                // Textured: the specular colours too (`VertexLighting::light`).
+                let s = if textured {
+                    each3(|k| colors[2 + side][p.idx[k] as usize])
+                } else {
+                    [Vec3::ZERO; 3]
+                };
+                plane_equations(
+                    (i64::from(v[0].0), i64::from(v[0].1)),
+                    t,
+                    area,
+                    [v[0].3, v[1].3, v[2].3],
+                    [c, s],
+                    !textured,
+                )
+            } else {
+                let c = clipped.next();
+                debug_assert_eq!(c.map(|c| c.0), Some(slot), "every slot is pending or clipped");
+                c.map(|c| c.1).unwrap_or_default()
+            }
+        }));
+    });
+}
+
+/// `used` as `n` flags, all false (last frame's memory kept).
+fn unmark(used: &mut Vec<AtomicBool>, n: usize) {
+    used.truncate(n);
+    used.par_iter().for_each(|u| u.store(false, Ordering::Relaxed));
+    used.resize_with(n, || AtomicBool::new(false));
 }
