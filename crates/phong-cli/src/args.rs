@@ -31,7 +31,7 @@ pub enum GpuPathArg {
 /// What `render` and `bench` share: the input, its overrides and how to render it.
 #[derive(clap::Args)]
 pub struct RunArgs {
-    /// Scene file (.toml) or model (.obj).
+    /// Scene file (.toml) or model (.obj, .gltf, .glb, .ply, .stl).
     pub input: PathBuf,
     /// Image width in pixels (overrides the scene).
     #[arg(long)]

@@ -50,7 +50,7 @@ fn texture_store(arg: Option<PathBuf>) -> Option<phong_scene::TextureStore> {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene file (.toml) or an OBJ model (.obj) to a PNG.
+    /// Render a scene file (.toml) or a model (OBJ, glTF, PLY, STL) to a PNG.
     Render(render::RenderArgs),
     /// Render many scenes or views from a JSON Lines file (a shard of them on a cluster).
     Batch(batch::BatchArgs),
@@ -60,7 +60,7 @@ enum Command {
     Serve(serve::ServeArgs),
     /// Fit a material to a target image of a scene, or to a BRDF.
     Fit(fit::FitArgs),
-    /// Write the scene's illumination model as shaders: GLSL 1.20, 3.30 or ES 3.00, or a WebGL2 page.
+    /// Write the scene's illumination model as shaders: GLSL, WGSL, a WebGL2 page, a three.js material or a BRDF Explorer file.
     Shader(shader::ShaderArgs),
     /// List the built-in materials, or show one.
     Materials {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub(crate) struct ServeArgs {
-    /// Scene file (.toml) or model (.obj) to open; the default scene without one.
+    /// Scene file (.toml) or model (.obj, .gltf, .glb, .ply, .stl) to open; the default scene without one.
     input: Option<PathBuf>,
     /// Port to listen on.
     #[arg(long, default_value_t = 8080)]
