@@ -305,7 +305,7 @@ impl SceneCore {
                 .with_uvs(uvs)
                 .map_err(|e| InputError::new_err(format!("uvs: {e}")))?;
         }
-        let part = phong_scene::ObjPart {
+        let part = phong_scene::ModelPart {
             name: "mesh".into(),
             mesh,
             material: None,

@@ -1,7 +1,7 @@
 //! What to render: the source, and the settings the user gives over it.
 
 use crate::{Error, Models};
-use phong_scene::{JsonError, Loaded, MeshLookup, ModelOptions, ObjPart, Overrides};
+use phong_scene::{JsonError, Loaded, MeshLookup, ModelOptions, ModelPart, Overrides};
 use serde_json::{Map, Value};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -227,7 +227,7 @@ impl Found {
 fn file_lookup<'a>(
     anchor: &'a Path,
     models: &'a Models,
-) -> (impl Fn(&str) -> Result<Vec<ObjPart>, String> + 'a, std::rc::Rc<Found>) {
+) -> (impl Fn(&str) -> Result<Vec<ModelPart>, String> + 'a, std::rc::Rc<Found>) {
     let found = std::rc::Rc::new(Found::default());
     let f = found.clone();
     let lookup = move |name: &str| {

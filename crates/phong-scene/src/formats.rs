@@ -4,7 +4,7 @@
 //! else is an error naming the formats phong reads.
 
 use crate::obj::{decode_text, obj_from_text};
-use crate::{Error, ObjPart, read_bounded};
+use crate::{Error, ModelPart, read_bounded};
 use glam::{DVec3, Vec3};
 use phong_core::limits::MAX_MODEL_BYTES;
 use std::path::{Path, PathBuf};
@@ -28,7 +28,7 @@ pub enum ModelFormat {
 #[derive(Clone, Debug)]
 pub struct LoadedModel {
     /// The parts (a group and material each).
-    pub parts: Vec<ObjPart>,
+    pub parts: Vec<ModelPart>,
     /// The file's camera (glTF).
     pub camera: Option<crate::gltf_model::FileCamera>,
     /// The file's lights (glTF's KHR_lights_punctual).
@@ -45,7 +45,7 @@ pub struct LoadedModel {
 impl LoadedModel {
     /// A model whose file says nothing of a camera, lights or which faces are drawn (OBJ, PLY,
     /// STL).
-    pub fn new(parts: Vec<ObjPart>, format: ModelFormat) -> LoadedModel {
+    pub fn new(parts: Vec<ModelPart>, format: ModelFormat) -> LoadedModel {
         LoadedModel {
             parts,
             camera: None,
@@ -107,7 +107,7 @@ pub fn load_model_sources(
     path: &Path,
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
-) -> Result<Vec<ObjPart>, Error> {
+) -> Result<Vec<ModelPart>, Error> {
     load_model_full(path, warnings, sources).map(|m| m.parts)
 }
 
@@ -187,7 +187,7 @@ fn read_bytes(
 /// A PLY, STL or glTF model from its bytes (`path` names it and tells the format as
 /// [`model_format`] does); an OBJ is refused here (its MTL libraries are files: use
 /// [`load_model_sources`] or [`load_obj_text`](crate::load_obj_text)).
-pub fn parse_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+pub fn parse_mesh_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Error> {
     parse_mesh_bytes_with(path, bytes, &|uri| Err(format!("{uri} is not available here")))
 }
 
@@ -196,7 +196,7 @@ pub fn parse_mesh_bytes_with(
     path: &Path,
     bytes: &[u8],
     resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
-) -> Result<Vec<ObjPart>, Error> {
+) -> Result<Vec<ModelPart>, Error> {
     parse_model_bytes_with(path, bytes, resource).map(|m| m.parts)
 }
 
@@ -212,7 +212,7 @@ pub fn parse_model_bytes_with(
 }
 
 /// [`load_model_sources`] without the list of files read.
-pub fn load_model(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
+pub fn load_model(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ModelPart>, Error> {
     load_model_sources(path, warnings, &mut Vec::new())
 }
 

@@ -24,7 +24,7 @@ mod buffers;
 
 use crate::formats::far_origin;
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
-use crate::{Error, ObjPart};
+use crate::{Error, ModelPart};
 use base64::Engine;
 use buffers::{check_accessor, load_buffers, packed_indices, packed_positions, percent_decode};
 use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
@@ -77,7 +77,7 @@ pub struct FileLight {
 #[derive(Clone, Debug, Default)]
 pub struct GltfModel {
     /// One part per primitive (positions in world space, re-centred together).
-    pub parts: Vec<ObjPart>,
+    pub parts: Vec<ModelPart>,
     /// The first camera met in the default scene.
     pub camera: Option<FileCamera>,
     /// The KHR_lights_punctual lights of the default scene.
@@ -556,7 +556,7 @@ impl Textures<'_> {
 
 /// The parts of the read primitives, the whole model re-centred together (one origin for
 /// every part).
-fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<Vec<ObjPart>, Error> {
+fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<Vec<ModelPart>, Error> {
     let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
     pending
         .into_iter()
@@ -568,7 +568,7 @@ fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<V
                 .and_then(|m| m.with_colors(p.colors))
                 .and_then(|m| m.with_tangents(p.tangents))
                 .map_err(|e| fail(format!("{}: {e}", p.name)))?;
-            Ok(ObjPart {
+            Ok(ModelPart {
                 name: p.name,
                 mesh,
                 material: p.material,

@@ -252,7 +252,7 @@ mod tests {
     use super::*;
     use serde_json::json;
 
-    fn no_meshes(name: &str) -> Result<Vec<crate::ObjPart>, String> {
+    fn no_meshes(name: &str) -> Result<Vec<crate::ModelPart>, String> {
         Err(format!("no uploaded model named \"{name}\""))
     }
 

@@ -14,6 +14,7 @@ mod json_scene;
 mod model;
 mod obj;
 mod overrides;
+mod part;
 mod ply;
 mod png_out;
 mod polygon;
@@ -32,8 +33,9 @@ pub use formats::{
 pub use gltf_model::{FileCamera, FileLight, MAX_GLTF_SHININESS};
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json, parse_scene_json_at, toml_to_json};
 pub use model::{Axis, ModelOptions, Sides, ViewName, model_scene, model_scene_with, scene_for_loaded};
-pub use obj::{ObjPart, load_obj, load_obj_sources, load_obj_text};
+pub use obj::{load_obj, load_obj_sources, load_obj_text};
 pub use overrides::Overrides;
+pub use part::ModelPart;
 pub use png_out::{encode_png, encode_png8, encode_rgba8, is_complete_png, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
 pub use texture_file::{ReadFile, TextureStats, decode as decode_texture, last_store_error};

@@ -6,7 +6,7 @@
 //! framed by the same arithmetic. The view is built in the model's frame: its up axis (given,
 //! or detected), its front, and the camera placed so that every vertex is inside the frame.
 
-use crate::{Error, Loaded, LoadedModel, ModelFormat, ObjPart, load_model_full};
+use crate::{Error, Loaded, LoadedModel, ModelFormat, ModelPart, load_model_full};
 use glam::{DVec3, Vec3};
 use rustc_hash::FxHashMap;
 use std::path::Path;
@@ -151,7 +151,7 @@ pub fn scene_for_loaded(path: &Path, model: &LoadedModel, options: &ModelOptions
 /// The centre and bounding-sphere radius of a model's parts (half its bounding box's
 /// diagonal; 1 for a model of one point), in the parts' coordinates: what `fit = true` maps to
 /// the origin and to 1.
-pub(crate) fn fit_of(parts: &[ObjPart]) -> Option<(DVec3, f64)> {
+pub(crate) fn fit_of(parts: &[ModelPart]) -> Option<(DVec3, f64)> {
     let (lo, hi) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
@@ -205,7 +205,7 @@ const FILL: f32 = 0.92;
 /// - the camera: `options.camera`, else the named view (default: front, a little right and
 ///   above), at the distance where every vertex is inside 92% of the frame, its near and
 ///   far planes from the vertices' depths; perspective, 45°.
-pub fn model_scene(name: &str, parts: &[ObjPart], options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
+pub fn model_scene(name: &str, parts: &[ModelPart], options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
     model_scene_with(name, &LoadedModel::new(parts.to_vec(), ModelFormat::Obj), options)
 }
 
@@ -303,7 +303,7 @@ pub fn model_scene_with(name: &str, model: &LoadedModel, options: &ModelOptions)
 }
 
 /// The up axis: `options.up`, y for a glTF, else detected (said in `notes`).
-fn up_axis(parts: &[ObjPart], gltf: bool, options: &ModelOptions, notes: &mut Vec<String>) -> Axis {
+fn up_axis(parts: &[ModelPart], gltf: bool, options: &ModelOptions, notes: &mut Vec<String>) -> Axis {
     match options.up {
         Some(a) => a,
         None if gltf => Axis::Y,
@@ -321,7 +321,13 @@ fn up_axis(parts: &[ObjPart], gltf: bool, options: &ModelOptions, notes: &mut Ve
 
 /// The front: where the model tells it ([`detect_front`], said in `notes` unless the camera is
 /// given), else the convention's axis for `up` (+z for y up, −y for z up).
-fn front(parts: &[ObjPart], up: Axis, closed: Option<Closed>, options: &ModelOptions, notes: &mut Vec<String>) -> Vec3 {
+fn front(
+    parts: &[ModelPart],
+    up: Axis,
+    closed: Option<Closed>,
+    options: &ModelOptions,
+    notes: &mut Vec<String>,
+) -> Vec3 {
     let f = match up {
         Axis::Y => Vec3::Z,
         Axis::NegY => Vec3::NEG_Z,
@@ -459,7 +465,7 @@ fn round6(v: Vec3) -> [f64; 3] {
 
 /// The camera distance along `dir` (from the origin of the fitted frame) at which every vertex
 /// is inside [`FILL`] of a frame of aspect `aspect`, the camera's up `up`.
-fn framing_distance(parts: &[ObjPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec3, up: Vec3, aspect: f32) -> f32 {
+fn framing_distance(parts: &[ModelPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec3, up: Vec3, aspect: f32) -> f32 {
     let right = up.cross(dir).normalize();
     let up = dir.cross(right);
     let ty = (FOV.to_radians() * 0.5).tan() * FILL;
@@ -476,7 +482,7 @@ fn framing_distance(parts: &[ObjPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec3,
 
 /// Near and far planes for a camera at `eye` looking at `target`: just outside the vertices'
 /// depths (a camera inside the model gets a near plane of 1/1000 of the model's radius).
-fn depth_range(parts: &[ObjPart], fitted: &dyn Fn(Vec3) -> Vec3, eye: Vec3, target: Vec3) -> (f32, f32) {
+fn depth_range(parts: &[ModelPart], fitted: &dyn Fn(Vec3) -> Vec3, eye: Vec3, target: Vec3) -> (f32, f32) {
     let d = (target - eye).normalize_or(Vec3::NEG_Z);
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
     for p in parts.iter().flat_map(|p| p.mesh.positions()) {
@@ -503,7 +509,7 @@ fn axis_name(v: Vec3) -> String {
 /// - else, a model longer along `f` than it is tall (an animal on its legs, as Spot) turns its
 ///   top toward its front (the head above the body): `−f` when the vertices of its top tenth
 ///   lie behind the middle by more than 10% of its depth.
-fn detect_front(parts: &[ObjPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(Vec3, &'static str)> {
+fn detect_front(parts: &[ModelPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(Vec3, &'static str)> {
     let r = u.cross(f);
     let (lo, hi) = parts
         .iter()
@@ -554,7 +560,7 @@ fn detect_front(parts: &[ObjPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(
 /// end-on): z. Standing on a flat base facing −z (faces within 18° of −z in the lowest 2% of
 /// its height hold at least 2% of its area, and 3 times the area that faces −y in its lowest
 /// 2% along y): z. Else y.
-fn detect_up(parts: &[ObjPart]) -> (Axis, Option<&'static str>) {
+fn detect_up(parts: &[ModelPart]) -> (Axis, Option<&'static str>) {
     let Some((lo, hi)) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
@@ -623,7 +629,7 @@ impl Closed {
 const MAX_CLOSED_CHECK: usize = 4_000_000;
 
 /// [`Closed`] for a model's parts together, vertices joined where their positions are equal.
-fn closedness(parts: &[ObjPart]) -> Closed {
+fn closedness(parts: &[ModelPart]) -> Closed {
     let count: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
     if count > MAX_CLOSED_CHECK {
         return Closed::Unchecked;
@@ -698,8 +704,8 @@ mod tests {
     use super::*;
     use phong_core::{Mesh, primitives};
 
-    fn part(mesh: Mesh) -> ObjPart {
-        ObjPart {
+    fn part(mesh: Mesh) -> ModelPart {
+        ModelPart {
             name: "t".into(),
             mesh,
             material: None,

@@ -4,8 +4,8 @@
 //! claims is held to what the rest of the file can hold before anything is allocated, and every
 //! error names the header line, or the element and row (and, in an ASCII file, the line).
 
+use crate::ModelPart;
 use crate::formats::{model_error, part_name, recentred, vertex_color_material};
-use crate::obj::ObjPart;
 use crate::{Error, polygon};
 use glam::{DVec3, Vec3};
 use phong_core::{Color, Mesh};
@@ -456,7 +456,7 @@ fn read_faces<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> Result<(),
 
 /// A PLY file's `vertex` and `face` elements as one part (polygons triangulated; other
 /// elements read past).
-pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Error> {
     let fail = |m: String| model_error(path, format!("malformed PLY: {m}"));
     let h = header(bytes).map_err(fail)?;
     let room = bytes.len() - h.body;
@@ -527,7 +527,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error>
         .map_err(|e| fail(e.to_string()))?;
     // With colours, a white material: they are the ambient and diffuse colours.
     let material = (!mesh.colors().is_empty()).then(vertex_color_material);
-    Ok(vec![ObjPart {
+    Ok(vec![ModelPart {
         name: part_name(path),
         mesh,
         material,

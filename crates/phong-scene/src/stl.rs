@@ -5,8 +5,8 @@
 //! body), with a located error for what is not STL.
 
 use crate::Error;
+use crate::ModelPart;
 use crate::formats::{far_origin, model_error, part_name};
-use crate::obj::ObjPart;
 use glam::{DVec3, Vec3};
 use phong_core::Mesh;
 use rustc_hash::FxHashMap;
@@ -16,7 +16,7 @@ use std::path::Path;
 type Solid = (String, Vec<[Vec3; 3]>);
 
 /// The parts of the STL file `path` whose bytes are `bytes`.
-pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error> {
+pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Error> {
     let fail = |m: String| model_error(path, format!("malformed STL: {m}"));
     let binary = bytes.len() >= 84 && {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]);
@@ -45,7 +45,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ObjPart>, Error>
         let normals = vec![Vec3::ZERO; positions.len()];
         let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
         let base = part_name(path);
-        parts.push(ObjPart {
+        parts.push(ModelPart {
             name: match (several, name.is_empty()) {
                 (false, _) => base,
                 (true, true) => format!("{base}#{}", i + 1),

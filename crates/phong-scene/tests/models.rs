@@ -62,7 +62,7 @@ fn shared() -> Option<PathBuf> {
 }
 
 /// Twice the area of the triangles of every part (|Σ cross| per triangle, summed).
-fn area(parts: &[phong_scene::ObjPart]) -> f64 {
+fn area(parts: &[phong_scene::ModelPart]) -> f64 {
     parts
         .iter()
         .map(|p| {

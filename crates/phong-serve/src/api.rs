@@ -290,7 +290,7 @@ fn scene_from_json(state: &AppState, client: &str, value: &Value) -> Result<Scen
         });
     }
     shape_triangles(value)?;
-    let lookup = |name: &str| -> Result<Vec<phong_scene::ObjPart>, String> {
+    let lookup = |name: &str| -> Result<Vec<phong_scene::ModelPart>, String> {
         if let Some(p) = state.library.get(name) {
             return Ok((*p).clone());
         }

@@ -4,7 +4,7 @@
 
 use crate::api::AppState;
 use phong_core::limits::{SERVE_IDLE_SECONDS, SERVE_MAX_UPLOAD_TOTAL, SERVE_MAX_UPLOADS};
-use phong_scene::{LoadedModel, ModelFormat, ObjPart};
+use phong_scene::{LoadedModel, ModelFormat, ModelPart};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -13,17 +13,17 @@ use std::time::{Duration, Instant};
 /// Models loaded at startup, by the name the scene gives.
 #[derive(Default)]
 pub struct Library {
-    models: HashMap<String, Arc<Vec<ObjPart>>>,
+    models: HashMap<String, Arc<Vec<ModelPart>>>,
 }
 
 impl Library {
     /// Adds a model.
-    pub fn insert(&mut self, name: String, parts: Vec<ObjPart>) {
+    pub fn insert(&mut self, name: String, parts: Vec<ModelPart>) {
         self.models.insert(name, Arc::new(parts));
     }
 
     /// A model's parts.
-    pub fn get(&self, name: &str) -> Option<Arc<Vec<ObjPart>>> {
+    pub fn get(&self, name: &str) -> Option<Arc<Vec<ModelPart>>> {
         self.models.get(name).cloned()
     }
 
@@ -39,7 +39,7 @@ impl Library {
 #[derive(Default)]
 pub struct Uploads {
     files: HashMap<String, Arc<Vec<u8>>>,
-    parsed: HashMap<String, Arc<Vec<ObjPart>>>,
+    parsed: HashMap<String, Arc<Vec<ModelPart>>>,
     bytes: usize,
     /// When the client last used the server.
     pub last_used: Option<Instant>,
@@ -95,7 +95,7 @@ impl Uploads {
 
     /// The parts of uploaded OBJ `name` if parsed already; else its files, to parse with
     /// [`parse_upload`] outside the store's lock. `None`: no such upload.
-    pub fn lookup(&self, name: &str) -> Option<Result<Arc<Vec<ObjPart>>, Files>> {
+    pub fn lookup(&self, name: &str) -> Option<Result<Arc<Vec<ModelPart>>, Files>> {
         if let Some(p) = self.parsed.get(name) {
             return Some(Ok(p.clone()));
         }
@@ -103,7 +103,7 @@ impl Uploads {
     }
 
     /// Keeps `parts` as the parse of `name`, unless the uploads changed since `files` was taken.
-    pub fn remember(&mut self, name: &str, files: &Files, parts: &Arc<Vec<ObjPart>>) {
+    pub fn remember(&mut self, name: &str, files: &Files, parts: &Arc<Vec<ModelPart>>) {
         let same = files.0.len() == self.files.len()
             && files
                 .0
@@ -120,7 +120,7 @@ pub struct Files(HashMap<String, Arc<Vec<u8>>>);
 
 /// Parses uploaded model `name` (an OBJ with its MTL libraries, a glTF with its buffers, a
 /// PLY, an STL) from `files`; `Err` is the message for the scene's `mesh` key (or the upload).
-pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ObjPart>>, String> {
+pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ModelPart>>, String> {
     parse_upload_model(name, files).map(|m| Arc::new(m.parts))
 }
 

@@ -19,34 +19,15 @@ mod mtl;
 mod read;
 mod text;
 
-use crate::Error;
 use crate::texture_file::{MapRequest, ReadFile, Source, TextureCache, prefetch, resolve};
-use glam::{DVec3, Vec2, Vec3};
+use crate::{Error, ModelPart};
+use glam::{Vec2, Vec3};
 use mtl::{check_mtl, mtl_names, normalize_mtl, to_material, transparency};
 use phong_core::{Color, Maps, Material, Mesh};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use text::lines;
-
-/// One group of an OBJ file with one material.
-#[derive(Debug, Clone)]
-pub struct ObjPart {
-    /// `file:group`.
-    pub name: String,
-    /// Object-space geometry (normals from the file, or zero when it has none).
-    pub mesh: Mesh,
-    /// Its MTL material, if any.
-    pub material: Option<Material>,
-    /// Its material's texture maps (none where it has none, or none could be read).
-    pub maps: Maps,
-    /// True when the file gave normals for every vertex of this part.
-    pub has_normals: bool,
-    /// The point the positions are relative to, in the file's coordinates: a model far from
-    /// the origin for its size is re-centred in f64 before its positions become f32 (so that
-    /// it keeps its detail); zero otherwise. Every part of a model has the same.
-    pub origin: DVec3,
-}
 
 /// The triangles of a tobj mesh's faces (`arities` empty when all are triangles), each
 /// polygon triangulated by [`polygon::triangulate`](crate::polygon::triangulate).
@@ -159,7 +140,7 @@ fn materials_of(path: &Path, mtl: &[tobj::Material], warnings: &mut Vec<String>)
 }
 
 /// Loads an OBJ file and its MTL materials: one part per group and material.
-pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ObjPart>, Error> {
+pub fn load_obj(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<ModelPart>, Error> {
     load_obj_sources(path, warnings, &mut Vec::new())
 }
 
@@ -168,7 +149,7 @@ pub fn load_obj_sources(
     path: &Path,
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
-) -> Result<Vec<ObjPart>, Error> {
+) -> Result<Vec<ModelPart>, Error> {
     let src = read(path, warnings)?;
     sources.push(path.to_path_buf());
     obj_from_text(path, &src, warnings, sources)
@@ -181,7 +162,7 @@ pub(crate) fn obj_from_text(
     src: &str,
     warnings: &mut Vec<String>,
     sources: &mut Vec<PathBuf>,
-) -> Result<Vec<ObjPart>, Error> {
+) -> Result<Vec<ModelPart>, Error> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_mtl = std::cell::RefCell::new(Vec::new());
     let latin1 = std::cell::RefCell::new(Vec::new());
@@ -234,7 +215,7 @@ pub fn load_obj_text(
     read_mtl: &dyn Fn(&Path) -> std::io::Result<String>,
     read_texture: &ReadFile,
     warnings: &mut Vec<String>,
-) -> Result<Vec<ObjPart>, Error> {
+) -> Result<Vec<ModelPart>, Error> {
     let _budget = crate::texture_file::TextureBudget::start();
     let joined = text::join_continuations(src);
     let src: &str = &joined;
@@ -372,7 +353,7 @@ fn part_of(
     (materials, maps): (&[Material], &[Maps]),
     origin: glam::DVec3,
     warnings: &mut Vec<String>,
-) -> Result<Option<(ObjPart, Option<usize>)>, Error> {
+) -> Result<Option<(ModelPart, Option<usize>)>, Error> {
     let file = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -427,7 +408,7 @@ fn part_of(
         .and_then(|mesh| mesh.with_colors(colors))
         .map_err(|e| Error::at(path, src, 0, None, format!("group {}: {e}", model.name)))?;
     Ok(Some((
-        ObjPart {
+        ModelPart {
             name: format!("{file}:{}", model.name),
             mesh,
             material: match material {
@@ -480,8 +461,8 @@ fn no_faces(path: &Path, src: &str, notes: &[String]) -> Error {
 
 /// Parts that share a material within the same group name, merged (where they agree on
 /// having normals).
-fn merge_parts(parts: Vec<(ObjPart, Option<usize>)>) -> Vec<ObjPart> {
-    let mut merged: Vec<ObjPart> = Vec::new();
+fn merge_parts(parts: Vec<(ModelPart, Option<usize>)>) -> Vec<ModelPart> {
+    let mut merged: Vec<ModelPart> = Vec::new();
     let mut index: HashMap<(String, Option<usize>), usize> = HashMap::new();
     for (p, id) in parts {
         let key = (p.name.clone(), id);

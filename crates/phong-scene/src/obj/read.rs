@@ -26,7 +26,7 @@ pub(super) struct Read {
     pub materials: Result<Vec<tobj::Material>, tobj::LoadError>,
     /// What was skipped or repaired, for warnings.
     pub notes: Vec<String>,
-    /// Subtracted from every position (see `ObjPart::origin`).
+    /// Subtracted from every position (see `ModelPart::origin`).
     pub origin: DVec3,
     /// The names `usemtl` statements give (as their lines give them).
     pub used: Vec<String>,

@@ -4,7 +4,7 @@
 
 use super::choices::parse_choice;
 pub(crate) use super::raw::S;
-use crate::{Error, ObjPart};
+use crate::{Error, ModelPart};
 use glam::Vec3;
 use phong_core::Color;
 use std::path::Path;
@@ -28,7 +28,7 @@ pub(crate) struct Ctx<'a> {
 
 /// Resolves a `mesh` name to its parts without touching the file system (the error is the
 /// message shown for the `mesh` key).
-pub type MeshLookup<'a> = dyn Fn(&str) -> Result<Vec<ObjPart>, String> + 'a;
+pub type MeshLookup<'a> = dyn Fn(&str) -> Result<Vec<ModelPart>, String> + 'a;
 
 impl Ctx<'_> {
     /// Counts an object's triangles against the scene's budget.
