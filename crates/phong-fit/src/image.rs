@@ -452,6 +452,21 @@ pub fn find_object(scene: &Scene, which: Option<&str>) -> Result<usize, FitError
     }
 }
 
+/// An error unless `target` (and `mask`, one flag a pixel) has the scene's image size.
+fn same_size(scene: &Scene, target: &Target, mask: Option<&[bool]>) -> Result<(), FitError> {
+    let (w, h) = (scene.image.width, scene.image.height);
+    if (target.width, target.height) != (w, h) {
+        return Err(FitError::Input(format!(
+            "the target is {}x{} but the scene's image is {w}x{h}",
+            target.width, target.height
+        )));
+    }
+    if mask.is_some_and(|m| m.len() != (w * h) as usize) {
+        return Err(FitError::Input(format!("the mask is not {w}x{h}, the scene's image")));
+    }
+    Ok(())
+}
+
 /// Fits object `object`'s material in `scene` to `target`; `mask` (one flag a pixel) limits
 /// the pixels.
 pub fn fit_image(
@@ -462,13 +477,7 @@ pub fn fit_image(
     mask: Option<&[bool]>,
     options: RenderOptions,
 ) -> Result<ImageFit, FitError> {
-    let (w, h) = (scene.image.width, scene.image.height);
-    if (target.width, target.height) != (w, h) {
-        return Err(FitError::Input(format!(
-            "the target is {}x{} but the scene's image is {w}x{h}",
-            target.width, target.height
-        )));
-    }
+    same_size(scene, target, mask)?;
     let start = scene.objects[object].material;
     let mut basis = Basis::new(scene, object, options)?;
     let used = basis.whole_pixels(mask);
@@ -638,6 +647,7 @@ pub fn best_by_search(
     mask: Option<&[bool]>,
     options: RenderOptions,
 ) -> Result<Search, FitError> {
+    same_size(scene, target, mask)?;
     let start = scene.objects[object].material;
     let mut basis = Basis::new(scene, object, options)?;
     let used = basis.whole_pixels(mask);

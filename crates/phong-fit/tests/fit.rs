@@ -510,3 +510,26 @@ fn physically_based_targets_are_fitted_as_well_as_brute_force() {
         }
     }
 }
+
+/// The brute-force search refuses a target or mask of another size, as the fit does (no
+/// index past the image).
+#[test]
+fn search_refuses_a_target_of_another_size() {
+    let sc = scene(
+        lights(0),
+        ShadingOptions::default(),
+        Material::default(),
+        Interpolation::Phong,
+    );
+    let mut small = sc.clone();
+    small.image.width = 80;
+    let t = target(&small, &mut Rng(3), 0.0);
+    let search = |mask: Option<&[bool]>, t: &Target| {
+        phong_fit::image::best_by_search(&sc, 0, t, Free::default_set(), mask, RenderOptions::default())
+    };
+    let e = search(None, &t).err().expect("refused").to_string();
+    assert!(e.contains("80x160"), "{e}");
+    let full = target(&sc, &mut Rng(3), 0.0);
+    let e = search(Some(&[true; 10]), &full).err().expect("refused").to_string();
+    assert!(e.contains("mask"), "{e}");
+}
