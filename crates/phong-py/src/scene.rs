@@ -5,7 +5,7 @@
 use crate::{InputError, guarded, py_err};
 use numpy::PyReadonlyArray2;
 use phong_run::{Models, Settings, Source};
-use phong_scene::{LoadedModel, ModelOptions};
+use phong_scene::{ModelFile, ModelOptions};
 use pyo3::prelude::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 /// A model held in memory, and how it is viewed.
 pub(crate) struct Backing {
-    pub model: LoadedModel,
+    pub model: ModelFile,
 }
 
 /// A model's automatic cameras.
@@ -99,7 +99,7 @@ impl SceneCore {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let (doc, _) = phong_scene::model_scene_with(&name, &backing.model, &view);
+        let (doc, _) = phong_scene::model_scene(&name, &backing.model, &view);
         let mut core = SceneCore::new(doc, path.to_path_buf(), Some(backing), view);
         if let Some(like) = like {
             core.models = like.models.clone();
@@ -127,7 +127,7 @@ impl SceneCore {
                     aspect: Some(aspect),
                     ..self.view
                 };
-                let (doc, _) = phong_scene::model_scene_with(&self.mesh_name(), &b.model, &view);
+                let (doc, _) = phong_scene::model_scene(&self.mesh_name(), &b.model, &view);
                 let camera = doc["camera"].clone();
                 if cache.framings.len() >= 8 {
                     cache.framings.remove(0);
@@ -177,9 +177,7 @@ impl SceneCore {
         py.detach(|| {
             guarded(|| {
                 if phong_scene::is_model_path(&path) {
-                    let (mut warnings, mut sources) = (Vec::new(), Vec::new());
-                    let model = phong_scene::load_model_full(&path, &mut warnings, &mut sources)
-                        .map_err(|e| py_err(e.into()))?;
+                    let model = phong_scene::ModelFile::read(&path).map_err(|e| py_err(e.into()))?;
                     return SceneCore::framed_model(&path, Arc::new(Backing { model }), options, None);
                 }
                 if view.given() {
@@ -313,7 +311,7 @@ impl SceneCore {
             has_normals,
             origin: glam::DVec3::ZERO,
         };
-        let model = LoadedModel::new(vec![part], phong_scene::ModelFormat::Obj);
+        let model = ModelFile::from_parts(vec![part]);
         py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options, None)))
     }
 

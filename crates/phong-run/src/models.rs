@@ -1,7 +1,7 @@
 //! Model files read once and used many times: `phong batch` renders many views of one model,
 //! and a Python loop many frames of one scene.
 
-use phong_scene::LoadedModel;
+use phong_scene::ModelFile;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 /// A model read, with what reading it said.
 #[derive(Debug)]
 pub(crate) struct Read {
-    pub model: LoadedModel,
+    pub model: ModelFile,
     pub warnings: Vec<String>,
     pub sources: Vec<PathBuf>,
 }
@@ -38,12 +38,11 @@ fn key(path: &Path) -> PathBuf {
 }
 
 fn read(path: &Path) -> Result<Read, phong_scene::Error> {
-    let (mut warnings, mut sources) = (Vec::new(), Vec::new());
-    let model = phong_scene::load_model_full(path, &mut warnings, &mut sources)?;
+    let mut model = phong_scene::ModelFile::read(path)?;
     Ok(Read {
+        warnings: std::mem::take(&mut model.warnings),
+        sources: std::mem::take(&mut model.sources),
         model,
-        warnings,
-        sources,
     })
 }
 

@@ -111,7 +111,7 @@ pub fn load_viewed(
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let (doc, _) = phong_scene::model_scene_with(&name, &read.model, &view);
+            let (doc, _) = phong_scene::model_scene(&name, &read.model, &view);
             let parts = &read.model.parts;
             let lookup = |_: &str| Ok(parts.clone());
             let scene = built.load(&doc, path, Some(&lookup), settings, models)?;
@@ -153,18 +153,18 @@ fn load_model(path: &Path, settings: &Settings, view: &ModelOptions, models: &Mo
 /// A model read from `path`, framed for `view`, `settings.tables` merged over its scene.
 fn framed(
     path: &Path,
-    model: &phong_scene::LoadedModel,
+    model: &phong_scene::ModelFile,
     settings: &Settings,
     view: &ModelOptions,
 ) -> Result<Loaded, Error> {
     if settings.tables.is_empty() {
-        return Ok(phong_scene::scene_for_loaded(path, model, view)?);
+        return Ok(phong_scene::scene_of_model(path, model, view)?);
     }
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (mut doc, notes) = phong_scene::model_scene_with(&name, model, view);
+    let (mut doc, notes) = phong_scene::model_scene(&name, model, view);
     merge_tables(&mut doc, &settings.tables).map_err(|e| json_error(path, e))?;
     let parts = &model.parts;
     let lookup = |_: &str| Ok(parts.clone());

@@ -8,39 +8,27 @@
 //! column and key (`scene.toml:12:13: \`shininess\`: must be >= 0, got -1`).
 
 mod error;
-mod formats;
-mod gltf_model;
+mod framing;
 mod json_scene;
-mod model;
-mod obj;
+mod models;
 mod overrides;
-mod part;
-mod ply;
 mod png_out;
-mod polygon;
 mod read;
-mod stl;
 mod texture_file;
 mod texture_store;
 mod timing;
 mod toml_scene;
 
 pub use error::Error;
-pub use formats::{
-    LoadedModel, ModelFormat, load_model, load_model_full, load_model_sources, model_format, parse_mesh_bytes,
-    parse_mesh_bytes_with, parse_model_bytes_with,
-};
-pub use gltf_model::{FileCamera, FileLight, MAX_GLTF_SHININESS};
+pub use framing::{Axis, ModelOptions, Sides, ViewName, model_scene, scene_of_model};
 pub use json_scene::{JsonError, TomlText, json_to_toml, parse_scene_json, parse_scene_json_at, toml_to_json};
-pub use model::{Axis, ModelOptions, Sides, ViewName, model_scene, model_scene_with, scene_for_loaded};
-pub use obj::{load_obj, load_obj_sources, load_obj_text};
+pub use models::{FileCamera, FileLight, ModelFile, ModelFormat, ModelPart, Resource};
 pub use overrides::Overrides;
-pub use part::ModelPart;
 pub use png_out::{encode_png, encode_png8, encode_rgba8, is_complete_png, write_file, write_png, write_png8};
 pub use read::{read_bounded, read_text};
-pub use texture_file::{ReadFile, TextureStats, decode as decode_texture, last_store_error};
+pub use texture_file::{TextureStats, decode as decode_texture, last_store_error};
 pub use texture_store::{TextureStore, set_texture_store, texture_store};
-pub use timing::{LoadTimes, take_times};
+pub use timing::LoadTimes;
 pub use toml_scene::{
     INTERPOLATIONS, MODELS, MeshLookup, Model, OUTPUTS, apply_model, parse_choice, parse_scene, parse_scene_from,
     parse_scene_with,
@@ -98,7 +86,7 @@ pub fn load_with(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
 
 fn load_without_stats(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     if is_model_path(path) {
-        model::scene_for_model(path, options)
+        framing::scene_for_model(path, options)
     } else {
         let src = read_text(
             path,

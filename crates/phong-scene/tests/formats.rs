@@ -2,7 +2,15 @@
 //! that what they hold is known independently of the readers.
 
 use glam::Vec3;
-use phong_scene::{Error, ModelFormat, load, load_model, model_format};
+use phong_scene::{Error, ModelFile, ModelFormat, load};
+
+/// The parts of the model at `path`, its warnings added to `warnings`.
+fn load_model(path: &std::path::Path, warnings: &mut Vec<String>) -> Result<Vec<phong_scene::ModelPart>, Error> {
+    let model = ModelFile::read(path)?;
+    warnings.extend(model.warnings);
+    Ok(model.parts)
+}
+
 use std::path::{Path, PathBuf};
 
 fn dir(tag: &str) -> PathBuf {
@@ -124,7 +132,7 @@ fn ply_ascii_and_binary_in_both_byte_orders() {
         ("big.ply", binary_ply_cube(true)),
     ] {
         let p = write(&d, name, &bytes);
-        assert_eq!(model_format(&p, &bytes).unwrap(), ModelFormat::Ply);
+        assert_eq!(ModelFormat::detect(&p, &bytes).unwrap(), ModelFormat::Ply);
         let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(parts.len(), 1);
         let m = &parts[0].mesh;
@@ -156,7 +164,7 @@ fn stl_binary_and_ascii() {
     ascii += "endsolid cube\n";
     for (name, bytes) in [("bin.stl", bin), ("ascii.stl", ascii.into_bytes())] {
         let p = write(&d, name, &bytes);
-        assert_eq!(model_format(&p, &bytes).unwrap(), ModelFormat::Stl, "{name}");
+        assert_eq!(ModelFormat::detect(&p, &bytes).unwrap(), ModelFormat::Stl, "{name}");
         let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
         let m = &parts[0].mesh;
         assert_eq!(corners(m), tris, "{name}");

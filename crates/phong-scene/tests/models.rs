@@ -4,7 +4,15 @@
 
 use base64::Engine;
 use glam::{DVec3, Vec2, Vec3};
-use phong_scene::{Axis, ModelOptions, ViewName, load_model, load_model_full, load_with};
+use phong_scene::{Axis, Error, ModelFile, ModelOptions, ViewName, load_with};
+
+/// The parts of the model at `path`, its warnings added to `warnings`.
+fn load_model(path: &std::path::Path, warnings: &mut Vec<String>) -> Result<Vec<phong_scene::ModelPart>, Error> {
+    let model = ModelFile::read(path)?;
+    warnings.extend(model.warnings);
+    Ok(model.parts)
+}
+
 use std::path::{Path, PathBuf};
 
 /// A fresh folder for one test's files, removed when the test ends (passed or failed).
@@ -461,7 +469,7 @@ fn gltf_json(extra_nodes: &str, required: &str, bad_index: bool) -> String {
 fn gltf_geometry_materials_and_errors() {
     let d = dir("gltf");
     let p = write(&d, "quad.gltf", gltf_json("", "", false).as_bytes());
-    let model = load_model_full(&p, &mut Vec::new(), &mut Vec::new()).unwrap();
+    let model = ModelFile::read(&p).unwrap();
     assert_eq!(model.parts.len(), 2);
     for part in &model.parts {
         assert_eq!(part.mesh.triangles().len(), 2);
@@ -639,7 +647,7 @@ fn shared_gltf_samples() {
     )
     .unwrap();
     assert!(engine.len() > 20, "{} parts", engine.len());
-    let cams = load_model_full(&g.join("cameras/Cameras.gltf"), &mut Vec::new(), &mut Vec::new()).unwrap();
+    let cams = ModelFile::read(&g.join("cameras/Cameras.gltf")).unwrap();
     assert!(cams.camera.is_some());
 }
 

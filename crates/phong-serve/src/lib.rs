@@ -56,16 +56,15 @@ pub fn initial_scene(
     let json = match file {
         None => toml_to_json(DEFAULT_SCENE, Path::new("default.toml"))?,
         Some(f) if is_obj => {
-            let mut warnings = Vec::new();
-            let model = phong_scene::load_model_full(f, &mut warnings, &mut Vec::new())?;
-            for w in warnings {
+            let model = phong_scene::ModelFile::read(f)?;
+            for w in &model.warnings {
                 eprintln!("warning: {w}");
             }
             let name = f
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let (scene, _) = phong_scene::model_scene_with(&name, &model, view);
+            let (scene, _) = phong_scene::model_scene(&name, &model, view);
             library.insert(name, model.parts);
             scene
         }
@@ -80,9 +79,8 @@ pub fn initial_scene(
             let dir = f.parent().unwrap_or(Path::new(""));
             for o in json.get("object").and_then(|o| o.as_array()).into_iter().flatten() {
                 if let Some(m) = o.get("mesh").and_then(|m| m.as_str()) {
-                    let mut warnings = Vec::new();
-                    let parts = phong_scene::load_model(&dir.join(m), &mut warnings)?;
-                    library.insert(m.to_string(), parts);
+                    let model = phong_scene::ModelFile::read(&dir.join(m))?;
+                    library.insert(m.to_string(), model.parts);
                 }
             }
             json

@@ -4,7 +4,7 @@
 
 use crate::api::AppState;
 use phong_core::limits::{SERVE_IDLE_SECONDS, SERVE_MAX_UPLOAD_TOTAL, SERVE_MAX_UPLOADS};
-use phong_scene::{LoadedModel, ModelFormat, ModelPart};
+use phong_scene::{ModelFile, ModelPart};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -126,7 +126,7 @@ pub fn parse_upload(name: &str, files: &Files) -> Result<Arc<Vec<ModelPart>>, St
 
 /// [`parse_upload`] with what a glTF also holds (camera, lights, `doubleSided`), for the
 /// scene of the model alone.
-pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, String> {
+pub fn parse_upload_model(name: &str, files: &Files) -> Result<ModelFile, String> {
     let data = files.0.get(name).ok_or_else(|| format!("no upload named \"{name}\""))?;
     let lower = name.to_ascii_lowercase();
     // A file the model names (a glTF's buffers and images, an MTL's images) is looked up among
@@ -141,23 +141,8 @@ pub fn parse_upload_model(name: &str, files: &Files) -> Result<LoadedModel, Stri
                 .ok_or_else(|| format!("{key} is not uploaded (upload it with the {what})"))
         }
     };
-    if [".ply", ".stl", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
-        return phong_scene::parse_model_bytes_with(Path::new(name), data, &uploaded("glTF"))
-            .map_err(|e| e.to_string());
-    }
-    let src = std::str::from_utf8(data).map_err(|_| format!("uploaded {name} is not UTF-8 text"))?;
-    let read = |mtl: &Path| -> std::io::Result<String> {
-        let key = mtl.to_string_lossy();
-        let key = key.rsplit(['/', '\\']).next().unwrap_or(&key);
-        let f = files.0.get(key).ok_or_else(|| {
-            std::io::Error::new(std::io::ErrorKind::NotFound, "not uploaded (upload it with the OBJ)")
-        })?;
-        String::from_utf8(f.to_vec()).map_err(|_| std::io::Error::other("not UTF-8 text"))
-    };
-    let mut warnings = Vec::new();
-    let parts = phong_scene::load_obj_text(Path::new(name), src, &read, &uploaded("OBJ"), &mut warnings)
-        .map_err(|e| e.to_string())?;
-    Ok(LoadedModel::new(parts, ModelFormat::Obj))
+    let what = if lower.ends_with(".obj") { "OBJ" } else { "glTF" };
+    phong_scene::ModelFile::from_bytes(Path::new(name), data, &uploaded(what)).map_err(|e| e.to_string())
 }
 
 /// Drops the uploads of clients idle for [`SERVE_IDLE_SECONDS`], every minute.
@@ -173,6 +158,6 @@ pub async fn sweep_idle(state: Arc<AppState>) {
 }
 
 /// The page's scene for a model alone: `phong render MODEL`'s with the default view.
-pub fn model_scene(name: &str, model: &LoadedModel) -> serde_json::Value {
-    phong_scene::model_scene_with(name, model, &phong_scene::ModelOptions::default()).0
+pub fn model_scene(name: &str, model: &ModelFile) -> serde_json::Value {
+    phong_scene::model_scene(name, model, &phong_scene::ModelOptions::default()).0
 }

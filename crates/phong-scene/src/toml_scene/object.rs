@@ -5,7 +5,7 @@ use super::ctx::{Ctx, S};
 use super::material::{Mat, lookup_material, material};
 use super::raw::{MaterialRef, RawMaterial, RawObject, Scale};
 use crate::Error;
-use crate::load_model_sources;
+use crate::ModelFile;
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::MAX_SEGMENTS;
 use phong_core::{Maps, Mesh, Object, ShadingSettings, primitives};
@@ -225,9 +225,14 @@ fn mesh_objects(
                 return ctx.err(&m.span(), "mesh", format!("file not found: {}", file.display()));
             }
             // A file in no format phong reads is reported at the scene's `mesh` key.
-            match load_model_sources(&file, &mut warnings, &mut sources) {
+            match ModelFile::read(&file) {
                 Err(e @ Error::Model { .. }) => return ctx.err(&m.span(), "mesh", e.to_string()),
-                r => r?,
+                r => {
+                    let model = r?;
+                    warnings.extend(model.warnings);
+                    sources.extend(model.sources);
+                    model.parts
+                }
             }
         }
     };
@@ -235,7 +240,7 @@ fn mesh_objects(
     // it), or with `fit` the model centred at the origin with a bounding sphere of
     // radius 1, before the object's own transform. A fitted model is fitted before its
     // normals are computed (at 1e30, f32 cross products overflow).
-    let (fit_frame, world_from_file) = match crate::model::fit_of(&parts) {
+    let (fit_frame, world_from_file) = match crate::framing::fit_of(&parts) {
         Some(frame) if fit => (Some(frame), world_from_object),
         _ => match parts.first() {
             Some(p) if p.origin != glam::DVec3::ZERO => {

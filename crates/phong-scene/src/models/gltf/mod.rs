@@ -1,0 +1,818 @@
+//! glTF 2.0 models (`.gltf` with `.bin` files or data URIs, `.glb`), with the `gltf` crate:
+//! every triangle primitive of the default scene, placed by its nodes' transforms, with its
+//! material turned into a Phong material; the file's first camera and its KHR_lights_punctual
+//! lights, for a model alone.
+//!
+//! The material mapping (metallic-roughness, the glTF default):
+//! `diffuse = base·(1 − metallic)`, `specular = mix(0.04, base, metallic)`,
+//! `ambient = diffuse`, `emission = emissive·strength`, `alpha = base alpha`, and the
+//! shininess from the roughness as Blinn-Phong's equivalent of the Beckmann distribution:
+//! `α = roughness²`, `s = 2/α² − 2` (capped at [`MetalRough::MAX_SHININESS`]).
+//! KHR_materials_pbrSpecularGlossiness: `diffuse`, `specular` as given, `roughness = 1 −
+//! glossiness`. A primitive without a material gets OpenGL's default material (as an OBJ
+//! without MTL), not glTF's metallic default, which would be a black mirror here.
+//!
+//! Textures: the base colour texture (sRGB) is the diffuse map (modulating the diffuse and
+//! ambient colours as the factor does; its alpha multiplies the material's), the emissive
+//! texture (sRGB) the emission map, with their texture coordinate sets, KHR_texture_transform
+//! and samplers; the normal texture (with its scale) the normal map; the metallic-roughness
+//! texture the same mapping per texel (phong-core's `MetalRough`); the occlusion texture (with
+//! its strength) scales the ambient terms. `alphaMode: MASK` is the alpha test at `alphaCutoff`. Texture coordinates are
+//! flipped to OpenGL's (`v = 1 − v`: glTF's `v` runs down the image).
+
+mod buffers;
+
+use super::ModelPart;
+use super::far_origin;
+use crate::Error;
+use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
+use base64::Engine;
+use buffers::{check_accessor, load_buffers, packed_indices, packed_positions, percent_decode};
+use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
+use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// Extensions phong reads (or whose absence of support is harmless to the geometry); any
+/// other required extension is refused.
+const SUPPORTED: [&str; 5] = [
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+    "KHR_materials_unlit",
+];
+
+/// A camera of the file, in its coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FileCamera {
+    /// Eye.
+    pub position: DVec3,
+    /// The direction it looks (the node's −z).
+    pub forward: DVec3,
+    /// Its up (the node's +y).
+    pub up: DVec3,
+    /// Vertical field of view, degrees (`None`: orthographic).
+    pub fov_deg: Option<f32>,
+}
+
+/// A light of the file (KHR_lights_punctual), in its coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileLight {
+    /// `"directional"`, `"point"` or `"spot"`.
+    pub kind: &'static str,
+    /// Position (point, spot).
+    pub position: DVec3,
+    /// Direction the light travels (directional, spot).
+    pub direction: DVec3,
+    /// Colour times intensity.
+    pub color: [f32; 3],
+    /// Spot: the outer cone's half-angle, degrees.
+    pub cutoff_deg: f32,
+}
+
+/// A glTF model: its parts, and the file's first camera and its lights.
+#[derive(Clone, Debug, Default)]
+pub struct GltfModel {
+    /// One part per primitive (positions in world space, re-centred together).
+    pub parts: Vec<ModelPart>,
+    /// The first camera met in the default scene.
+    pub camera: Option<FileCamera>,
+    /// The KHR_lights_punctual lights of the default scene.
+    pub lights: Vec<FileLight>,
+    /// Whether any primitive's material is double-sided (glTF culls back faces otherwise).
+    pub double_sided: bool,
+}
+
+/// Reads a glTF model from `bytes` (a `.gltf` JSON or a `.glb`), its external buffers read
+/// by `resource` (given the URI, percent-decoded, relative to the model's folder).
+pub fn read_gltf(
+    path: &Path,
+    bytes: &[u8],
+    resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+    warnings: &mut Vec<String>,
+) -> Result<GltfModel, Error> {
+    let fail = |m: String| Error::Model {
+        path: path.to_path_buf(),
+        message: format!("glTF: {m}"),
+    };
+    check_before_validation(bytes, &fail)?;
+    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
+    let doc = &file.document;
+    let buffers = load_buffers(&file, resource, &fail)?;
+    let instances = node_instances(doc, &fail)?;
+    let mut model = GltfModel::default();
+    let (mut skipped_modes, mut colours) = (0usize, 0usize);
+    let mut textures = Textures {
+        path,
+        resource,
+        cache: TextureCache::default(),
+        white: None,
+    };
+    // Positions in f64 world space for all parts, re-centred together below.
+    let mut pending: Vec<Pending> = Vec::new();
+    let mut triangles_total: u64 = 0;
+    for (node, world) in &instances {
+        if model.camera.is_none() {
+            model.camera = file_camera(node, world);
+        }
+        model.lights.extend(file_light(node, world));
+        let Some(mesh) = node.mesh() else { continue };
+        for prim in mesh.primitives() {
+            if !matches!(
+                prim.mode(),
+                ::gltf::mesh::Mode::Triangles | ::gltf::mesh::Mode::TriangleStrip | ::gltf::mesh::Mode::TriangleFan
+            ) {
+                skipped_modes += 1;
+                continue;
+            }
+            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            let has_normal_accessor = check_primitive(&prim, &buffers, &what, &fail)?;
+            let g = geometry(&prim, &buffers, world, has_normal_accessor, &what, &fail)?;
+            colours += usize::from(g.colours_dropped);
+            triangles_total += g.tris.len() as u64;
+            if triangles_total > phong_core::limits::MAX_SCENE_TRIANGLES {
+                return Err(fail(format!(
+                    "more than {} triangles (MAX_SCENE_TRIANGLES)",
+                    phong_core::limits::MAX_SCENE_TRIANGLES
+                )));
+            }
+            let mat = prim.material();
+            model.double_sided |= mat.double_sided();
+            let mut material = mat.index().map(|_| phong_material(&mat));
+            let (maps, uvs, uvs1) = textures.maps(&prim, g.world_pos.len(), &buffers, &what, &mut material, warnings);
+            let name = format!(
+                "{}:{}",
+                path.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                mesh.name()
+                    .map_or_else(|| format!("mesh{}", mesh.index()), str::to_string)
+            );
+            // The file's tangents serve a normal map; without one they are not kept.
+            let tangents = if maps.normal.is_some() { g.tangents } else { Vec::new() };
+            pending.push(Pending {
+                name,
+                tangents,
+                world_pos: g.world_pos,
+                normals: g.normals,
+                tris: g.tris,
+                material,
+                has_normals: g.has_normals,
+                uvs,
+                uvs1,
+                colors: g.colors,
+                maps,
+            });
+        }
+    }
+    if pending.is_empty() {
+        return Err(fail(format!(
+            "no triangles in the default scene: nothing to render{}",
+            if skipped_modes > 0 {
+                format!(" ({skipped_modes} primitives of points or lines skipped)")
+            } else {
+                String::new()
+            }
+        )));
+    }
+    let file = path.display();
+    if skipped_modes > 0 {
+        warnings.push(format!(
+            "{file}: {skipped_modes} primitives of points or lines skipped: phong draws surfaces"
+        ));
+    }
+    if colours > 0 {
+        warnings.push(format!(
+            "{file}: vertex colours (COLOR_0, {colours} primitives) are not used: not one finite colour per vertex"
+        ));
+    }
+    model.parts = into_parts(pending, &fail)?;
+    Ok(model)
+}
+
+/// What the `gltf` crate's own validation would not say, or would panic on: a required
+/// extension phong does not read (the crate refuses it without saying why), and a primitive's
+/// accessor index out of range (gltf-json's validation indexes the POSITION accessor
+/// unchecked: found by the `gltf` fuzz target).
+fn check_before_validation(bytes: &[u8], fail: &dyn Fn(String) -> Error) -> Result<(), Error> {
+    let unchecked = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    for ext in unchecked.document.extensions_required() {
+        if !SUPPORTED.contains(&ext) {
+            return Err(fail(format!(
+                "the file requires the extension {ext}, which phong does not read{}",
+                if ext.contains("draco") || ext.contains("meshopt") {
+                    " (compressed geometry: decompress it first, e.g. with gltf-transform)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let refs = prim.attributes.values().chain(prim.indices.as_ref());
+            if let Some(bad) = refs.map(|i| i.value()).find(|&i| i >= json.accessors.len()) {
+                return Err(fail(format!(
+                    "mesh {m} primitive {p} names accessor {bad}, but the file has {}",
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The camera of `node` placed by `world`, if it has one.
+fn file_camera(node: &::gltf::Node, world: &DMat4) -> Option<FileCamera> {
+    let cam = node.camera()?;
+    let fov_deg = match cam.projection() {
+        ::gltf::camera::Projection::Perspective(p) => Some(p.yfov().to_degrees()),
+        ::gltf::camera::Projection::Orthographic(_) => None,
+    };
+    Some(FileCamera {
+        position: world.transform_point3(DVec3::ZERO),
+        forward: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+        up: world.transform_vector3(DVec3::Y).normalize_or(DVec3::Y),
+        fov_deg,
+    })
+}
+
+/// The KHR_lights_punctual light of `node` placed by `world`, if it has one.
+fn file_light(node: &::gltf::Node, world: &DMat4) -> Option<FileLight> {
+    let light = node.light()?;
+    let (kind, cutoff_deg) = match light.kind() {
+        ::gltf::khr_lights_punctual::Kind::Directional => ("directional", 0.0),
+        ::gltf::khr_lights_punctual::Kind::Point => ("point", 0.0),
+        ::gltf::khr_lights_punctual::Kind::Spot { outer_cone_angle, .. } => {
+            ("spot", outer_cone_angle.to_degrees().clamp(0.0, 90.0))
+        }
+    };
+    Some(FileLight {
+        kind,
+        position: world.transform_point3(DVec3::ZERO),
+        direction: world.transform_vector3(DVec3::NEG_Z).normalize_or(DVec3::NEG_Z),
+        color: light.color().map(|c| c * light.intensity()),
+        cutoff_deg,
+    })
+}
+
+/// Checks every accessor a primitive's reading will use (counts, types, bounds within the
+/// buffers), so that the crate's reader cannot fail or panic on them; whether it has normals.
+fn check_primitive(
+    prim: &::gltf::Primitive,
+    buffers: &[Vec<u8>],
+    what: &str,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<bool, Error> {
+    use ::gltf::accessor::{DataType, Dimensions};
+    let pos = prim
+        .get(&::gltf::Semantic::Positions)
+        .ok_or_else(|| fail(format!("{what} has no POSITION")))?;
+    check_accessor(&pos, buffers, &[Dimensions::Vec3], true)
+        .map_err(|m| fail(format!("{what}: POSITION (accessor {}): {m}", pos.index())))?;
+    let normal = prim.get(&::gltf::Semantic::Normals);
+    if let Some(a) = &normal {
+        check_accessor(a, buffers, &[Dimensions::Vec3], true)
+            .map_err(|m| fail(format!("{what}: NORMAL (accessor {}): {m}", a.index())))?;
+    }
+    if let Some(a) = prim.indices() {
+        check_accessor(&a, buffers, &[Dimensions::Scalar], false)
+            .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
+        // Unsigned integers only, as the specification says (the crate's reader treats any
+        // other component type as unreachable: found by the `gltf` fuzz target).
+        if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) || a.normalized() {
+            return Err(fail(format!(
+                "{what}: indices (accessor {}) are not unsigned integers",
+                a.index()
+            )));
+        }
+    }
+    // The texture coordinate sets the material's textures use (checked like the others).
+    let sets: BTreeSet<u32> = texture_infos(&prim.material()).iter().map(|t| t.set).collect();
+    for &set in &sets {
+        if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
+            check_accessor(&a, buffers, &[Dimensions::Vec2], false)
+                .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
+        }
+    }
+    if let Some(a) = prim.get(&::gltf::Semantic::Colors(0)) {
+        check_accessor(&a, buffers, &[Dimensions::Vec3, Dimensions::Vec4], false)
+            .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
+    }
+    Ok(normal.is_some())
+}
+
+/// A primitive's geometry in world space.
+struct Geometry {
+    world_pos: Vec<DVec3>,
+    normals: Vec<Vec3>,
+    has_normals: bool,
+    tris: Vec<[u32; 3]>,
+    colors: Vec<Color>,
+    /// COLOR_0 was there but not one finite colour a vertex: dropped.
+    colours_dropped: bool,
+    tangents: Vec<Vec4>,
+}
+
+/// Reads a checked primitive's positions, vertex colours, triangles (strips and fans
+/// unrolled, wound back where `world` mirrors), normals and tangents, placed by `world`.
+fn geometry(
+    prim: &::gltf::Primitive,
+    buffers: &[Vec<u8>],
+    world: &DMat4,
+    has_normal_accessor: bool,
+    what: &str,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Geometry, Error> {
+    let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
+    let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions = packed_positions(prim, buffers)
+        .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
+        .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
+    if let Some((i, p)) = positions
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+    {
+        return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
+    }
+    let n = positions.len();
+    // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
+    let (colors, colours_dropped) = match reader.read_colors(0) {
+        Some(c) => {
+            let c: Vec<Color> = c
+                .into_rgb_f32()
+                .map(|[r, g, b]| Color::new(r.max(0.0), g.max(0.0), b.max(0.0)))
+                .collect();
+            if c.len() == n && c.iter().all(|c| c.is_finite()) {
+                (c, false)
+            } else {
+                (Vec::new(), true)
+            }
+        }
+        None => (Vec::new(), false),
+    };
+    let indices: Vec<u32> = match (packed_indices(prim, buffers), reader.read_indices()) {
+        (Some(i), _) => i,
+        (None, Some(i)) => i.into_u32().collect(),
+        (None, None) => (0..n as u32).collect(),
+    };
+    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
+    }
+    let mut tris: Vec<[u32; 3]> = match prim.mode() {
+        ::gltf::mesh::Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                let t = [indices[k - 2], indices[k - 1], indices[k]];
+                // Every other triangle of a strip is wound the other way.
+                if k % 2 == 1 { [t[1], t[0], t[2]] } else { t }
+            })
+            .collect(),
+        ::gltf::mesh::Mode::TriangleFan => (2..indices.len())
+            .map(|k| [indices[0], indices[k - 1], indices[k]])
+            .collect(),
+        _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    };
+    if mirrored {
+        tris.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    let world_pos: Vec<DVec3> = positions
+        .iter()
+        .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
+        .collect();
+    let (normals, has_normals) = match reader.read_normals().filter(|_| has_normal_accessor) {
+        Some(ns) => {
+            let ns: Vec<Vec3> = ns
+                .map(|v| {
+                    (normal_matrix * DVec3::from_array(v.map(f64::from)))
+                        .normalize_or_zero()
+                        .as_vec3()
+                })
+                .collect();
+            let ok = ns.len() == n;
+            (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
+        }
+        None => (vec![Vec3::ZERO; n], false),
+    };
+    // TANGENT (read with normals, as the format pairs them): a direction in the surface,
+    // by the node's matrix itself; a mirror flips the bitangent's sign.
+    let tangents: Vec<Vec4> = match prim.get(&::gltf::Semantic::Tangents) {
+        Some(a) if has_normals => {
+            check_accessor(&a, buffers, &[::gltf::accessor::Dimensions::Vec4], true)
+                .map_err(|m| fail(format!("{what}: TANGENT (accessor {}): {m}", a.index())))?;
+            let linear = DMat3::from_mat4(*world);
+            let t: Vec<Vec4> = reader
+                .read_tangents()
+                .into_iter()
+                .flatten()
+                .map(|[x, y, z, w]| {
+                    let d = (linear * DVec3::new(x.into(), y.into(), z.into())).normalize_or_zero();
+                    d.as_vec3().extend(if mirrored { -w } else { w })
+                })
+                .collect();
+            if t.len() == n && t.iter().all(|t| t.is_finite()) {
+                t
+            } else {
+                Vec::new()
+            }
+        }
+        _ => Vec::new(),
+    };
+    Ok(Geometry {
+        world_pos,
+        normals,
+        has_normals,
+        tris,
+        colors,
+        colours_dropped,
+        tangents,
+    })
+}
+
+/// The file's textures as they are read: where from, the images decoded so far, and the white
+/// emission map (one for the file, uploaded once by the GPU).
+struct Textures<'a> {
+    path: &'a Path,
+    resource: &'a dyn Fn(&str) -> Result<Vec<u8>, String>,
+    cache: TextureCache,
+    white: Option<std::sync::Arc<phong_core::Texture>>,
+}
+
+impl Textures<'_> {
+    /// A primitive's maps and its two sets of texture coordinates (`v` flipped to OpenGL's),
+    /// for its `n` vertices; `material` becomes the one a metallic-roughness map scales.
+    fn maps(
+        &mut self,
+        prim: &::gltf::Primitive,
+        n: usize,
+        buffers: &[Vec<u8>],
+        what: &str,
+        material: &mut Option<Material>,
+        warnings: &mut Vec<String>,
+    ) -> (Maps, Vec<Vec2>, Vec<Vec2>) {
+        let path = self.path;
+        let mat = &prim.material();
+        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        // The mesh's first set is the normal texture's (its tangents are made from it), else
+        // the base colour's (else the first used); its second, the other of TEXCOORD_0 and
+        // TEXCOORD_1 used, if any. A third set is not read.
+        let mut infos = texture_infos(mat);
+        let first = infos
+            .iter()
+            .find(|t| t.slot == Slot::Normal)
+            .or(infos.first())
+            .map(|t| t.set);
+        let second = infos.iter().map(|t| t.set).find(|&s| Some(s) != first && s <= 1);
+        let read_set = |set: Option<u32>| -> Vec<Vec2> {
+            match set.and_then(|s| reader.read_tex_coords(s)) {
+                Some(t) => {
+                    let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
+                    if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
+                        uv
+                    } else {
+                        Vec::new()
+                    }
+                }
+                None => Vec::new(),
+            }
+        };
+        let (uvs, uvs1) = (read_set(first), read_set(second));
+        let beyond = infos
+            .iter()
+            .filter(|t| Some(t.set) != first && Some(t.set) != second)
+            .count();
+        if beyond > 0 {
+            warnings.push(format!(
+                "{}: {what}: {beyond} textures not used: they read a third texture coordinate set (phong reads two)",
+                path.display()
+            ));
+        }
+        if second.is_some() && uvs1.is_empty() && !uvs.is_empty() {
+            warnings.push(format!(
+                "{}: {what}: textures on TEXCOORD_{} not used: the primitive has no usable TEXCOORD_{0}",
+                path.display(),
+                second.unwrap_or(1)
+            ));
+        }
+        // Each texture's set as the mesh's: 0 the first, 1 the second.
+        infos.retain(|t| Some(t.set) == first || (Some(t.set) == second && !uvs1.is_empty()));
+        for t in &mut infos {
+            t.set = u32::from(Some(t.set) != first);
+        }
+        let maps = if mat.index().is_some() && !uvs.is_empty() {
+            let requests: Vec<MapRequest> = infos.iter().filter_map(|t| texture_request(t, buffers, what)).collect();
+            let mut maps = resolve(
+                &requests,
+                mat.name().unwrap_or("(unnamed)"),
+                self.resource,
+                &mut self.cache,
+                warnings,
+            );
+            if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
+                maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
+            }
+            // The factors go with the map, and the material becomes the one it scales.
+            if let (Some(mr), Some(m)) = (&mut maps.metal_rough, &mut *material) {
+                let pbr = mat.pbr_metallic_roughness();
+                let b = pbr.base_color_factor();
+                mr.base_factor = Color::new(b[0], b[1], b[2]).clamp01();
+                mr.metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+                mr.roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+                *m = mr.material(m.emission(), m.alpha());
+            }
+            // glTF's emission is not the base colour's to modulate (GL_MODULATE's would be):
+            // a white emission map keeps it apart.
+            let modulated = maps.diffuse.is_some() || maps.metal_rough.is_some();
+            if maps.emission.is_none() && modulated && material.is_some_and(|m| m.emission() != Color::BLACK) {
+                let white = self.white.get_or_insert_with(|| {
+                    std::sync::Arc::new(phong_core::Texture::from_rgba8(1, 1, &[[255; 4]]).expect("a 1×1 texture"))
+                });
+                maps.emission = Some(phong_core::TextureMap::new(std::sync::Arc::clone(white)));
+            }
+            maps
+        } else {
+            if !infos.is_empty() {
+                warnings.push(format!(
+                    "{}: {what}: textures not used: the primitive has no usable TEXCOORD_{}",
+                    path.display(),
+                    first.unwrap_or(0)
+                ));
+            }
+            Maps::default()
+        };
+        // `alphaMode: BLEND`: blended by the base colour's alpha (and its texture's).
+        let maps = Maps {
+            blend: mat.alpha_mode() == ::gltf::material::AlphaMode::Blend,
+            ..maps
+        };
+        (maps, uvs, uvs1)
+    }
+}
+
+/// The parts of the read primitives, the whole model re-centred together (one origin for
+/// every part).
+fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<Vec<ModelPart>, Error> {
+    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
+    pending
+        .into_iter()
+        .map(|p| {
+            let positions: Vec<Vec3> = p.world_pos.iter().map(|w| (*w - origin).as_vec3()).collect();
+            let mesh = Mesh::new(positions, p.normals, p.tris)
+                .and_then(|m| m.with_uvs(p.uvs))
+                .and_then(|m| m.with_uvs1(p.uvs1))
+                .and_then(|m| m.with_colors(p.colors))
+                .and_then(|m| m.with_tangents(p.tangents))
+                .map_err(|e| fail(format!("{}: {e}", p.name)))?;
+            Ok(ModelPart {
+                name: p.name,
+                mesh,
+                material: p.material,
+                maps: p.maps,
+                has_normals: p.has_normals,
+                origin,
+            })
+        })
+        .collect()
+}
+
+/// The nodes of the default scene (else of the first, else every node that is no node's
+/// child, as other viewers do) with their world transforms (composed in f64), depth first. A
+/// node reached twice (a cycle, or a node with two parents, which the format forbids) is an
+/// error; each node is visited once, so the work is linear in the nodes.
+fn node_instances<'a>(
+    doc: &'a ::gltf::Document,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Vec<(::gltf::Node<'a>, DMat4)>, Error> {
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<::gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let children: BTreeSet<usize> = doc.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            doc.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut instances = Vec::new();
+    let mut stack: Vec<(::gltf::Node, DMat4)> = roots.into_iter().rev().map(|n| (n, DMat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(fail(format!(
+                "node {} is reached twice (a cycle in the node tree, or a node with two parents)",
+                node.index()
+            )));
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((c, world));
+        }
+        instances.push((node, world));
+    }
+    Ok(instances)
+}
+
+/// A primitive read, in f64 world space, waiting for the model's common origin.
+struct Pending {
+    name: String,
+    tangents: Vec<Vec4>,
+    uvs: Vec<Vec2>,
+    /// The second set of texture coordinates, where a texture reads it.
+    uvs1: Vec<Vec2>,
+    colors: Vec<Color>,
+    maps: Maps,
+    world_pos: Vec<DVec3>,
+    normals: Vec<Vec3>,
+    tris: Vec<[u32; 3]>,
+    material: Option<Material>,
+    has_normals: bool,
+}
+
+/// The Phong material of a glTF material (the mapping in the module's doc).
+fn phong_material(m: &::gltf::Material) -> Material {
+    let pbr = m.pbr_metallic_roughness();
+    let base = pbr.base_color_factor();
+    let (diffuse, specular, roughness, alpha) = match m.pbr_specular_glossiness() {
+        Some(sg) => {
+            let d = sg.diffuse_factor();
+            (
+                [d[0], d[1], d[2]],
+                sg.specular_factor(),
+                1.0 - sg.glossiness_factor(),
+                d[3],
+            )
+        }
+        None => {
+            let metal = pbr.metallic_factor().clamp(0.0, 1.0);
+            let rgb = [base[0], base[1], base[2]];
+            (
+                rgb.map(|c| c * (1.0 - metal)),
+                rgb.map(|c| 0.04 + (c - 0.04) * metal),
+                pbr.roughness_factor(),
+                base[3],
+            )
+        }
+    };
+    let shininess = MetalRough::shininess(roughness);
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let col = |c: [f32; 3]| {
+        let c = c.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+        Color::new(c[0], c[1], c[2])
+    };
+    let d = col(diffuse);
+    let built = Material::new(
+        d,
+        d,
+        col(specular),
+        col(m.emissive_factor().map(|e| e * strength)),
+        shininess,
+    )
+    .unwrap_or_default();
+    built.with_alpha(alpha.clamp(0.0, 1.0)).unwrap_or(built)
+}
+
+/// The textures a material uses that phong renders, with their slots: base colour (or
+/// KHR_materials_pbrSpecularGlossiness's diffuse texture), emissive.
+/// A texture a material uses: its slot, the texture, its coordinate set, its
+/// KHR_texture_transform and (a normal texture) its scale.
+struct Tex<'a> {
+    slot: Slot,
+    texture: ::gltf::Texture<'a>,
+    set: u32,
+    transform: Option<::gltf::texture::TextureTransform<'a>>,
+    scale: f32,
+}
+
+impl<'a> Tex<'a> {
+    fn of(slot: Slot, info: ::gltf::texture::Info<'a>) -> Tex<'a> {
+        let transform = info.texture_transform();
+        Tex {
+            slot,
+            texture: info.texture(),
+            // KHR_texture_transform's own `texCoord` overrides the texture info's.
+            set: transform
+                .as_ref()
+                .and_then(|t| t.tex_coord())
+                .unwrap_or(info.tex_coord()),
+            transform,
+            scale: 1.0,
+        }
+    }
+}
+
+fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
+    let mut out = Vec::new();
+    let diffuse = match mat.pbr_specular_glossiness() {
+        Some(sg) => sg.diffuse_texture(),
+        None => mat.pbr_metallic_roughness().base_color_texture(),
+    };
+    if let Some(t) = diffuse {
+        out.push(Tex::of(Slot::Diffuse, t));
+    }
+    if let Some(t) = mat.emissive_texture() {
+        out.push(Tex::of(Slot::Emission, t));
+    }
+    if mat.pbr_specular_glossiness().is_none()
+        && let Some(t) = mat.pbr_metallic_roughness().metallic_roughness_texture()
+    {
+        out.push(Tex::of(Slot::MetalRough, t));
+    }
+    if let Some(o) = mat.occlusion_texture() {
+        out.push(Tex {
+            slot: Slot::Occlusion,
+            texture: o.texture(),
+            set: o.tex_coord(),
+            transform: None,
+            scale: o.strength(),
+        });
+    }
+    if let Some(n) = mat.normal_texture() {
+        let t = Tex {
+            slot: Slot::Normal,
+            texture: n.texture(),
+            set: n.tex_coord(),
+            transform: None,
+            scale: n.scale(),
+        };
+        out.push(t);
+    }
+    out
+}
+
+/// A glTF texture as a map request: its image (a buffer view's bytes, a data URI, or a file
+/// read by the loader's reader), sampler and KHR_texture_transform, in OpenGL's coordinates.
+fn texture_request(tex: &Tex, buffers: &[Vec<u8>], what: &str) -> Option<MapRequest> {
+    let (slot, texture) = (tex.slot, tex.texture.clone());
+    let name = format!("image {}", texture.source().index());
+    let source = match texture.source().source() {
+        ::gltf::image::Source::View { view, .. } => {
+            let data = buffers.get(view.buffer().index())?;
+            let end = view.offset().checked_add(view.length())?;
+            Source::Bytes(std::sync::Arc::new(data.get(view.offset()..end)?.to_vec()), name)
+        }
+        ::gltf::image::Source::Uri { uri, .. } => match uri.strip_prefix("data:") {
+            Some(rest) => {
+                let (_, data) = rest.split_once(";base64,")?;
+                let bytes = base64::engine::general_purpose::STANDARD.decode(data).ok()?;
+                Source::Bytes(std::sync::Arc::new(bytes), name)
+            }
+            None => Source::File(percent_decode(uri)),
+        },
+    };
+    let s = texture.sampler();
+    let wrap = |w: ::gltf::texture::WrappingMode| match w {
+        ::gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+    };
+    use ::gltf::texture::{MagFilter, MinFilter};
+    let (min, mip) = match s.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, MipFilter::None),
+        Some(MinFilter::Linear) => (Filter::Linear, MipFilter::None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, MipFilter::Nearest),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, MipFilter::Nearest),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, MipFilter::Linear),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, MipFilter::Linear),
+    };
+    let sampler = Sampler {
+        wrap_u: wrap(s.wrap_s()),
+        wrap_v: wrap(s.wrap_t()),
+        mag: if s.mag_filter() == Some(MagFilter::Nearest) {
+            Filter::Nearest
+        } else {
+            Filter::Linear
+        },
+        min,
+        mip,
+    };
+    // glTF's transform acts on its coordinates (v down); ours are flipped: F·M·F.
+    let flip = UvTransform {
+        linear: Mat2::from_diagonal(Vec2::new(1.0, -1.0)),
+        offset: Vec2::new(0.0, 1.0),
+    };
+    let m = match &tex.transform {
+        Some(t) => {
+            let (sin, cos) = t.rotation().sin_cos();
+            let rotation = Mat2::from_cols(Vec2::new(cos, -sin), Vec2::new(sin, cos));
+            UvTransform {
+                linear: rotation * Mat2::from_diagonal(Vec2::from(t.scale())),
+                offset: Vec2::from(t.offset()),
+            }
+        }
+        None => UvTransform::default(),
+    };
+    Some(MapRequest {
+        slot,
+        source,
+        transform: flip.after(&m.after(&flip)),
+        sampler,
+        channel: None,
+        srgb: true,
+        at: what.to_string(),
+        scale: tex.scale,
+        green_down: false,
+        set: u8::from(tex.set == 1),
+    })
+}
