@@ -10,9 +10,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let name = ["fuzz.gltf", "fuzz.glb"][usize::from(pick % 2)];
-    match phong_scene::parse_mesh_bytes(Path::new(name), bytes) {
-        Ok(parts) => {
-            for p in parts {
+    let none = |uri: &str| Err(format!("{uri} is not available here"));
+    match phong_scene::ModelFile::from_bytes(Path::new(name), bytes, &none) {
+        Ok(model) => {
+            for p in model.parts {
                 let n = p.mesh.positions().len() as u32;
                 assert!(p.mesh.triangles().iter().flatten().all(|&i| i < n));
                 assert!(p.mesh.positions().iter().all(|v| v.is_finite()));

@@ -15,11 +15,12 @@ fuzz_target!(|data: &[u8]| {
     let (Ok(obj), Ok(mtl)) = (std::str::from_utf8(obj), std::str::from_utf8(mtl)) else {
         return;
     };
-    let read = |_: &Path| Ok(mtl.to_string());
-    let texture = |_: &str| Ok(image.to_vec());
-    let mut warnings = Vec::new();
-    match phong_scene::load_obj_text(Path::new("fuzz.obj"), obj, &read, &texture, &mut warnings) {
-        Ok(parts) => assert!(!parts.is_empty()),
+    // Every MTL library the OBJ names is `mtl`, every image `image`.
+    let resource = |name: &str| {
+        Ok(if name.to_ascii_lowercase().ends_with(".mtl") { mtl.as_bytes() } else { image }.to_vec())
+    };
+    match phong_scene::ModelFile::from_bytes(Path::new("fuzz.obj"), obj.as_bytes(), &resource) {
+        Ok(model) => assert!(!model.parts.is_empty()),
         Err(phong_scene::Error::Parse { line, col, .. }) => assert!(line >= 1 && col >= 1),
         Err(e) => panic!("not a located error: {e}"),
     }
