@@ -457,7 +457,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     at: (V, V, V),
     k: &[V; 24],
 ) -> Lanes<V> {
-    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let zero = V::splat(0.0);
     let (pos, nrm) = position_normal(q);
     // The coordinates, then the maps that change the light (a normal map tilts the normal, a
     // shininess or metallic-roughness map sets the shininess), then the colour maps, and the
@@ -473,6 +473,44 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     } else {
         (nrm, None, None)
     };
+    let texels = colour_texels::<V, FULL>(maps, uv, uv1);
+    let lit = if PER_VERTEX {
+        None
+    } else {
+        Some(shade_shininess(prep, pos, nrm, sv))
+    };
+    let (primary, specular, ambient) = lit_colours::<V, FULL>(prep, maps, q, lit);
+    let Texels { td, ts, ta, te, ao } = texels;
+    let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
+    if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
+        return Err([primary, specular, if FULL { ambient } else { [zero; 3] }]);
+    }
+    let texels = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten(), ao.flatten());
+    Ok(modulated::<V, FULL>(
+        prep,
+        maps,
+        k,
+        (dx, dy, w),
+        [primary, specular, ambient],
+        mr,
+        texels,
+    ))
+}
+
+/// A vector's texels of the colour maps (`None` where the object has no such map; `Some(None)`
+/// where its coordinates could not be wrapped exactly): diffuse, specular, ambient, emission,
+/// and the occlusion's red channel.
+struct Texels<V> {
+    td: Option<Option<[V; 3]>>,
+    ts: Option<Option<[V; 3]>>,
+    ta: Option<Option<[V; 3]>>,
+    te: Option<Option<[V; 3]>>,
+    ao: Option<Option<V>>,
+}
+
+/// The texels of `maps`' colour maps at coordinates `uv` (first set) and `uv1` (second).
+#[inline(always)]
+fn colour_texels<V: Sampling, const FULL: bool>(maps: &VectorMaps, uv: [V; 6], uv1: [V; 6]) -> Texels<V> {
     // (Matches, not closures: see `modulo`.)
     #[allow(clippy::manual_map)]
     let td = match &maps.diffuse {
@@ -502,11 +540,19 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
         }),
         _ => None,
     };
-    let lit = if PER_VERTEX {
-        None
-    } else {
-        Some(shade_shininess(prep, pos, nrm, sv))
-    };
+    Texels { td, ts, ta, te, ao }
+}
+
+/// The light's colours before the maps, `[primary, specular, ambient]` as `phong_core::light`
+/// gives them: from the light `lit` per pixel, else (Gouraud) the vertices' colours in `q`.
+#[inline(always)]
+fn lit_colours<V: Sampling, const FULL: bool>(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    q: [V; 6],
+    lit: Option<super::kernel::Terms<V>>,
+) -> ([V; 3], [V; 3], [V; 3]) {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
     // `FULL` is `maps.full()`, made a constant so that the common case (diffuse and specular
     // maps on the first set) does not keep the ambient terms alive, nor choose a set per map
     // (benches/HISTORY.md, "Ambient, emission, occlusion and second-set maps").
@@ -544,10 +590,31 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
             specular[c] = s;
         }
     }
-    let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
-    if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
-        return Err([primary, specular, if FULL { ambient } else { [zero; 3] }]);
-    }
+    (primary, specular, ambient)
+}
+
+/// The texels' colours `(T_Kd, T_Ks, T_Ka, T_Ke, T_AO.r)` applied to the light's colours
+/// `[primary, specular, ambient]` in `Lit::modulate`'s order, tinted by the vertex colours'
+/// planes in `k` (at `(dx, dy)`, over `w`) and with a metallic-roughness texel `mr`'s metalness.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn modulated<V: Sampling, const FULL: bool>(
+    prep: &Prepared,
+    maps: &VectorMaps,
+    k: &[V; 24],
+    (dx, dy, w): (V, V, V),
+    [primary, specular, ambient]: [[V; 3]; 3],
+    mr: Option<[V; 3]>,
+    (td, ts, ta, te, ao): (
+        Option<[V; 3]>,
+        Option<[V; 3]>,
+        Option<[V; 3]>,
+        Option<[V; 3]>,
+        Option<V>,
+    ),
+) -> [V; 3] {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let e = [prep.emission.r, prep.emission.g, prep.emission.b];
     // Vertex colours: their planes at 11, 14, 17, over `w` as the coordinates.
     let mut tint = [one; 3];
     if maps.tinted {
@@ -556,7 +623,6 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
             *t = k[i].add(k[i + 1].mul(dx)).add(k[i + 2].mul(dy)).mul(w);
         }
     }
-    let (td, ts, ta, te) = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten());
     // A metallic-roughness texel's metalness `m` (its blue): `T_Kd·(1 − m)`, and the specular
     // texel `0.04·(1 − m) + base⊗T_Kd·m` in the specular map's place (`Maps::sample_sets`).
     let (td, ts) = match (FULL, mr, &maps.metal_rough) {
@@ -576,7 +642,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
         _ => (td, ts),
     };
     // The occlusion's factor `1 + strength·(T.r − 1)`.
-    let ao = match (ao.flatten(), &maps.occlusion) {
+    let ao = match (ao, &maps.occlusion) {
         (Some(r), Some((_, strength))) => Some(r.sub(one).mul_add(V::splat(*strength), one)),
         _ => None,
     };
@@ -619,7 +685,7 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
         }
         rgb[c] = x;
     }
-    Ok(rgb)
+    rgb
 }
 
 /// Lanes `k..k + 3` of `q`.

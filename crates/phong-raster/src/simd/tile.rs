@@ -136,18 +136,9 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
     use core::arch::x86_64::*;
     // Pixels whose depth left +∞ (no depth returns to it: `z < d` fails at `z = +∞`).
     let mut covered = 0u64;
-    let inf = _mm_set1_ps(f32::INFINITY);
     let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
     let lanes_epi = _mm_setr_epi32(0, 1, 2, 3);
-    // Blend masks from a window's pass bits, by shifting bit j into the sign of lane j (of a
-    // 4-pixel mask), or of lanes 4·j..4·j + 4 (of the masks of pixels 0, 1 and of 2, 3).
-    let shift4 = _mm_setr_epi32(31, 30, 29, 28);
-    let shift01 = _mm256_setr_epi32(31, 31, 31, 31, 30, 30, 30, 30);
-    let shift23 = _mm256_setr_epi32(29, 29, 29, 29, 28, 28, 28, 28);
-    let (zero, one, half, c255) = (_mm_setzero_ps(), _mm_set1_ps(1.0), _mm_set1_ps(0.5), _mm_set1_ps(255.0));
-    // 8-bit pixels: alpha 1 encodes as 255; the byte order from channel planes to pixels.
-    let opaque = _mm_set1_epi32(255);
-    let interleave = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+    let (one, half) = (_mm_set1_ps(1.0), _mm_set1_ps(0.5));
     for k in 0..n {
         let t = tri(k);
         let ((c0, c1), (r0, r1)) = (t.cols, t.rows);
@@ -198,35 +189,7 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
                             _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
                             _mm_mul_ps(l[2], z[2]),
                         );
-                        let at = line + col as usize;
-                        let pass = if let Some(d4) = depth.get_mut(at..at + 4) {
-                            // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend
-                            // and a store of the same address are otherwise turned into a masked
-                            // store (`vmaskmovps`), slow on AMD and not forwarded to later loads
-                            // (BENCHMARKS.md, K1).
-                            // SAFETY: `d4` is 4 readable f32.
-                            let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
-                            let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
-                            covered += u64::from((pass & _mm_movemask_ps(_mm_cmpeq_ps(d, inf)) as u32).count_ones());
-                            let m = _mm_castsi128_ps(_mm_sllv_epi32(_mm_set1_epi32(pass as i32), shift4));
-                            // SAFETY: `d4` is 4 writable f32.
-                            unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, m)) };
-                            pass
-                        } else {
-                            // A caller's depth without room for whole windows: one at a time.
-                            let mut zs = [0f32; 4];
-                            // SAFETY: `zs` is 4 writable f32.
-                            unsafe { _mm_storeu_ps(zs.as_mut_ptr(), zz) };
-                            let mut pass = 0;
-                            for (j, &zj) in zs.iter().enumerate() {
-                                if inside & (1 << j) != 0 && zj < depth[at + j] {
-                                    covered += u64::from(depth[at + j] == f32::INFINITY);
-                                    depth[at + j] = zj;
-                                    pass |= 1 << j;
-                                }
-                            }
-                            pass
-                        };
+                        let pass = depth_window(depth, line + col as usize, zz, inside, &mut covered);
                         if pass != 0 {
                             let c = col as usize;
                             let px =
@@ -238,76 +201,9 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
                             let w = _mm_div_ps(one, q[3]);
                             let (cr, cg, cb) = (_mm_mul_ps(q[0], w), _mm_mul_ps(q[1], w), _mm_mul_ps(q[2], w));
                             if P::EIGHT {
-                                let row: &mut [[u8; 4]] = bytemuck::cast_slice_mut(row);
-                                // `Encoding::Linear` as `encode_linear` computes it, per channel:
-                                // `(clamp(c, 0, 1)·255 + 0.5)` truncated, NaN as 0.
-                                let enc = |v: __m128| {
-                                    _mm_cvttps_epi32(_mm_add_ps(
-                                        _mm_mul_ps(_mm_min_ps(_mm_max_ps(v, zero), one), c255),
-                                        half,
-                                    ))
-                                };
-                                // [r0..r3 g0..g3 b0..b3 a a a a] bytes, then pixel by pixel.
-                                let planar = _mm_packus_epi16(
-                                    _mm_packs_epi32(enc(cr), enc(cg)),
-                                    _mm_packs_epi32(enc(cb), opaque),
-                                );
-                                let packed = _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave));
-                                if let Some(win) = row.get_mut(c..c + 4) {
-                                    let m = _mm_castsi128_ps(_mm_sllv_epi32(_mm_set1_epi32(pass as i32), shift4));
-                                    let ptr = win.as_mut_ptr().cast::<f32>();
-                                    // SAFETY: `win` is 4 pixels, 16 readable and writable bytes
-                                    // from `ptr`. By `lddqu`, as the depth above.
-                                    unsafe {
-                                        let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
-                                        _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, m));
-                                    }
-                                } else {
-                                    let mut bytes = [[0u8; 4]; 4];
-                                    // SAFETY: `bytes` is 16 writable bytes.
-                                    unsafe { _mm_storeu_ps(bytes.as_mut_ptr().cast(), packed) };
-                                    let mut m = pass;
-                                    while m != 0 {
-                                        let j = m.trailing_zeros() as usize;
-                                        row[c + j] = bytes[j];
-                                        m &= m - 1;
-                                    }
-                                }
+                                store_rgba8(bytemuck::cast_slice_mut(row), c, pass, [cr, cg, cb]);
                             } else {
-                                let row: &mut [[f32; 4]] = bytemuck::cast_slice_mut(row);
-                                // Transposed: pixel j is [r_j, g_j, b_j, 1].
-                                let (rg_lo, rg_hi) = (_mm_unpacklo_ps(cr, cg), _mm_unpackhi_ps(cr, cg));
-                                let (b1_lo, b1_hi) = (_mm_unpacklo_ps(cb, one), _mm_unpackhi_ps(cb, one));
-                                let pixels = [
-                                    _mm_movelh_ps(rg_lo, b1_lo),
-                                    _mm_movehl_ps(b1_lo, rg_lo),
-                                    _mm_movelh_ps(rg_hi, b1_hi),
-                                    _mm_movehl_ps(b1_hi, rg_hi),
-                                ];
-                                if let Some(win) = row.get_mut(c..c + 4) {
-                                    let pb = _mm256_set1_epi32(pass as i32);
-                                    let m01 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift01));
-                                    let m23 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, shift23));
-                                    let ptr = win.as_mut_ptr().cast::<f32>();
-                                    // SAFETY: `win` is 4 pixels, 16 readable and writable f32 from `ptr`.
-                                    unsafe {
-                                        // By `lddqu`, as the depth above.
-                                        let old01 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.cast()));
-                                        let old23 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.add(8).cast()));
-                                        let new01 = _mm256_set_m128(pixels[1], pixels[0]);
-                                        let new23 = _mm256_set_m128(pixels[3], pixels[2]);
-                                        _mm256_storeu_ps(ptr, _mm256_blendv_ps(old01, new01, m01));
-                                        _mm256_storeu_ps(ptr.add(8), _mm256_blendv_ps(old23, new23, m23));
-                                    }
-                                } else {
-                                    let mut m = pass;
-                                    while m != 0 {
-                                        let j = m.trailing_zeros() as usize;
-                                        // SAFETY: `row[c + j]` is 4 writable f32 (bounds-checked).
-                                        unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
-                                        m &= m - 1;
-                                    }
-                                }
+                                store_rgba32(bytemuck::cast_slice_mut(row), c, pass, [cr, cg, cb]);
                             }
                         }
                     }
@@ -323,4 +219,134 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
         }
     }
     covered
+}
+
+/// The depth test of the window of 4 pixels at `depth[at..]`: each `inside` lane whose depth
+/// `zz` is below the stored one stores it. Returns the lanes that passed, adding to `covered`
+/// those that were `+∞`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn depth_window(depth: &mut [f32], at: usize, zz: core::arch::x86_64::__m128, inside: u32, covered: &mut u64) -> u32 {
+    use core::arch::x86_64::*;
+    if let Some(d4) = depth.get_mut(at..at + 4) {
+        // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend and a store of
+        // the same address are otherwise turned into a masked store (`vmaskmovps`), slow on
+        // AMD and not forwarded to later loads (BENCHMARKS.md, K1).
+        // SAFETY: `d4` is 4 readable f32.
+        let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
+        let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
+        *covered +=
+            u64::from((pass & _mm_movemask_ps(_mm_cmpeq_ps(d, _mm_set1_ps(f32::INFINITY))) as u32).count_ones());
+        // SAFETY: `d4` is 4 writable f32.
+        unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, lane_mask(pass))) };
+        return pass;
+    }
+    // A caller's depth without room for whole windows: one at a time.
+    let mut zs = [0f32; 4];
+    // SAFETY: `zs` is 4 writable f32.
+    unsafe { _mm_storeu_ps(zs.as_mut_ptr(), zz) };
+    let mut pass = 0;
+    for (j, &zj) in zs.iter().enumerate() {
+        if inside & (1 << j) != 0 && zj < depth[at + j] {
+            *covered += u64::from(depth[at + j] == f32::INFINITY);
+            depth[at + j] = zj;
+            pass |= 1 << j;
+        }
+    }
+    pass
+}
+
+/// A blend mask from a window's bits: bit j into the sign of lane j.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn lane_mask(bits: u32) -> core::arch::x86_64::__m128 {
+    use core::arch::x86_64::*;
+    _mm_castsi128_ps(_mm_sllv_epi32(
+        _mm_set1_epi32(bits as i32),
+        _mm_setr_epi32(31, 30, 29, 28),
+    ))
+}
+
+/// The colours `rgb` (channel planes of 4 pixels) of a window's `pass` lanes written as 8-bit
+/// pixels to `row[c..]`, as `encode_linear` computes them: `(clamp(v, 0, 1)·255 + 0.5)`
+/// truncated, NaN as 0, alpha 255.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn store_rgba8(row: &mut [[u8; 4]], c: usize, pass: u32, rgb: [core::arch::x86_64::__m128; 3]) {
+    use core::arch::x86_64::*;
+    let (zero, one, half, c255) = (_mm_setzero_ps(), _mm_set1_ps(1.0), _mm_set1_ps(0.5), _mm_set1_ps(255.0));
+    let enc = |v: __m128| _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(_mm_min_ps(_mm_max_ps(v, zero), one), c255), half));
+    // [r0..r3 g0..g3 b0..b3 a a a a] bytes, then pixel by pixel.
+    let planar = _mm_packus_epi16(
+        _mm_packs_epi32(enc(rgb[0]), enc(rgb[1])),
+        _mm_packs_epi32(enc(rgb[2]), _mm_set1_epi32(255)),
+    );
+    let interleave = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+    let packed = _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave));
+    if let Some(win) = row.get_mut(c..c + 4) {
+        let ptr = win.as_mut_ptr().cast::<f32>();
+        // SAFETY: `win` is 4 pixels, 16 readable and writable bytes from `ptr`. By `lddqu`, as
+        // the depth in `depth_window`.
+        unsafe {
+            let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
+            _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, lane_mask(pass)));
+        }
+    } else {
+        let mut bytes = [[0u8; 4]; 4];
+        // SAFETY: `bytes` is 16 writable bytes.
+        unsafe { _mm_storeu_ps(bytes.as_mut_ptr().cast(), packed) };
+        let mut m = pass;
+        while m != 0 {
+            let j = m.trailing_zeros() as usize;
+            row[c + j] = bytes[j];
+            m &= m - 1;
+        }
+    }
+}
+
+/// The colours `rgb` (channel planes of 4 pixels) of a window's `pass` lanes written as
+/// `[r, g, b, 1]` f32 pixels to `row[c..]`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn store_rgba32(row: &mut [[f32; 4]], c: usize, pass: u32, [cr, cg, cb]: [core::arch::x86_64::__m128; 3]) {
+    use core::arch::x86_64::*;
+    let one = _mm_set1_ps(1.0);
+    // Transposed: pixel j is [r_j, g_j, b_j, 1].
+    let (rg_lo, rg_hi) = (_mm_unpacklo_ps(cr, cg), _mm_unpackhi_ps(cr, cg));
+    let (b1_lo, b1_hi) = (_mm_unpacklo_ps(cb, one), _mm_unpackhi_ps(cb, one));
+    let pixels = [
+        _mm_movelh_ps(rg_lo, b1_lo),
+        _mm_movehl_ps(b1_lo, rg_lo),
+        _mm_movelh_ps(rg_hi, b1_hi),
+        _mm_movehl_ps(b1_hi, rg_hi),
+    ];
+    if let Some(win) = row.get_mut(c..c + 4) {
+        // The masks of pixels 0, 1 and of 2, 3: bit j into the sign of lanes 4·j..4·j + 4.
+        let pb = _mm256_set1_epi32(pass as i32);
+        let m01 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, _mm256_setr_epi32(31, 31, 31, 31, 30, 30, 30, 30)));
+        let m23 = _mm256_castsi256_ps(_mm256_sllv_epi32(pb, _mm256_setr_epi32(29, 29, 29, 29, 28, 28, 28, 28)));
+        let ptr = win.as_mut_ptr().cast::<f32>();
+        // SAFETY: `win` is 4 pixels, 16 readable and writable f32 from `ptr`.
+        unsafe {
+            // By `lddqu`, as the depth in `depth_window`.
+            let old01 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.cast()));
+            let old23 = _mm256_castsi256_ps(_mm256_lddqu_si256(ptr.add(8).cast()));
+            let new01 = _mm256_set_m128(pixels[1], pixels[0]);
+            let new23 = _mm256_set_m128(pixels[3], pixels[2]);
+            _mm256_storeu_ps(ptr, _mm256_blendv_ps(old01, new01, m01));
+            _mm256_storeu_ps(ptr.add(8), _mm256_blendv_ps(old23, new23, m23));
+        }
+    } else {
+        let mut m = pass;
+        while m != 0 {
+            let j = m.trailing_zeros() as usize;
+            // SAFETY: `row[c + j]` is 4 writable f32 (bounds-checked).
+            unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
+            m &= m - 1;
+        }
+    }
 }

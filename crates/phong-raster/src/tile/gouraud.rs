@@ -6,47 +6,12 @@
 
 use super::Tile;
 use super::Tiles;
-use super::visible::{Forward, Scan, visible_single};
+use super::visible::{ColorPlanes, Forward, Scan, visible_single};
 use crate::fixed::each3;
-use crate::simd::{GouraudTri, Planes, TilePixel, gouraud_tile};
+use crate::simd::{GouraudTri, TilePixel, gouraud_tile};
 use crate::stats::Marks;
 use crate::target::resolve;
 use phong_core::limits::SUBPIXEL_BITS;
-
-/// A triangle's Gouraud planes (see [`Planes`]) as columns of four, `[r/w, g/w, b/w, 1/w]`, so
-/// that a pixel's colour is one 4-wide vector from start to store, the layout of the
-/// `[f32; 4]` pixel it is written to (BENCHMARKS.md, C6).
-#[derive(Clone, Copy)]
-pub(super) struct ColorPlanes {
-    c: [f32; 4],
-    gx: [f32; 4],
-    gy: [f32; 4],
-    origin: [f32; 2],
-}
-
-impl ColorPlanes {
-    #[inline(always)]
-    pub fn new(p: &Planes) -> ColorPlanes {
-        let column = |k: usize| [p.attr[0][k], p.attr[1][k], p.attr[2][k], p.inv_w[k]];
-        ColorPlanes {
-            c: column(0),
-            gx: column(1),
-            gy: column(2),
-            origin: p.origin,
-        }
-    }
-
-    /// The colour at the centre of pixel `(px, py)`: `q_c / q_w`, each `q = c + gx·dx + gy·dy`
-    /// in `f32` (no fused multiply-adds), an exact division: the arithmetic of the reference's
-    /// interpolation of Gouraud colours.
-    #[inline(always)]
-    pub fn at(&self, px: u32, py: u32) -> [f32; 4] {
-        let (dx, dy) = (px as f32 + 0.5 - self.origin[0], py as f32 + 0.5 - self.origin[1]);
-        let q: [f32; 4] = std::array::from_fn(|i| self.c[i] + self.gx[i] * dx + self.gy[i] * dy);
-        let w = 1.0 / q[3];
-        [q[0] * w, q[1] * w, q[2] * w, 1.0]
-    }
-}
 
 impl Tiles<'_> {
     /// Draws `tile` of an all-Gouraud, one-sample frame into `rows`, by the AVX2 kernel with

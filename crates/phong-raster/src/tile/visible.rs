@@ -7,13 +7,12 @@
 //! ([`Tiles::tile_multi`]) each sample is tested in turn.
 
 use super::Tiles;
-use super::gouraud::ColorPlanes;
 use super::reference::over;
 use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
-use crate::simd::{TilePixel, covered_span};
+use crate::simd::{Planes, TilePixel, covered_span};
 use crate::stats::Marks;
 use crate::target::{Store, resolve};
 use phong_core::limits::SUBPIXEL_BITS;
@@ -27,6 +26,41 @@ pub(super) const FORWARD: u32 = u32::MAX - 1;
 pub(super) struct Forward<'r, 'i, T> {
     pub planes: ColorPlanes,
     pub rows: &'r mut [&'i mut [T]],
+}
+
+/// A triangle's Gouraud planes (see [`Planes`]) as columns of four, `[r/w, g/w, b/w, 1/w]`, so
+/// that a pixel's colour is one 4-wide vector from start to store, the layout of the
+/// `[f32; 4]` pixel it is written to (BENCHMARKS.md, C6).
+#[derive(Clone, Copy)]
+pub(super) struct ColorPlanes {
+    c: [f32; 4],
+    gx: [f32; 4],
+    gy: [f32; 4],
+    origin: [f32; 2],
+}
+
+impl ColorPlanes {
+    #[inline(always)]
+    pub fn new(p: &Planes) -> ColorPlanes {
+        let column = |k: usize| [p.attr[0][k], p.attr[1][k], p.attr[2][k], p.inv_w[k]];
+        ColorPlanes {
+            c: column(0),
+            gx: column(1),
+            gy: column(2),
+            origin: p.origin,
+        }
+    }
+
+    /// The colour at the centre of pixel `(px, py)`: `q_c / q_w`, each `q = c + gx·dx + gy·dy`
+    /// in `f32` (no fused multiply-adds), an exact division: the arithmetic of the reference's
+    /// interpolation of Gouraud colours.
+    #[inline(always)]
+    pub fn at(&self, px: u32, py: u32) -> [f32; 4] {
+        let (dx, dy) = (px as f32 + 0.5 - self.origin[0], py as f32 + 0.5 - self.origin[1]);
+        let q: [f32; 4] = std::array::from_fn(|i| self.c[i] + self.gx[i] * dx + self.gy[i] * dy);
+        let w = 1.0 / q[3];
+        [q[0] * w, q[1] * w, q[2] * w, 1.0]
+    }
 }
 
 /// A tile's rectangle as the row loop reads it: `(x0, y0, width, y1)`.
