@@ -50,7 +50,9 @@ pub(super) const NO_MATERIAL: &str = "phong:no-material";
 /// writes it), the newlines it removes added after the joined line, so that every later line
 /// keeps its number.
 pub(super) fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
-    if !src.contains("\\\n") && !src.contains("\\\r\n") {
+    if memchr::memmem::find(src.as_bytes(), b"\\\n").is_none()
+        && memchr::memmem::find(src.as_bytes(), b"\\\r\n").is_none()
+    {
         return std::borrow::Cow::Borrowed(src);
     }
     let mut out = String::with_capacity(src.len());
@@ -81,10 +83,13 @@ pub(super) fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
 
 pub(super) fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
     let mut off = 0;
-    src.split_inclusive('\n').map(move |l| {
+    std::iter::from_fn(move || {
+        if off >= src.len() {
+            return None;
+        }
         let start = off;
-        off += l.len();
-        (start, l.trim_end_matches(['\n', '\r']))
+        off = memchr::memchr(b'\n', &src.as_bytes()[start..]).map_or(src.len(), |i| start + i + 1);
+        Some((start, src[start..off].trim_end_matches(['\n', '\r'])))
     })
 }
 
