@@ -457,23 +457,33 @@ impl Mesh {
                 (f, f.normalize_or_zero())
             })
             .unzip();
-        let around = Around::new(w.positions.len(), &w.triangles);
-        let mut work = 0u64;
         // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
         // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
         // what the loop would.
         let cos_half = (1.0..=179.0)
             .contains(&crease_deg)
             .then(|| ((crease_deg - 0.02) * 0.5).to_radians().cos());
-        let cosines = (cos_crease, cos_half);
-        let vertex_rule: Vec<Rule> = (0..w.positions.len())
-            .map(|v| vertex_rule(around.of(v), v as u32, &w.triangles, &facet, &unit, cosines, &mut work))
-            .collect();
-        let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
-        let mut out = CornerVertices::new(w.positions.len());
         // Where corners carry nothing but their normal, a vertex of one normal is one vertex.
         let plain = self.uvs.is_empty() && self.uvs1.is_empty() && self.colors.is_empty();
-        let mut one = vec![u32::MAX; if plain { w.positions.len() } else { 0 }];
+        let n = w.positions.len();
+        // Most vertices take `Rule::Same`, found in two passes over the faces; the faces
+        // around each vertex and the other rules only for the rest.
+        let (same, count) = same_normals(&w, &facet, &unit, cos_half);
+        let mut work = 6 * w.triangles.len() as u64;
+        let rest = (0..n).filter(|&v| same[v] == Vec3::ZERO && count[v] > 0);
+        let around = (rest.clone().next().is_some()).then(|| Around::new(n, &w.triangles));
+        let mut slot = vec![u32::MAX; if around.is_some() { n } else { 0 }];
+        let mut rules = Vec::new();
+        if let Some(around) = &around {
+            let cosines = (cos_crease, cos_half);
+            for v in rest {
+                slot[v] = rules.len() as u32;
+                rules.push(vertex_rule(around.of(v), v as u32, &w.triangles, &facet, &unit, cosines, &mut work));
+            }
+        }
+        let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
+        let mut out = CornerVertices::new(n);
+        let mut one = vec![u32::MAX; if plain { n } else { 0 }];
         let mut triangles = Vec::with_capacity(w.triangles.len());
         for (f, t) in w.triangles.iter().enumerate() {
             if plain {
@@ -485,19 +495,29 @@ impl Mesh {
                 }
             }
             let own = unit[f];
-            let mut corner = 0;
-            let tri = t.map(|v| {
+            let mut tri = [0u32; 3];
+            // (A loop, not `t.map`: the closure was not inlined, its array moved per corner.)
+            for corner in 0..3 {
+                let v = t[corner];
                 // A corner keeps its own texture coordinates: vertices split where they differ.
                 let k = self.triangles[f][corner] as usize;
-                corner += 1;
-                let rule = &vertex_rule[v as usize];
-                if let (true, Rule::Same(n)) = (plain, rule) {
-                    let i = &mut one[v as usize];
-                    if *i == u32::MAX {
-                        *i = out.vertex(v, w.positions[v as usize], *n, self, k, false);
-                    }
-                    return *i;
+                let mean = same[v as usize];
+                if mean != Vec3::ZERO {
+                    tri[corner] = if !plain {
+                        out.vertex(v, w.positions[v as usize], mean, self, k, false)
+                    } else {
+                        let i = &mut one[v as usize];
+                        if *i == u32::MAX {
+                            *i = out.alone(w.positions[v as usize], mean);
+                        }
+                        *i
+                    };
+                    continue;
                 }
+                let (around, rule) = match &around {
+                    Some(a) => (a, &rules[slot[v as usize] as usize]),
+                    None => unreachable!("a used vertex without Rule::Same has a rule"),
+                };
                 let n = match rule {
                     Rule::Same(n) => *n,
                     Rule::Plain => around
@@ -519,12 +539,50 @@ impl Mesh {
                     Rule::Edges(groups) => groups[&(f as u32)],
                 };
                 let many = matches!(rule, Rule::Directions(_) | Rule::Edges(_));
-                out.vertex(v, w.positions[v as usize], n, self, k, many)
-            });
+                tri[corner] = out.vertex(v, w.positions[v as usize], n, self, k, many);
+            }
             triangles.push(tri);
         }
         (out.mesh(triangles), work)
     }
+}
+
+/// Faces at a vertex up to which the mean direction may stand for all of them
+/// ([`vertex_rule`]).
+const MANY: usize = 32;
+
+/// Per vertex of the welded mesh `w`, the normal of `Rule::Same` where [`vertex_rule`] would
+/// give it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
+/// `cos_half`), else zero; and its number of corners. The facets are summed per vertex in
+/// face order, as [`vertex_rule`] sums them: the same bits, without the faces-around lists.
+fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) -> (Vec<Vec3>, Vec<u32>) {
+    let n = w.positions.len();
+    let mut mean = vec![Vec3::ZERO; n];
+    let mut count = vec![0u32; n];
+    for (t, f) in w.triangles.iter().zip(facet) {
+        for &v in t {
+            mean[v as usize] += *f;
+            count[v as usize] += 1;
+        }
+    }
+    let Some(cos_half) = cos_half else {
+        mean.fill(Vec3::ZERO);
+        return (mean, count);
+    };
+    for (m, &c) in mean.iter_mut().zip(&count) {
+        *m = if c as usize > MANY { Vec3::ZERO } else { m.normalize_or_zero() };
+    }
+    for (t, u) in w.triangles.iter().zip(unit) {
+        for &v in t {
+            let m = &mut mean[v as usize];
+            // (`!(a >= b)`: a NaN fails the test, as in `vertex_rule`.)
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if *m != Vec3::ZERO && !(u.dot(*m) >= cos_half) {
+                *m = Vec3::ZERO;
+            }
+        }
+    }
+    (mean, count)
 }
 
 /// The faces around each vertex, in face order: `of(v)` is `faces[start[v]..start[v + 1]]`
@@ -576,7 +634,6 @@ fn vertex_rule(
     (cos_crease, cos_half): (f32, Option<f32>),
     work: &mut u64,
 ) -> Rule {
-    const MANY: usize = 32;
     const MANY_GROUPS: usize = 64;
     if fs.len() <= MANY {
         if let Some(cos_half) = cos_half {
@@ -639,6 +696,17 @@ impl CornerVertices {
             next: Vec::with_capacity(welded),
             many: FxHashMap::default(),
         }
+    }
+
+    /// A vertex at `p` with normal `n` and no other attribute that no other corner will look
+    /// up (a plain mesh's vertex of one normal).
+    fn alone(&mut self, p: Vec3, n: Vec3) -> u32 {
+        let i = self.positions.len() as u32;
+        self.positions.push(p);
+        self.normals.push(n);
+        self.keys.push(Default::default());
+        self.next.push(u32::MAX);
+        i
     }
 
     /// The vertex at welded position `v` (at `p`) with normal `n` and the attributes of vertex

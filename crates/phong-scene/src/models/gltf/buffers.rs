@@ -3,18 +3,23 @@
 
 use crate::Error;
 use base64::Engine;
+use std::borrow::Cow;
+
+/// A buffer's bytes: the GLB's binary chunk borrowed from the file, others owned.
+pub(super) type Buffer<'b> = Cow<'b, [u8]>;
 
 /// The file's buffers: the GLB's binary chunk, base64 data URIs, and files read by `resource`;
 /// each at least as long as the file says.
-pub(super) fn load_buffers(
-    file: &::gltf::Gltf,
+pub(super) fn load_buffers<'b>(
+    doc: &::gltf::Document,
+    bin: Option<Cow<'b, [u8]>>,
     resource: &dyn Fn(&str) -> Result<Vec<u8>, String>,
     fail: &dyn Fn(String) -> Error,
-) -> Result<Vec<Vec<u8>>, Error> {
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
-    for b in file.document.buffers() {
-        let data = match b.source() {
-            ::gltf::buffer::Source::Bin => file.blob.clone().ok_or_else(|| {
+) -> Result<Vec<Buffer<'b>>, Error> {
+    let mut buffers: Vec<Buffer> = Vec::new();
+    for b in doc.buffers() {
+        let data: Buffer = match b.source() {
+            ::gltf::buffer::Source::Bin => bin.clone().ok_or_else(|| {
                 fail(format!(
                     "buffer {} is the GLB's binary chunk, which is missing",
                     b.index()
@@ -25,11 +30,16 @@ pub(super) fn load_buffers(
                     let (_, data) = rest
                         .split_once(";base64,")
                         .ok_or_else(|| fail(format!("buffer {}: a data URI that is not base64", b.index())))?;
-                    base64::engine::general_purpose::STANDARD
-                        .decode(data)
-                        .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?
+                    Cow::Owned(
+                        base64::engine::general_purpose::STANDARD
+                            .decode(data)
+                            .map_err(|e| fail(format!("buffer {}: its base64 data: {e}", b.index())))?,
+                    )
                 } else {
-                    resource(&percent_decode(uri)).map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?
+                    Cow::Owned(
+                        resource(&percent_decode(uri))
+                            .map_err(|e| fail(format!("buffer {} ({uri}): {e}", b.index())))?,
+                    )
                 }
             }
         };
@@ -49,7 +59,7 @@ pub(super) fn load_buffers(
 /// Checks an accessor before the reader trusts it: its type, a float component type where
 /// `float`, at least one element, and every element inside its buffer view and buffer.
 /// A primitive's positions read as a slice, where they are packed 32-bit floats.
-pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<[f32; 3]>> {
+pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<[f32; 3]>> {
     let (bytes, kind) = packed(&prim.get(&::gltf::Semantic::Positions)?, buffers)?;
     (kind == ::gltf::accessor::DataType::F32).then(|| {
         bytes
@@ -60,7 +70,7 @@ pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) ->
 }
 
 /// A primitive's indices read as a slice, where they are packed 16- or 32-bit integers.
-pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> Option<Vec<u32>> {
+pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<u32>> {
     let (b, kind) = packed(&prim.indices()?, buffers)?;
     match kind {
         ::gltf::accessor::DataType::U32 => Some(
@@ -82,7 +92,7 @@ pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Vec<u8>]) -> O
 /// as a slice rather than element by element.
 pub(super) fn packed<'b>(
     a: &::gltf::Accessor,
-    buffers: &'b [Vec<u8>],
+    buffers: &'b [Buffer],
 ) -> Option<(&'b [u8], ::gltf::accessor::DataType)> {
     let view = a.view()?;
     let size = a.size();
@@ -100,7 +110,7 @@ pub(super) fn packed<'b>(
 
 pub(super) fn check_accessor(
     a: &::gltf::Accessor,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     dims: &[::gltf::accessor::Dimensions],
     float: bool,
 ) -> Result<(), String> {
@@ -138,7 +148,7 @@ pub(super) fn check_accessor(
     if end > view.length() as u64 {
         return Err(format!("it ends at byte {end} of a {}-byte buffer view", view.length()));
     }
-    let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len()) as u64;
     if view.offset() as u64 + view.length() as u64 > buffer_len {
         return Err(format!(
             "its buffer view ends at byte {} of a {buffer_len}-byte buffer",

@@ -27,7 +27,7 @@ use super::far_origin;
 use crate::Error;
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use base64::Engine;
-use buffers::{check_accessor, load_buffers, packed_indices, packed_positions, percent_decode};
+use buffers::{Buffer, check_accessor, load_buffers, packed_indices, packed_positions, percent_decode};
 use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
 use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
 use std::collections::BTreeSet;
@@ -96,10 +96,20 @@ pub fn read_gltf(
         path: path.to_path_buf(),
         message: format!("glTF: {m}"),
     };
-    check_before_validation(bytes, &fail)?;
-    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))?;
-    let doc = &file.document;
-    let buffers = load_buffers(&file, resource, &fail)?;
+    // One parse of the JSON, checked, then validated; a GLB's binary chunk borrowed, not copied.
+    let gltf_err = |e: ::gltf::Error| fail(e.to_string());
+    let (json, bin) = if bytes.starts_with(b"glTF") {
+        let glb = ::gltf::Glb::from_slice(bytes).map_err(gltf_err)?;
+        (glb.json, glb.bin)
+    } else {
+        (std::borrow::Cow::Borrowed(bytes), None)
+    };
+    let root: ::gltf::json::Root =
+        ::gltf::json::deserialize::from_slice(&json).map_err(|e| gltf_err(::gltf::Error::Deserialize(e)))?;
+    check_before_validation(&root, &fail)?;
+    let document = ::gltf::Document::from_json(root).map_err(gltf_err)?;
+    let doc = &document;
+    let buffers = load_buffers(doc, bin, resource, &fail)?;
     let instances = node_instances(doc, &fail)?;
     let mut model = GltfModel::default();
     let (mut skipped_modes, mut colours) = (0usize, 0usize);
@@ -195,9 +205,8 @@ pub fn read_gltf(
 /// extension phong does not read (the crate refuses it without saying why), and a primitive's
 /// accessor index out of range (gltf-json's validation indexes the POSITION accessor
 /// unchecked: found by the `gltf` fuzz target).
-fn check_before_validation(bytes: &[u8], fail: &dyn Fn(String) -> Error) -> Result<(), Error> {
-    let unchecked = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
-    for ext in unchecked.document.extensions_required() {
+fn check_before_validation(json: &::gltf::json::Root, fail: &dyn Fn(String) -> Error) -> Result<(), Error> {
+    for ext in json.extensions_required.iter().map(String::as_str) {
         if !SUPPORTED.contains(&ext) {
             return Err(fail(format!(
                 "the file requires the extension {ext}, which phong does not read{}",
@@ -209,7 +218,6 @@ fn check_before_validation(bytes: &[u8], fail: &dyn Fn(String) -> Error) -> Resu
             )));
         }
     }
-    let json = unchecked.document.as_json();
     for (m, mesh) in json.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             let refs = prim.attributes.values().chain(prim.indices.as_ref());
@@ -262,7 +270,7 @@ fn file_light(node: &::gltf::Node, world: &DMat4) -> Option<FileLight> {
 /// buffers), so that the crate's reader cannot fail or panic on them; whether it has normals.
 fn check_primitive(
     prim: &::gltf::Primitive,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     what: &str,
     fail: &dyn Fn(String) -> Error,
 ) -> Result<bool, Error> {
@@ -320,7 +328,7 @@ struct Geometry {
 /// unrolled, wound back where `world` mirrors), normals and tangents, placed by `world`.
 fn geometry(
     prim: &::gltf::Primitive,
-    buffers: &[Vec<u8>],
+    buffers: &[Buffer],
     world: &DMat4,
     has_normal_accessor: bool,
     what: &str,
@@ -328,7 +336,7 @@ fn geometry(
 ) -> Result<Geometry, Error> {
     let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
     let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|b| &b[..]));
     let positions = packed_positions(prim, buffers)
         .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
         .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
@@ -448,14 +456,14 @@ impl Textures<'_> {
         &mut self,
         prim: &::gltf::Primitive,
         n: usize,
-        buffers: &[Vec<u8>],
+        buffers: &[Buffer],
         what: &str,
         material: &mut Option<Material>,
         warnings: &mut Vec<String>,
     ) -> (Maps, Vec<Vec2>, Vec<Vec2>) {
         let path = self.path;
         let mat = &prim.material();
-        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|b| &b[..]));
         // The mesh's first set is the normal texture's (its tangents are made from it), else
         // the base colour's (else the first used); its second, the other of TEXCOORD_0 and
         // TEXCOORD_1 used, if any. A third set is not read.
@@ -743,7 +751,7 @@ fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
 
 /// A glTF texture as a map request: its image (a buffer view's bytes, a data URI, or a file
 /// read by the loader's reader), sampler and KHR_texture_transform, in OpenGL's coordinates.
-fn texture_request(tex: &Tex, buffers: &[Vec<u8>], what: &str) -> Option<MapRequest> {
+fn texture_request(tex: &Tex, buffers: &[Buffer], what: &str) -> Option<MapRequest> {
     let (slot, texture) = (tex.slot, tex.texture.clone());
     let name = format!("image {}", texture.source().index());
     let source = match texture.source().source() {
