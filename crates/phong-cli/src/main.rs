@@ -1,6 +1,12 @@
 //! `phong`: the command line. Glue only: arguments resolved once (`args`), then each
 //! command in its own module; this file maps errors to exit codes.
 
+/// mimalloc keeps freed memory for the next allocation instead of returning it to the
+/// system: a model's load and its first frame allocate and free large arrays in turn, and
+/// every fresh page costs a fault (BENCHMARKS.md, "Loading against trimesh").
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod args;
 mod batch;
 mod bench;
