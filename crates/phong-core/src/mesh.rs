@@ -478,7 +478,15 @@ impl Mesh {
             let cosines = (cos_crease, cos_half);
             for v in rest {
                 slot[v] = rules.len() as u32;
-                rules.push(vertex_rule(around.of(v), v as u32, &w.triangles, &facet, &unit, cosines, &mut work));
+                rules.push(vertex_rule(
+                    around.of(v),
+                    v as u32,
+                    &w.triangles,
+                    &facet,
+                    &unit,
+                    cosines,
+                    &mut work,
+                ));
             }
         }
         let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
@@ -570,7 +578,11 @@ fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) 
         return (mean, count);
     };
     for (m, &c) in mean.iter_mut().zip(&count) {
-        *m = if c as usize > MANY { Vec3::ZERO } else { m.normalize_or_zero() };
+        *m = if c as usize > MANY {
+            Vec3::ZERO
+        } else {
+            m.normalize_or_zero()
+        };
     }
     for (t, u) in w.triangles.iter().zip(unit) {
         for &v in t {

@@ -132,7 +132,7 @@ pub fn scene_of_model(path: &Path, model: &ModelFile, options: &ModelOptions) ->
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (json, notes) = model_scene(&name, model, options);
+    let (json, notes) = crate::timing::timed(|t| &mut t.framing, || model_scene(&name, model, options));
     let parts = &model.parts;
     let lookup = |_: &str| Ok(parts.clone());
     let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {

@@ -13,6 +13,8 @@ pub struct LoadTimes {
     pub parse: Duration,
     /// Computing vertex normals (smooth, flat or by crease angle).
     pub normals: Duration,
+    /// Framing a model alone: its closedness, up axis, front and camera.
+    pub framing: Duration,
 }
 
 thread_local! {

@@ -261,6 +261,11 @@ trait Rows {
     fn scalar(&mut self, t: Scalar) -> Result<f64, String>;
     /// Where the reader is, for a message ("line 12" in an ASCII file).
     fn place(&self) -> String;
+    /// A binary body's bytes, the reader's offset in them and whether they are big-endian,
+    /// for elements read whole; `None` for ASCII.
+    fn raw(&mut self) -> Option<(&[u8], &mut usize, bool)> {
+        None
+    }
 }
 
 struct Binary<'a> {
@@ -279,6 +284,9 @@ impl Rows for Binary<'_> {
     }
     fn place(&self) -> String {
         format!("byte {}", self.at)
+    }
+    fn raw(&mut self) -> Option<(&[u8], &mut usize, bool)> {
+        Some((self.bytes, &mut self.at, self.big))
     }
 }
 
@@ -396,6 +404,9 @@ fn read_vertices<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> Result<
         return Err((0, "vertex 0 has no x, y and z".into()));
     }
     body.points.reserve_exact(n);
+    if !want_n && !want_c && binary_positions(e, &s, rows, body) {
+        return Ok(());
+    }
     let mut normals = Vec::with_capacity(if want_n { n } else { 0 });
     let mut colors = Vec::with_capacity(if want_c { n } else { 0 });
     let mut all_colored = want_c;
@@ -440,6 +451,9 @@ fn read_faces<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> Result<(),
     body.starts.reserve_exact(e.count as usize + 1);
     body.indices.reserve(3 * e.count as usize);
     body.starts.push(body.indices.len());
+    if e.props.len() == 1 && binary_lists(e, rows, body) {
+        return Ok(());
+    }
     let indices = &mut body.indices;
     for row in 0..e.count {
         for (k, p) in e.props.iter().enumerate() {
@@ -452,6 +466,90 @@ fn read_faces<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> Result<(),
         body.starts.push(indices.len());
     }
     Ok(())
+}
+
+/// A binary body's vertices of scalar properties read whole, their positions only, in rows of
+/// fixed size; false (nothing read) where they are not such rows or the file ends inside them
+/// (the general reader then says where).
+fn binary_positions<R: Rows>(e: &Element, s: &VertexSlots, rows: &mut R, body: &mut Body) -> bool {
+    let Some((bytes, at, big)) = rows.raw() else {
+        return false;
+    };
+    let Some(types) = e
+        .props
+        .iter()
+        .map(|p| match p.kind {
+            Kind::Scalar(t) => Some(t),
+            Kind::List(..) => None,
+        })
+        .collect::<Option<Vec<Scalar>>>()
+    else {
+        return false;
+    };
+    let mut offsets = Vec::with_capacity(types.len());
+    let mut stride = 0;
+    for t in &types {
+        offsets.push(stride);
+        stride += t.size();
+    }
+    let Some(need) = usize::try_from(e.count).ok().and_then(|n| n.checked_mul(stride)) else {
+        return false;
+    };
+    let [Some(x), Some(y), Some(z)] = s.p else {
+        return e.count == 0;
+    };
+    if stride == 0 || bytes.len() - *at < need {
+        return false;
+    }
+    let [(ox, tx), (oy, ty), (oz, tz)] = [x, y, z].map(|i| (offsets[i], types[i]));
+    for row in bytes[*at..*at + need].chunks_exact(stride) {
+        body.points.push(DVec3::new(
+            tx.get(&row[ox..], big),
+            ty.get(&row[oy..], big),
+            tz.get(&row[oz..], big),
+        ));
+    }
+    *at += need;
+    true
+}
+
+/// A binary body's faces that are one list each, read whole; false (nothing kept) where the
+/// file ends inside them or a list's count is out of range (the general reader then says
+/// where).
+fn binary_lists<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> bool {
+    let Kind::List(c, t) = e.props[0].kind else {
+        return false;
+    };
+    let Some((bytes, at, big)) = rows.raw() else {
+        return false;
+    };
+    let (indices, starts) = (body.indices.len(), body.starts.len());
+    let (cs, ts) = (c.size(), t.size());
+    let mut p = *at;
+    for _ in 0..e.count {
+        let Some(k) = bytes
+            .get(p..p + cs)
+            .map(|b| c.get(b, big))
+            .filter(|k| (0.0..=1e9).contains(k))
+        else {
+            break;
+        };
+        let end = p + cs + k as usize * ts;
+        let Some(items) = bytes.get(p + cs..end) else {
+            break;
+        };
+        body.indices
+            .extend(items.chunks_exact(ts).map(|i| t.get(i, big) as i64));
+        body.starts.push(body.indices.len());
+        p = end;
+    }
+    if body.starts.len() - starts == e.count as usize {
+        *at = p;
+        return true;
+    }
+    body.indices.truncate(indices);
+    body.starts.truncate(starts);
+    false
 }
 
 /// A PLY file's `vertex` and `face` elements as one part (polygons triangulated; other
