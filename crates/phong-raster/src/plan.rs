@@ -5,7 +5,7 @@
 
 use crate::fixed::pattern;
 use crate::setup::{Extra, Keep, SampleSpan};
-use crate::simd::{Batch, Isa, Prepared, Term, VectorMaps};
+use crate::simd::{Batch, Isa, Lean, Prepared, Term, VectorMaps};
 use crate::target::resolve;
 use glam::Mat4;
 use phong_core::limits::TILE_SIZE;
@@ -22,8 +22,10 @@ pub(crate) enum Path {
 
 /// How the fast path shades an object's pixels.
 pub(crate) enum Mode {
-    /// Interpolated position and normal, the vector kernel; the term shown.
-    Phong(Prepared, Term),
+    /// Interpolated position and normal, the vector kernel; the term shown, and the lean
+    /// kernel's data where that kernel shades the object (its colour, the common lights and
+    /// models: `simd/lean.rs`).
+    Phong(Prepared, Term, Option<Lean>),
     /// Interpolated vertex colours (flat: the triangle's colour).
     Gouraud,
     /// A textured object's colour, Phong-interpolated: light and maps by the vector sampler
@@ -42,7 +44,8 @@ impl Mode {
     /// The vector kernels' batch for this mode; `None` for scalar shading.
     pub fn batch(&self) -> Option<Batch<'_>> {
         match self {
-            Mode::Phong(prep, term) => Some(Batch::Phong(prep, *term)),
+            Mode::Phong(prep, _, Some(lean)) => Some(Batch::Lean(prep, lean)),
+            Mode::Phong(prep, term, None) => Some(Batch::Phong(prep, *term)),
             Mode::Gouraud => Some(Batch::Gouraud),
             Mode::Textured { .. } | Mode::Scalar => None,
         }
@@ -187,7 +190,11 @@ fn mode(
     let prepared = || Prepared::new(lighting, &object.material, &object.shading.options, view);
     if !object.textured() {
         return match object.shading.interpolation {
-            Interpolation::Phong => Mode::Phong(prepared(), term),
+            Interpolation::Phong => {
+                let prep = prepared();
+                let lean = if term == Term::Color { Lean::of(&prep) } else { None };
+                Mode::Phong(prep, term, lean)
+            }
             // Flat: the triangle's colour, planes without slope.
             Interpolation::Gouraud | Interpolation::Flat => Mode::Gouraud,
         };
@@ -394,10 +401,12 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
         assert!(matches!(frame.objects[6].mode, Mode::Scalar));
     }
 
-    /// One line of an object's plan, for the table below: mode, whether the vector sampler
+    /// One line of an object's plan, for the table below: mode (`phong-lean`: the lean colour
+    /// kernel), whether the vector sampler
     /// reads its maps, visibility, what its coordinates' planes carry, and its setup.
     fn row(plan: &ObjectPlan) -> String {
         let mode = match plan.mode {
+            Mode::Phong(_, _, Some(_)) => "phong-lean",
             Mode::Phong(..) => "phong",
             Mode::Gouraud => "gouraud",
             Mode::Textured { per_vertex: false, .. } => "textured",
@@ -463,11 +472,32 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
                 roughness: 0.5,
             });
         };
+        let normalised: Change = |o| o.shading.options.normalization = phong_core::Normalization::BlinnPhong;
+        let lyon: Change = |o| {
+            o.shading.options.specular = phong_core::SpecularModel::Lyon {
+                squarings: 3,
+                lambda: phong_core::LyonLambda::Dot,
+            }
+        };
         let diffuse = r#"material = { base = "brass", diffuse_map = "assets/bricks.png" }"#;
         let bump = r#"material = { base = "brass", diffuse_map = "assets/bricks.png", bump_map = "assets/bricks_height.png" }"#;
         let emission = r#"material = { base = "brass", emission_map = "assets/checker.png" }"#;
         let rows: &[(&str, &str, Change, Path, &str)] = &[
-            ("plain, per pixel", "", none, Path::Fast, "phong - opaque - fast"),
+            ("plain, per pixel", "", none, Path::Fast, "phong-lean - opaque - fast"),
+            (
+                "energy-normalised (the general kernel)",
+                "",
+                normalised,
+                Path::Fast,
+                "phong - opaque - fast",
+            ),
+            (
+                "Lyon's model (the general kernel)",
+                "",
+                lyon,
+                Path::Fast,
+                "phong - opaque - fast",
+            ),
             (
                 "plain, diffuse term",
                 r#"output = "diffuse""#,
@@ -515,7 +545,7 @@ material = { base = "brass", diffuse_map = "assets/bricks.png" }
                 "",
                 none,
                 Path::Reference,
-                "phong - opaque - full(corners)",
+                "phong-lean - opaque - full(corners)",
             ),
             (
                 "blended",

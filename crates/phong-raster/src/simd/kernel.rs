@@ -28,14 +28,14 @@ pub(super) const MAX_LANES: usize = 16;
 /// Three lanes of vectors.
 #[derive(Clone, Copy)]
 pub(super) struct V3<V> {
-    x: V,
-    y: V,
-    z: V,
+    pub(super) x: V,
+    pub(super) y: V,
+    pub(super) z: V,
 }
 
 impl<V: Vf32> V3<V> {
     #[inline(always)]
-    fn splat(v: Vec3) -> Self {
+    pub(super) fn splat(v: Vec3) -> Self {
         V3 {
             x: V::splat(v.x),
             y: V::splat(v.y),
@@ -43,7 +43,7 @@ impl<V: Vf32> V3<V> {
         }
     }
     #[inline(always)]
-    fn sub(self, o: Self) -> Self {
+    pub(super) fn sub(self, o: Self) -> Self {
         V3 {
             x: self.x.sub(o.x),
             y: self.y.sub(o.y),
@@ -51,7 +51,7 @@ impl<V: Vf32> V3<V> {
         }
     }
     #[inline(always)]
-    fn add(self, o: Self) -> Self {
+    pub(super) fn add(self, o: Self) -> Self {
         V3 {
             x: self.x.add(o.x),
             y: self.y.add(o.y),
@@ -59,7 +59,7 @@ impl<V: Vf32> V3<V> {
         }
     }
     #[inline(always)]
-    fn scale(self, k: V) -> Self {
+    pub(super) fn scale(self, k: V) -> Self {
         V3 {
             x: self.x.mul(k),
             y: self.y.mul(k),
@@ -67,11 +67,11 @@ impl<V: Vf32> V3<V> {
         }
     }
     #[inline(always)]
-    fn dot(self, o: Self) -> V {
+    pub(super) fn dot(self, o: Self) -> V {
         self.z.mul_add(o.z, self.x.mul_add(o.x, self.y.mul(o.y)))
     }
     #[inline(always)]
-    fn select(m: V::M, a: Self, b: Self) -> Self {
+    pub(super) fn select(m: V::M, a: Self, b: Self) -> Self {
         V3 {
             x: V::select(m, a.x, b.x),
             y: V::select(m, a.y, b.y),
@@ -88,7 +88,7 @@ impl<V: Vf32> V3<V> {
     }
     /// glam's `normalize_or_zero`: `v · (1/|v|)` when that reciprocal is finite and > 0.
     #[inline(always)]
-    fn normalize_or_zero(self) -> (Self, V::M) {
+    pub(super) fn normalize_or_zero(self) -> (Self, V::M) {
         let rcp = self.dot(self).rsqrt();
         let ok = V::and(rcp.finite(), rcp.gt(V::splat(0.0)));
         let zero = V::splat(0.0);
@@ -160,7 +160,7 @@ fn exp2<V: Vf32>(y: V) -> V {
 /// `(x⁺)^s` with `0^s = 0` (as `phong_core::pow_positive`), `x` clamped to 1, by `2^(s·log2 x)`
 /// (`s = 0` gives `2^0 = 1` for `x > 0`).
 #[inline(always)]
-fn pow_positive<V: Vf32>(x: V, s: f32) -> V {
+pub(super) fn pow_positive<V: Vf32>(x: V, s: f32) -> V {
     let xc = x.max(V::splat(f32::MIN_POSITIVE)).min(V::splat(1.0));
     let r = exp2(V::splat(s).mul(log2(xc)));
     V::select(x.gt(V::splat(0.0)), r, V::splat(0.0))
@@ -206,7 +206,7 @@ fn pow_falloff<V: Vf32>(x: V, s: f32) -> V {
 }
 
 #[derive(Clone, Copy)]
-enum Kind {
+pub(super) enum Kind {
     Directional {
         to_light: Vec3,
     },
@@ -218,26 +218,26 @@ enum Kind {
 }
 
 #[derive(Clone, Copy)]
-struct PreparedLight {
-    kind: Kind,
+pub(super) struct PreparedLight {
+    pub(super) kind: Kind,
     /// `a_m ⊗ a_l`, `d_m ⊗ d_l`, `s_m ⊗ s_l`.
-    amb: Color,
-    dif: Color,
-    spe: Color,
+    pub(super) amb: Color,
+    pub(super) dif: Color,
+    pub(super) spe: Color,
 }
 
 /// What `shade8` needs of one object, computed once per render.
 pub struct Prepared {
-    view: View,
+    pub(super) view: View,
     pub(super) options: ShadingOptions,
     /// The material's shininess.
     pub(super) shininess: f32,
     kd: f32,
     ks: f32,
-    base: Color,
+    pub(super) base: Color,
     /// The emission where it is kept apart from `base` ([`Prepared::emission_apart`]), else 0.
     pub(super) emission: Color,
-    lights: Vec<PreparedLight>,
+    pub(super) lights: Vec<PreparedLight>,
 }
 
 impl Prepared {
@@ -358,7 +358,7 @@ fn acc<V: Vf32>(c: &mut [V; 3], k: Color, f: V, m: V::M) {
 /// NaN → 0, overflow → ±f32::MAX, as `shade` (a function, not a closure: a closure is not
 /// always inlined into the AVX2 kernels, and its intrinsics then become calls).
 #[inline(always)]
-fn fin<V: Vf32>(x: V) -> V {
+pub(super) fn fin<V: Vf32>(x: V) -> V {
     V::select(
         x.nan(),
         V::splat(0.0),
@@ -525,6 +525,23 @@ pub(crate) fn shade_points<V: Vf32<A = [f32; LANES]>>(
     }
 }
 
+/// The lean kernel's colour (`lean.rs`) on arrays of positions and normals.
+#[inline(always)]
+pub(crate) fn lean_points<V: Vf32<A = [f32; LANES]>>(
+    p: &Prepared,
+    lean: &super::Lean,
+    position: &[Vec3; LANES],
+    normal: &[Vec3; LANES],
+) -> [[f32; LANES]; 3] {
+    let col = |a: &[Vec3; LANES], f: fn(Vec3) -> f32| V::from_array(std::array::from_fn(|i| f(a[i])));
+    let v3 = |a: &[Vec3; LANES]| V3 {
+        x: col(a, |v| v.x),
+        y: col(a, |v| v.y),
+        z: col(a, |v| v.z),
+    };
+    super::lean::shade_color_lean(p, lean, v3(position), v3(normal)).map(V::to_array)
+}
+
 /// Lights vertices for Gouraud, [`V::N`](Vf32::N) at a time: `out[i]` becomes `term` of the
 /// shading at `positions[i]` with normal `normals[i]` (negated with `flip`). The same
 /// arithmetic per lane as [`shade_points`], only the term asked for kept.
@@ -647,6 +664,8 @@ impl Planes {
 pub enum Batch<'a> {
     /// Interpolated position and normal, shaded by the kernel; the given term.
     Phong(&'a Prepared, Term),
+    /// Interpolated position and normal, the colour term by the lean kernel (`lean.rs`).
+    Lean(&'a Prepared, &'a super::Lean),
     /// Interpolated colour (Gouraud).
     Gouraud,
 }
@@ -671,6 +690,10 @@ fn batch_color<V: Vf32>(batch: Batch, q: [V; 6]) -> [V; 3] {
             let (pos, nrm) = position_normal(q);
             shade(prep, pos, nrm).get(term)
         }
+        Batch::Lean(prep, lean) => {
+            let (pos, nrm) = position_normal(q);
+            super::lean::shade_color_lean(prep, lean, pos, nrm)
+        }
         Batch::Gouraud => [q[0], q[1], q[2]],
     }
 }
@@ -685,7 +708,7 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     mut out: impl FnMut(usize, [f32; 3]),
 ) {
     let attrs = match batch {
-        Batch::Phong(..) => 6,
+        Batch::Phong(..) | Batch::Lean(..) => 6,
         Batch::Gouraud => 3,
     };
     let mut start = 0;
@@ -783,7 +806,7 @@ pub(crate) fn shade_group<V: Vf32>(
         return 0;
     }
     let attrs = match batch {
-        Batch::Phong(..) => 6,
+        Batch::Phong(..) | Batch::Lean(..) => 6,
         Batch::Gouraud => 3,
     };
     let planes = Broadcast::<V>::new(planes, attrs);

@@ -14,6 +14,7 @@
 
 mod filter;
 pub mod kernel;
+mod lean;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
 mod project;
 mod sampler;
@@ -23,6 +24,7 @@ mod vector;
 use crate::Kernels;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
+pub use lean::Lean;
 pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
@@ -123,6 +125,30 @@ pub fn shade8(isa: Isa, p: &Prepared, position: &[Vec3; LANES], normal: &[Vec3; 
     }
     let _ = isa;
     kernel::shade8(p, position, normal)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn shade8_lean_avx2(p: &Prepared, lean: &Lean, position: &[Vec3; LANES], normal: &[Vec3; LANES]) -> [[f32; LANES]; 3] {
+    kernel::lean_points::<vector::Avx2>(p, lean, position, normal)
+}
+
+/// The lean kernel's colour (`lean.rs`) on 8 points, by `isa`'s build; `None` where it does
+/// not shade `p`'s objects.
+pub fn shade8_lean(
+    isa: Isa,
+    p: &Prepared,
+    position: &[Vec3; LANES],
+    normal: &[Vec3; LANES],
+) -> Option<[[f32; LANES]; 3]> {
+    let lean = Lean::of(p)?;
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
+        return Some(unsafe { shade8_lean_avx2(p, &lean, position, normal) });
+    }
+    let _ = isa;
+    Some(kernel::lean_points::<vector::Portable>(p, &lean, position, normal))
 }
 
 #[cfg(target_arch = "x86_64")]
