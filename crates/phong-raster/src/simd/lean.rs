@@ -98,7 +98,7 @@ pub(super) fn shade_color_lean<V: Vf32>(p: &Prepared, lean: &Lean, pos: V3<V>, n
     let n_spec = V3::select(v_ok, n, none);
     let mut col = [V::splat(p.base.r), V::splat(p.base.g), V::splat(p.base.b)];
     // (Functions and loops, no closures: a closure is not always inlined into the AVX2
-    // builds, and its intrinsics then become calls.)
+    // builds, and its intrinsics then become calls: BENCHMARKS.md, C11.)
     for (light, &threshold) in p.lights.iter().zip(&lean.thresholds) {
         let (l, factor) = match light.kind {
             Kind::Directional { to_light } => (V3::splat(to_light), V::splat(1.0)),
