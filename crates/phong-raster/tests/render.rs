@@ -568,7 +568,14 @@ fn interpolation_modes_against_core() {
                     Vec3::from(r.color.to_array())
                 };
                 let label = format!("{model:?} {interp:?}");
-                check_interior(&img, n, (a, b, c), 2e-5, &label, |l, p| match interp {
+                // The fast paths' lean kernel may drop a highlight below 0.05/255 a light
+                // (simd/lean.rs); the reference path and the general kernel stay within 2e-5.
+                let tol = if path.name == "reference" {
+                    2e-5
+                } else {
+                    2e-5 + 2.0 * 0.05 / 255.0
+                };
+                check_interior(&img, n, (a, b, c), tol, &label, |l, p| match interp {
                     Interpolation::Flat => sh((a + b + c) / 3.0, (b - a).cross(c - a).normalize()),
                     Interpolation::Gouraud => sh(a, na) * l[0] + sh(b, nb) * l[1] + sh(c, nc) * l[2],
                     Interpolation::Phong => sh(p, na * l[0] + nb * l[1] + nc * l[2]),

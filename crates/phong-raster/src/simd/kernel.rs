@@ -799,7 +799,7 @@ pub(crate) fn shade_group<V: Vf32>(
     planes: &Planes,
     (x0, y0): (u32, u32),
     pixels: &[u32],
-    mut out: impl FnMut(u32, [f32; 3]),
+    mut out: impl FnMut(u32, [&[f32]; 3]),
 ) -> usize {
     let full = pixels.len() / V::N * V::N;
     if full == 0 {
@@ -810,12 +810,32 @@ pub(crate) fn shade_group<V: Vf32>(
         Batch::Gouraud => 3,
     };
     let planes = Broadcast::<V>::new(planes, attrs);
+    let mut lanes = V::A::default();
+    for (i, l) in lanes.as_mut().iter_mut().enumerate() {
+        *l = i as f32;
+    }
+    let lanes = V::from_array(lanes);
     for chunk in pixels[..full].chunks_exact(V::N) {
-        let (x, y) = centres::<V>((x0, y0), chunk);
+        // A run of a row (the common case inside a triangle): its centres from the first,
+        // its colours given to `out` at once.
+        // (`pixels` ascend: N of them spanning N columns are consecutive.)
+        debug_assert!(chunk.windows(2).all(|w| w[0] < w[1]));
+        let run = chunk[V::N - 1].wrapping_sub(chunk[0]) == (V::N - 1) as u32;
+        let (x, y) = if run {
+            let (x, y) = pixel_centre((x0, y0), chunk[0]);
+            (V::splat(x).add(lanes), V::splat(y))
+        } else {
+            centres::<V>((x0, y0), chunk)
+        };
         let (q, _) = planes.at(x, y, attrs);
         let rgb = batch_color(batch, q).map(V::to_array);
-        for (i, &p) in chunk.iter().enumerate() {
-            out(p, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
+        let [r, g, b] = [rgb[0].as_ref(), rgb[1].as_ref(), rgb[2].as_ref()];
+        if run {
+            out(chunk[0], [r, g, b]);
+        } else {
+            for (i, &p) in chunk.iter().enumerate() {
+                out(p, [&r[i..=i], &g[i..=i], &b[i..=i]]);
+            }
         }
     }
     full

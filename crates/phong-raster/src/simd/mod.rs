@@ -413,15 +413,16 @@ avx2_and_wide! {
         planes: &Planes,
         origin: (u32, u32),
         pixels: &[u32],
-        out: impl FnMut(u32, [f32; 3]),
+        out: impl FnMut(u32, [&[f32]; 3]),
     ) -> usize {
         kernel::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
     }
 }
 
 /// Interpolates and shades the pixels of one triangle (its [`Planes`] broadcast to all lanes):
-/// `pixels` are `row << 16 | column` from `origin`, `out(pixel, rgb)` takes each colour. Whole
-/// vectors only: returns how many of `pixels` (from the start) were shaded.
+/// `pixels` are `row << 16 | column` from `origin`; `out(pixel, [r, g, b])` takes the colours
+/// of that pixel and of the ones after it on its row (a vector's run), or of that pixel
+/// alone. Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline]
 pub fn shade_group(
     isa: Isa,
@@ -429,7 +430,7 @@ pub fn shade_group(
     planes: &Planes,
     origin: (u32, u32),
     pixels: &[u32],
-    out: impl FnMut(u32, [f32; 3]),
+    out: impl FnMut(u32, [&[f32]; 3]),
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {

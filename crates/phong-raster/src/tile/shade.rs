@@ -191,9 +191,12 @@ impl Tiles<'_> {
                     self.binned.planes(id),
                     (x0, y0),
                     pixels,
-                    |p, rgb| {
+                    |p, [red, green, blue]| {
                         let (r, c) = at(p);
-                        out[r][c] = [rgb[0], rgb[1], rgb[2], 1.0];
+                        let run = &mut out[r][c..c + red.len()];
+                        for (((o, &r), &g), &b) in run.iter_mut().zip(red).zip(green).zip(blue) {
+                            *o = [r, g, b, 1.0];
+                        }
                     },
                 )
             };
