@@ -52,7 +52,9 @@ pub use stats::RenderStats;
 #[doc(hidden)]
 pub mod internals {
     pub use crate::clip::{ClipVertex, Clipped, clip_triangle};
-    pub use crate::simd::{Isa, LANES, Prepared, Shaded8, Term, avx2_available, light_vertices, shade8, shade8_lean};
+    pub use crate::simd::{
+        Isa, LANES, Lean, Prepared, Shaded8, Term, avx2_available, light_vertices, shade8, shade8_lean,
+    };
 }
 
 use phong_core::{Encoding, Image, Image8, Scene};

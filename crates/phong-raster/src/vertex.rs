@@ -3,7 +3,7 @@
 
 use crate::clip::{NOT_FINITE, OUTSIDE_CLIP, outcode};
 use crate::fixed::{ONE, round_i64};
-use crate::simd::{Isa, Prepared, Term, light_vertices, light_vertices_lit, project_vertices};
+use crate::simd::{Isa, Lean, Prepared, Term, light_vertices, light_vertices_lit, project_vertices};
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -80,6 +80,9 @@ pub(crate) struct VertexLighting {
     pub two_sided: bool,
     /// Textured: the primary and specular colours apart.
     pub textured: bool,
+    /// The lean kernel's data where it lights the vertices (the colour term of the objects it
+    /// covers: `simd/lean.rs`).
+    pub lean: Option<Lean>,
 }
 
 /// A numbered piece of the front colours, with the same piece of the back, front specular and
@@ -99,6 +102,24 @@ fn pieces(colors: &mut [Vec<Vec3>; 4]) -> Vec<Piece<'_>> {
 }
 
 impl VertexLighting {
+    /// The lighting of an object's vertices: `term` of `prepared`, the lean kernel where it
+    /// covers them.
+    pub fn new(isa: Isa, prepared: Prepared, term: Term, two_sided: bool, textured: bool) -> VertexLighting {
+        let lean = if !textured && term == Term::Color {
+            Lean::of(&prepared)
+        } else {
+            None
+        };
+        VertexLighting {
+            isa,
+            prepared,
+            term,
+            two_sided,
+            textured,
+            lean,
+        }
+    }
+
     /// The colours of vertices `ps` with normals `ns`: `out[0]` from the front, `out[1]` from
     /// the back (two-sided only); textured, those are the primary colours and `out[2]`,
     /// `out[3]` the specular ones (else not written).
@@ -110,7 +131,16 @@ impl VertexLighting {
             if self.textured {
                 light_vertices_lit(self.isa, &self.prepared, ps, ns, side == 1, [o, spec]);
             } else {
-                light_vertices(self.isa, &self.prepared, self.term, ps, ns, side == 1, o);
+                light_vertices(
+                    self.isa,
+                    &self.prepared,
+                    self.term,
+                    self.lean.as_ref(),
+                    ps,
+                    ns,
+                    side == 1,
+                    o,
+                );
             }
         }
     }

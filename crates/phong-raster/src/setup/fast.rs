@@ -50,12 +50,14 @@ impl Stage<'_> {
         let tangent_of = |i: u32| tangents.get(i as usize).copied().unwrap_or(Vec4::ZERO);
         let extra = plan.extra;
         let extra_of = |i: u32| extra.of(rgb_of(i), uv1_of(i), tangent_of(i));
-        let lighting = gouraud.then(|| VertexLighting {
-            isa,
-            prepared: Prepared::new(&self.scene.lighting, &obj.material, &obj.shading.options, plan.view),
-            term: lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
-            two_sided,
-            textured,
+        let lighting = gouraud.then(|| {
+            VertexLighting::new(
+                isa,
+                Prepared::new(&self.scene.lighting, &obj.material, &obj.shading.options, plan.view),
+                lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
+                two_sided,
+                textured,
+            )
         });
         if gouraud {
             unmark(&mut scratch.used, positions.len());

@@ -43,13 +43,13 @@ impl Stage<'_> {
             .then(|| lit_term(obj.shading.output))
             .flatten()
             .map(|term| {
-                let lighting = VertexLighting {
-                    isa: self.plan.isa,
-                    prepared: Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view),
+                let lighting = VertexLighting::new(
+                    self.plan.isa,
+                    Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view),
                     term,
                     two_sided,
-                    textured: obj.textured(),
-                };
+                    obj.textured(),
+                );
                 let p = mesh.positions();
                 let (centroids, normals): (Vec<Vec3>, Vec<Vec3>) = mesh
                     .triangles()

@@ -549,6 +549,7 @@ pub(crate) fn lean_points<V: Vf32<A = [f32; LANES]>>(
 pub(crate) fn light_vertices<V: Vf32>(
     p: &Prepared,
     term: Term,
+    lean: Option<&super::Lean>,
     positions: &[Vec3],
     normals: &[Vec3],
     flip: bool,
@@ -560,7 +561,11 @@ pub(crate) fn light_vertices<V: Vf32>(
         .zip(out.chunks_mut(V::N))
     {
         let (pos, nrm) = vertex_lanes::<V>(ps, ns, flip);
-        store_lanes(shade(p, pos, nrm).get(term), os);
+        let colour = match lean {
+            Some(lean) => super::lean::shade_color_lean(p, lean, pos, nrm),
+            None => shade(p, pos, nrm).get(term),
+        };
+        store_lanes(colour, os);
     }
 }
 
