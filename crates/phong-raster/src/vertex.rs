@@ -5,6 +5,7 @@ use crate::clip::{NOT_FINITE, OUTSIDE_CLIP, outcode};
 use crate::fixed::{ONE, round_i64};
 use crate::simd::{Isa, Lean, Prepared, Term, light_vertices, light_vertices_lit, project_vertices};
 use glam::{Mat4, Vec3, Vec4};
+use phong_core::{Lighting, Object, View};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -102,9 +103,18 @@ fn pieces(colors: &mut [Vec<Vec3>; 4]) -> Vec<Piece<'_>> {
 }
 
 impl VertexLighting {
-    /// The lighting of an object's vertices: `term` of `prepared`, the lean kernel where it
-    /// covers them.
-    pub fn new(isa: Isa, prepared: Prepared, term: Term, two_sided: bool, textured: bool) -> VertexLighting {
+    /// The lighting of `obj`'s vertices under `lighting` seen from `view`: `term`, by the lean
+    /// kernel where it covers them.
+    pub fn new(
+        isa: Isa,
+        lighting: &Lighting,
+        obj: &Object,
+        view: View,
+        term: Term,
+        two_sided: bool,
+        textured: bool,
+    ) -> VertexLighting {
+        let prepared = Prepared::new(lighting, &obj.material, &obj.shading.options, view);
         let lean = if !textured && term == Term::Color {
             Lean::of(&prepared)
         } else {

@@ -12,7 +12,7 @@ use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
 use crate::plan::{Mode, lit_term};
-use crate::simd::{Planes, Prepared};
+use crate::simd::Planes;
 use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -51,13 +51,8 @@ impl Stage<'_> {
         let extra = plan.extra;
         let extra_of = |i: u32| extra.of(rgb_of(i), uv1_of(i), tangent_of(i));
         let lighting = gouraud.then(|| {
-            VertexLighting::new(
-                isa,
-                Prepared::new(&self.scene.lighting, &obj.material, &obj.shading.options, plan.view),
-                lit_term(obj.shading.output).expect("Gouraud mode is a lit output"),
-                two_sided,
-                textured,
-            )
+            let term = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
+            VertexLighting::new(isa, &self.scene.lighting, obj, plan.view, term, two_sided, textured)
         });
         if gouraud {
             unmark(&mut scratch.used, positions.len());

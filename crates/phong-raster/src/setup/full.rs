@@ -10,7 +10,6 @@ use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::plan::lit_term;
 use crate::simd::Planes;
-use crate::simd::Prepared;
 use crate::vertex::{Projected, VertexLighting};
 use glam::{Vec3, Vec4};
 use phong_core::mesh::facet_normal;
@@ -45,7 +44,9 @@ impl Stage<'_> {
             .map(|term| {
                 let lighting = VertexLighting::new(
                     self.plan.isa,
-                    Prepared::new(&scene.lighting, &obj.material, &obj.shading.options, view),
+                    &scene.lighting,
+                    obj,
+                    view,
                     term,
                     two_sided,
                     obj.textured(),
