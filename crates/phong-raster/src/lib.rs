@@ -53,7 +53,7 @@ pub use stats::RenderStats;
 pub mod internals {
     pub use crate::clip::{ClipVertex, Clipped, clip_triangle};
     pub use crate::simd::{
-        Isa, LANES, Lean, Prepared, Shaded8, Term, avx2_available, light_vertices, shade8, shade8_lean,
+        Isa, LANES, Lean, Prepared, Shaded8, Term, VertexTerm, avx2_available, light_vertices, shade8, shade8_lean,
     };
 }
 

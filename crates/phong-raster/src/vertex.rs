@@ -3,7 +3,7 @@
 
 use crate::clip::{NOT_FINITE, OUTSIDE_CLIP, outcode};
 use crate::fixed::{ONE, round_i64};
-use crate::simd::{Isa, Lean, Prepared, Term, light_vertices, light_vertices_lit, project_vertices};
+use crate::simd::{Isa, Lean, Prepared, Term, VertexTerm, light_vertices, light_vertices_lit, project_vertices};
 use glam::{Mat4, Vec3, Vec4};
 use phong_core::{Lighting, Object, View};
 use rayon::prelude::*;
@@ -141,16 +141,11 @@ impl VertexLighting {
             if self.textured {
                 light_vertices_lit(self.isa, &self.prepared, ps, ns, side == 1, [o, spec]);
             } else {
-                light_vertices(
-                    self.isa,
-                    &self.prepared,
-                    self.term,
-                    self.lean.as_ref(),
-                    ps,
-                    ns,
-                    side == 1,
-                    o,
-                );
+                let term = match &self.lean {
+                    Some(lean) => VertexTerm::Lean(lean),
+                    None => VertexTerm::General(self.term),
+                };
+                light_vertices(self.isa, &self.prepared, term, ps, ns, side == 1, o);
             }
         }
     }

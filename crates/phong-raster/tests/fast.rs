@@ -7,7 +7,7 @@ use common::Rng;
 use glam::Vec3;
 use phong_core::*;
 use phong_raster::internals::{
-    ClipVertex, Clipped, LANES, Lean, Prepared, Term, clip_triangle, light_vertices, shade8, shade8_lean,
+    ClipVertex, Clipped, LANES, Lean, Prepared, Term, VertexTerm, clip_triangle, light_vertices, shade8, shade8_lean,
 };
 use phong_raster::{Kernels, RenderOptions, render};
 use std::path::Path;
@@ -98,7 +98,7 @@ fn kernel_matches_shade() {
                 let ps: Vec<Vec3> = (0..n).map(|i| pos[i % LANES]).collect();
                 let ns: Vec<Vec3> = (0..n).map(|i| -nrm[i % LANES]).collect();
                 let mut out = vec![Vec3::NAN; n];
-                light_vertices(isa, &prep, term, None, &ps, &ns, true, &mut out);
+                light_vertices(isa, &prep, VertexTerm::General(term), &ps, &ns, true, &mut out);
                 for (i, o) in out.iter().enumerate() {
                     let w = Vec3::new(want[0][i % LANES], want[1][i % LANES], want[2][i % LANES]);
                     // Lane-wise the same operations: the same bits.
@@ -190,7 +190,7 @@ fn lean_kernel_matches_shade() {
             // Gouraud's vertex entry by the lean kernel (16 lanes in the AVX2 build, so its
             // skipped highlights may differ): the same bound.
             let mut vertices = [Vec3::NAN; LANES];
-            light_vertices(isa, &prep, Term::Color, Some(&lean), &pos, &nrm, false, &mut vertices);
+            light_vertices(isa, &prep, VertexTerm::Lean(&lean), &pos, &nrm, false, &mut vertices);
             for lane in 0..LANES {
                 let point = SurfacePoint {
                     position: pos[lane],

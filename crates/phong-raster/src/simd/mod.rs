@@ -15,6 +15,7 @@
 mod filter;
 pub mod kernel;
 mod lean;
+mod planes;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
 mod project;
 mod sampler;
@@ -23,7 +24,7 @@ mod vector;
 
 use crate::Kernels;
 use glam::Vec3;
-pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term};
+pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term, VertexTerm};
 pub use lean::Lean;
 pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
@@ -346,25 +347,22 @@ pub fn shade_batch<'p>(
 #[target_feature(enable = "avx2,fma")]
 fn light_vertices_avx2(
     p: &Prepared,
-    term: Term,
-    lean: Option<&Lean>,
+    term: VertexTerm,
     positions: &[Vec3],
     normals: &[Vec3],
     flip: bool,
     out: &mut [Vec3],
 ) {
-    kernel::light_vertices::<vector::Avx2x2>(p, term, lean, positions, normals, flip, out)
+    kernel::light_vertices::<vector::Avx2x2>(p, term, positions, normals, flip, out)
 }
 
 /// Gouraud's vertex lighting: `out[i]` = `term` of `phong_core::shade` at `positions[i]` with
 /// `normals[i]` (negated with `flip`), `pow` approximated as in `kernel.rs` (AVX2: 16 lanes);
-/// by the lean kernel where `lean` is given (the colour term, see `lean.rs`).
-#[allow(clippy::too_many_arguments)]
+/// the colour by the lean kernel with [`VertexTerm::Lean`] (see `lean.rs`).
 pub fn light_vertices(
     isa: Isa,
     p: &Prepared,
-    term: Term,
-    lean: Option<&Lean>,
+    term: VertexTerm,
     positions: &[Vec3],
     normals: &[Vec3],
     flip: bool,
@@ -374,10 +372,10 @@ pub fn light_vertices(
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
-        return unsafe { light_vertices_avx2(p, term, lean, positions, normals, flip, out) };
+        return unsafe { light_vertices_avx2(p, term, positions, normals, flip, out) };
     }
     let _ = isa;
-    kernel::light_vertices::<vector::Portable>(p, term, lean, positions, normals, flip, out)
+    kernel::light_vertices::<vector::Portable>(p, term, positions, normals, flip, out)
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -485,7 +485,13 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
     if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
         return Err([primary, specular, if FULL { ambient } else { [zero; 3] }]);
     }
-    let texels = (td.flatten(), ts.flatten(), ta.flatten(), te.flatten(), ao.flatten());
+    let texels = Wrapped {
+        td: td.flatten(),
+        ts: ts.flatten(),
+        ta: ta.flatten(),
+        te: te.flatten(),
+        ao: ao.flatten(),
+    };
     Ok(modulated::<V, FULL>(
         prep,
         maps,
@@ -506,6 +512,15 @@ struct Texels<V> {
     ta: Option<Option<[V; 3]>>,
     te: Option<Option<[V; 3]>>,
     ao: Option<Option<V>>,
+}
+
+/// [`Texels`] where every coordinate was wrapped: `None` only where the object has no such map.
+struct Wrapped<V> {
+    td: Option<[V; 3]>,
+    ts: Option<[V; 3]>,
+    ta: Option<[V; 3]>,
+    te: Option<[V; 3]>,
+    ao: Option<V>,
 }
 
 /// The texels of `maps`' colour maps at coordinates `uv` (first set) and `uv1` (second).
@@ -597,7 +612,6 @@ fn lit_colours<V: Sampling, const FULL: bool>(
 /// `[primary, specular, ambient]` in `Lit::modulate`'s order, tinted by the vertex colours'
 /// planes in `k` (at `(dx, dy)`, over `w`) and with a metallic-roughness texel `mr`'s metalness.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn modulated<V: Sampling, const FULL: bool>(
     prep: &Prepared,
     maps: &VectorMaps,
@@ -605,13 +619,7 @@ fn modulated<V: Sampling, const FULL: bool>(
     (dx, dy, w): (V, V, V),
     [primary, specular, ambient]: [[V; 3]; 3],
     mr: Option<[V; 3]>,
-    (td, ts, ta, te, ao): (
-        Option<[V; 3]>,
-        Option<[V; 3]>,
-        Option<[V; 3]>,
-        Option<[V; 3]>,
-        Option<V>,
-    ),
+    Wrapped { td, ts, ta, te, ao }: Wrapped<V>,
 ) -> [V; 3] {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
     let e = [prep.emission.r, prep.emission.g, prep.emission.b];
