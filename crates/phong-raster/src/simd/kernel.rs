@@ -548,7 +548,7 @@ pub(crate) fn lean_points<V: Vf32<A = [f32; LANES]>>(
 /// the lean kernel (`lean.rs`).
 #[derive(Clone, Copy)]
 pub enum VertexTerm<'a> {
-    /// The term, by [`shade`].
+    /// The term, by the general kernel (`shade` here).
     General(Term),
     /// The colour, by the lean kernel.
     Lean(&'a super::Lean),
