@@ -12,6 +12,37 @@ use phong_raster::internals::{
 use phong_raster::{Kernels, RenderOptions, render};
 use std::path::Path;
 
+/// A view of round `round`: local (per-point V) on even rounds, infinite on odd ones.
+fn random_view(r: &mut Rng, round: usize) -> View {
+    if round.is_multiple_of(2) {
+        View::Local { eye: r.v(6.0) }
+    } else {
+        View::Infinite { to_viewer: r.v(1.0) }
+    }
+}
+
+/// A material of random colours, its shininess from 0 to 1000 by round.
+fn random_material(r: &mut Rng, round: usize) -> (Material, f32) {
+    let shininess = [0.0, 1.0, 10.0, 51.2, 128.0, 1000.0][round % 6];
+    (
+        Material::new(r.c(), r.c(), r.c(), r.c() * 0.2, shininess).unwrap(),
+        shininess,
+    )
+}
+
+/// Positions and normals for the lanes; every 50th round one zero normal.
+fn random_points(r: &mut Rng, round: usize) -> ([Vec3; LANES], [Vec3; LANES]) {
+    let pos: [Vec3; LANES] = std::array::from_fn(|_| r.v(2.0));
+    let nrm: [Vec3; LANES] = std::array::from_fn(|i| {
+        if round.is_multiple_of(50) && i == 3 {
+            Vec3::ZERO
+        } else {
+            r.v(1.0)
+        }
+    });
+    (pos, nrm)
+}
+
 /// `shade8` against `shade`, lane by lane, on 20000 random points: every model, normalization,
 /// option and light type, shininess up to 1000, in the portable build and (where the CPU has
 /// it) the AVX2 build. Measured: largest difference 1.5e-6 relative to max(1, |value|);
@@ -59,8 +90,7 @@ fn kernel_matches_shade() {
             });
         }
         let lighting = Lighting::new(r.c() * 0.3, lights).unwrap();
-        let shininess = [0.0, 1.0, 10.0, 51.2, 128.0, 1000.0][round % 6];
-        let m = Material::new(r.c(), r.c(), r.c(), r.c() * 0.2, shininess).unwrap();
+        let (m, shininess) = random_material(&mut r, round);
         let options = ShadingOptions {
             specular: models[round % models.len()],
             gate_specular: r.f() < 0.7,
@@ -68,20 +98,9 @@ fn kernel_matches_shade() {
             normalization: norms[(round / 5) % norms.len()],
             two_sided: false,
         };
-        let view = if round % 2 == 0 {
-            View::Local { eye: r.v(6.0) }
-        } else {
-            View::Infinite { to_viewer: r.v(1.0) }
-        };
+        let view = random_view(&mut r, round);
         let prep = Prepared::new(&lighting, &m, &options, view);
-        let pos: [Vec3; LANES] = std::array::from_fn(|_| r.v(2.0));
-        let nrm: [Vec3; LANES] = std::array::from_fn(|i| {
-            if round % 50 == 0 && i == 3 {
-                Vec3::ZERO
-            } else {
-                r.v(1.0)
-            }
-        });
+        let (pos, nrm) = random_points(&mut r, round);
         for isa in common::isas() {
             let avx2 = isa.is_avx2();
             let got = shade8(isa, &prep, &pos, &nrm);
@@ -161,8 +180,7 @@ fn lean_kernel_matches_shade() {
             });
         }
         let lighting = Lighting::new(r.c() * 0.3, lights).unwrap();
-        let shininess = [0.0, 1.0, 10.0, 51.2, 128.0, 1000.0][round % 6];
-        let m = Material::new(r.c(), r.c(), r.c(), r.c() * 0.2, shininess).unwrap();
+        let (m, shininess) = random_material(&mut r, round);
         let options = ShadingOptions {
             specular: models[round % models.len()],
             gate_specular: r.f() < 0.7,
@@ -170,20 +188,9 @@ fn lean_kernel_matches_shade() {
             normalization: Normalization::None,
             two_sided: false,
         };
-        let view = if round % 2 == 0 {
-            View::Local { eye: r.v(6.0) }
-        } else {
-            View::Infinite { to_viewer: r.v(1.0) }
-        };
+        let view = random_view(&mut r, round);
         let prep = Prepared::new(&lighting, &m, &options, view);
-        let pos: [Vec3; LANES] = std::array::from_fn(|_| r.v(2.0));
-        let nrm: [Vec3; LANES] = std::array::from_fn(|i| {
-            if round % 50 == 0 && i == 3 {
-                Vec3::ZERO
-            } else {
-                r.v(1.0)
-            }
-        });
+        let (pos, nrm) = random_points(&mut r, round);
         let lean = Lean::of(&prep).expect("the lean kernel shades these");
         for isa in common::isas() {
             let got = shade8_lean(isa, &prep, &pos, &nrm).expect("the lean kernel shades these");
