@@ -567,16 +567,18 @@ fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) 
     let n = w.positions.len();
     let mut mean = vec![Vec3::ZERO; n];
     let mut count = vec![0u32; n];
+    let Some(cos_half) = cos_half else {
+        for &v in w.triangles.iter().flatten() {
+            count[v as usize] += 1;
+        }
+        return (mean, count);
+    };
     for (t, f) in w.triangles.iter().zip(facet) {
         for &v in t {
             mean[v as usize] += *f;
             count[v as usize] += 1;
         }
     }
-    let Some(cos_half) = cos_half else {
-        mean.fill(Vec3::ZERO);
-        return (mean, count);
-    };
     for (m, &c) in mean.iter_mut().zip(&count) {
         *m = if c as usize > MANY {
             Vec3::ZERO

@@ -6,14 +6,6 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-/// A model read, with what reading it said.
-#[derive(Debug)]
-pub(crate) struct Read {
-    pub model: ModelFile,
-    pub warnings: Vec<String>,
-    pub sources: Vec<PathBuf>,
-}
-
 /// Model files kept after their first read, each until its expected uses are done (so that a
 /// batch over a whole library does not keep every model). A file not announced with
 /// [`Models::expect`] is read every time it is asked for, unless the cache keeps everything
@@ -29,21 +21,12 @@ struct Inner {
     uses: HashMap<PathBuf, usize>,
     /// A slot per model kept: locked while its file is read, so that two threads asking for
     /// one model read it once.
-    slots: HashMap<PathBuf, Arc<Mutex<Option<Arc<Read>>>>>,
+    slots: HashMap<PathBuf, Arc<Mutex<Option<Arc<ModelFile>>>>>,
 }
 
 /// The cache's key for `path`: the canonical path where it has one.
 fn key(path: &Path) -> PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-}
-
-fn read(path: &Path) -> Result<Read, phong_scene::Error> {
-    let mut model = phong_scene::ModelFile::read(path)?;
-    Ok(Read {
-        warnings: std::mem::take(&mut model.warnings),
-        sources: std::mem::take(&mut model.sources),
-        model,
-    })
 }
 
 impl Models {
@@ -73,20 +56,20 @@ impl Models {
 
     /// The model at `path`, read now or kept from an earlier read; `fresh` is true where it
     /// was read now (so that its warnings are printed once).
-    pub(crate) fn get(&self, path: &Path) -> Result<(Arc<Read>, bool), phong_scene::Error> {
+    pub(crate) fn get(&self, path: &Path) -> Result<(Arc<ModelFile>, bool), phong_scene::Error> {
         let k = key(path);
         let slot = {
             let mut inner = self.inner.lock().expect("not poisoned");
             (inner.keep_all || inner.uses.contains_key(&k)).then(|| inner.slots.entry(k.clone()).or_default().clone())
         };
         let Some(slot) = slot else {
-            return Ok((Arc::new(read(path)?), true));
+            return Ok((Arc::new(ModelFile::read(path)?), true));
         };
         let result = {
             let mut guard = slot.lock().expect("not poisoned");
             match &*guard {
                 Some(r) => Ok((r.clone(), false)),
-                None => read(path).map(|r| {
+                None => ModelFile::read(path).map(|r| {
                     let r = Arc::new(r);
                     *guard = Some(r.clone());
                     (r, true)

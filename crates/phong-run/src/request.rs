@@ -111,8 +111,8 @@ pub fn load_viewed(
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let (doc, _) = phong_scene::model_scene(&name, &read.model, &view);
-            let parts = &read.model.parts;
+            let (doc, _) = phong_scene::model_scene(&name, &read, &view);
+            let parts = &read.parts;
             let lookup = |_: &str| Ok(parts.clone());
             let scene = built.load(&doc, path, Some(&lookup), settings, models)?;
             let warnings = if fresh { read.warnings.clone() } else { Vec::new() };
@@ -140,7 +140,7 @@ fn load_model(path: &Path, settings: &Settings, view: &ModelOptions, models: &Mo
         return Ok(phong_scene::load_with(path, view)?);
     }
     let (read, fresh) = models.get(path)?;
-    let mut loaded = framed(path, &read.model, settings, view)?;
+    let mut loaded = framed(path, &read, settings, view)?;
     if fresh {
         let mut w = read.warnings.clone();
         w.append(&mut loaded.warnings);
@@ -240,7 +240,7 @@ fn file_lookup<'a>(
             f.warnings.borrow_mut().extend(read.warnings.iter().cloned());
         }
         f.sources.borrow_mut().extend(read.sources.iter().cloned());
-        Ok(read.model.parts.clone())
+        Ok(read.parts.clone())
     };
     (lookup, found)
 }
