@@ -1476,3 +1476,83 @@ material = {{ base = "silver", diffuse_map = "assets/bricks.png" }}
         assert_fast_matches_reference(&scene, &format!("{samples:?}"));
     }
 }
+
+/// Multi-sample visibility (4 and 16 samples) of triangle soups that cross one another at
+/// random depths, one emissive colour per soup and nothing else lit: each pixel is the mean of
+/// its samples' triangles' colours, so the images show which triangle each sample kept. The
+/// AVX2 build's vector coverage must give the portable build's scalar loop and the reference
+/// path exactly.
+#[test]
+fn multi_sample_visibility_is_the_scalar_loops() {
+    let mut r = Rng(5);
+    let mut objects = String::new();
+    for _ in 0..5 {
+        let c = r.c();
+        objects += &format!(
+            "[[object]]\nshape = \"sphere\"\nmaterial = {{ ambient = [0.0, 0.0, 0.0], diffuse = [0.0, 0.0, 0.0], \
+             emission = [{}, {}, {}] }}\n",
+            c.r, c.g, c.b
+        );
+    }
+    let src = format!(
+        "[image]\nwidth = 157\nheight = 93\n[camera]\nposition = [0.0, 0.0, 6.0]\n[shading]\nambient = [0.0, 0.0, 0.0]\n{objects}"
+    );
+    let mut scene = phong_scene::parse_scene(&src, Path::new("soup.toml")).unwrap().scene;
+    for o in &mut scene.objects {
+        // Triangles of all sizes (a tenth of a pixel to a third of the frame), some edges on
+        // sample positions' rows and columns (integer vertex coordinates).
+        let mut positions = Vec::new();
+        for k in 0..300 {
+            let centre = r.v(2.5);
+            let size = [0.01, 0.1, 1.5][k % 3];
+            for _ in 0..3 {
+                let p = centre + r.v(size);
+                positions.push(if k % 7 == 0 { (p * 4.0).round() / 4.0 } else { p });
+            }
+        }
+        let mut triangles: Vec<[u32; 3]> = (0..300u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        // And a fine grid facing the camera, shared edges on every side: its rows' and columns'
+        // edges project to lines of equal y or x, some of which meet the samples' rows and
+        // columns exactly (the top-left rule decides those samples).
+        let (n, at) = (150u32, positions.len() as u32);
+        let z = r.r(-2.0, 0.0);
+        for j in 0..=n {
+            for i in 0..=n {
+                positions.push(Vec3::new(i as f32, j as f32, 0.0) * (7.0 / n as f32) - Vec3::new(3.5, 3.5, -z));
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let v = at + j * (n + 1) + i;
+                if (i + j + at) % 5 != 0 {
+                    triangles.extend([[v, v + 1, v + n + 2], [v, v + n + 2, v + n + 1]]);
+                }
+            }
+        }
+        let normals = vec![Vec3::Z; positions.len()];
+        o.mesh = Mesh::new(positions, normals, triangles).unwrap();
+    }
+    for samples in [Samples::Four, Samples::Sixteen] {
+        scene.image.samples = samples;
+        let image = |reference, kernels| {
+            let options = RenderOptions {
+                reference,
+                kernels,
+                threads: Some(2),
+                ..Default::default()
+            };
+            render(&scene, &options).unwrap().to_bytes(Encoding::Linear, false)
+        };
+        let avx2 = image(false, Kernels::Auto);
+        let lit = avx2.chunks(3).filter(|p| p.iter().any(|&c| c > 0)).count();
+        assert!(lit > 157 * 93 / 3, "{samples:?}: only {lit} pixels drawn");
+        assert!(
+            avx2 == image(false, Kernels::Portable),
+            "{samples:?}: AVX2 against portable"
+        );
+        assert!(
+            avx2 == image(true, Kernels::Auto),
+            "{samples:?}: AVX2 against the reference"
+        );
+    }
+}

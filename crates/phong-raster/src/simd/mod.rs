@@ -15,6 +15,7 @@
 mod filter;
 pub mod kernel;
 mod lean;
+mod multi;
 mod planes;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
 mod project;
@@ -26,6 +27,7 @@ use crate::Kernels;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term, VertexTerm};
 pub use lean::Lean;
+pub(crate) use multi::{SampleBuffers, multi_visible};
 pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
@@ -571,6 +573,20 @@ pub fn stream_fence() {
     unsafe {
         core::arch::x86_64::_mm_sfence()
     };
+}
+
+/// Asks the CPU to bring `x` into the caches ahead of its use: for records read in an order the
+/// hardware cannot predict (a tile's triangles, a sparse subset of the frame's).
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing the program sees and cannot fault; `x` is a reference.
+    unsafe {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 #[cfg(test)]

@@ -12,7 +12,11 @@ use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
-use crate::simd::{Planes, TilePixel, covered_span};
+use crate::simd::{Planes, SampleBuffers, TilePixel, covered_span, multi_visible, prefetch};
+
+/// How many triangles of a bin ahead [`Tiles::tile_multi`] asks for: its triangles are a
+/// sparse subset of the frame's records, which the hardware does not predict.
+const PREFETCH_AHEAD: usize = 8;
 use crate::stats::Marks;
 use crate::target::{Store, resolve};
 use phong_core::limits::SUBPIXEL_BITS;
@@ -206,6 +210,9 @@ impl Tiles<'_> {
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque samples.
         let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
+            if let Some(&ahead) = tile.bin.get(k + PREFETCH_AHEAD) {
+                prefetch(self.binned.tri(ahead));
+            }
             let t = self.binned.tri(ti);
             match self.plan.objects[self.binned.object(ti)].visibility {
                 Visibility::Blended => {
@@ -230,6 +237,14 @@ impl Tiles<'_> {
                     continue;
                 }
                 Visibility::Opaque => {}
+            }
+            let mut buf = SampleBuffers {
+                rect: (x0, y0, x1, y1),
+                depth,
+                ids,
+            };
+            if multi_visible(self.plan.isa, t, ti, &self.plan.pattern, &mut buf) {
+                continue;
             }
             // Per sample an offset from the pixel corner, per pixel a step of `a·256`: exact
             // integer adds, the reference's values.
