@@ -225,12 +225,13 @@ pub fn model_scene(name: &str, model: &ModelFile, options: &ModelOptions) -> (se
             origin.x, origin.y, origin.z
         ));
     }
-    let up = up_axis(parts, gltf, options, &mut notes);
+    // Computed once per model read, where asked: its views all ask.
+    let facets = || *model.facets.get_or_init(|| facets(parts));
+    let up = up_axis(&facets, gltf, options, &mut notes);
     let u = up.vector();
     // A glTF says its front and its faces: its edges are not examined.
-    // Computed once per model read: its views all ask.
     let closed = (!gltf).then(|| *model.closed.get_or_init(|| closedness(parts)));
-    let f = front(parts, up, closed, options, &mut notes);
+    let f = front(parts, &facets, up, closed, options, &mut notes);
     let r = u.cross(f);
     let two_sided = two_sided(model, closed, options, &mut notes);
     let aspect = options
@@ -298,12 +299,12 @@ pub fn model_scene(name: &str, model: &ModelFile, options: &ModelOptions) -> (se
 }
 
 /// The up axis: `options.up`, y for a glTF, else detected (said in `notes`).
-fn up_axis(parts: &[ModelPart], gltf: bool, options: &ModelOptions, notes: &mut Vec<String>) -> Axis {
+fn up_axis(facets: &dyn Fn() -> Facets, gltf: bool, options: &ModelOptions, notes: &mut Vec<String>) -> Axis {
     match options.up {
         Some(a) => a,
         None if gltf => Axis::Y,
         None => {
-            let (a, why) = detect_up(parts);
+            let (a, why) = detect_up(&facets());
             notes.push(format!(
                 "up axis {} (detected{}; --up to choose)",
                 a.name(),
@@ -318,6 +319,7 @@ fn up_axis(parts: &[ModelPart], gltf: bool, options: &ModelOptions, notes: &mut 
 /// given), else the convention's axis for `up` (+z for y up, −y for z up).
 fn front(
     parts: &[ModelPart],
+    facets: &dyn Fn() -> Facets,
     up: Axis,
     closed: Option<Closed>,
     options: &ModelOptions,
@@ -331,7 +333,7 @@ fn front(
         Axis::X => Vec3::Z,
         Axis::NegX => Vec3::Z,
     };
-    match closed.and_then(|c| detect_front(parts, up.vector(), f, c)) {
+    match closed.and_then(|c| detect_front(parts, &facets(), (up.vector(), f), c)) {
         Some((front, why)) => {
             if options.camera.is_none() {
                 notes.push(format!("front {} ({why})", axis_name(front)));
@@ -504,24 +506,23 @@ fn axis_name(v: Vec3) -> String {
 /// - else, a model longer along `f` than it is tall (an animal on its legs, as Spot) turns its
 ///   top toward its front (the head above the body): `−f` when the vertices of its top tenth
 ///   lie behind the middle by more than 10% of its depth.
-fn detect_front(parts: &[ModelPart], u: Vec3, f: Vec3, closed: Closed) -> Option<(Vec3, &'static str)> {
+fn detect_front(
+    parts: &[ModelPart],
+    facets: &Facets,
+    (u, f): (Vec3, Vec3),
+    closed: Closed,
+) -> Option<(Vec3, &'static str)> {
     let r = u.cross(f);
     let (lo, hi) = parts
         .iter()
         .filter_map(|p| p.mesh.bounds())
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
     if !matches!(closed, Closed::Outward | Closed::Inward) {
-        let (mut area, mut total) = (DVec3::ZERO, 0.0f64);
-        for p in parts {
-            for t in 0..p.mesh.triangles().len() {
-                let [a, b, c] = p.mesh.corners(t);
-                // In f64: a model's coordinates may be near f32's largest.
-                let [a, b, c] = [a, b, c].map(Vec3::as_dvec3);
-                let n = (b - a).cross(c - a) * 0.5;
-                area += n;
-                total += n.length();
-            }
-        }
+        let Facets {
+            area,
+            area_total: total,
+            ..
+        } = *facets;
         let along = |d: Vec3| d.as_dvec3().dot(area);
         let best = [f, -f, r, -r]
             .into_iter()
@@ -555,37 +556,13 @@ fn detect_front(parts: &[ModelPart], u: Vec3, f: Vec3, closed: Closed) -> Option
 /// end-on): z. Standing on a flat base facing −z (faces within 18° of −z in the lowest 2% of
 /// its height hold at least 2% of its area, and 3 times the area that faces −y in its lowest
 /// 2% along y): z. Else y.
-fn detect_up(parts: &[ModelPart]) -> (Axis, Option<&'static str>) {
-    let Some((lo, hi)) = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-    else {
+fn detect_up(facets: &Facets) -> (Axis, Option<&'static str>) {
+    let Some(ext) = facets.extent else {
         return (Axis::Y, None);
     };
-    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
-    let ext = hi - lo;
-    let (mut total, mut base_z, mut base_y) = (0.0f64, 0.0f64, 0.0f64);
-    for p in parts {
-        for t in 0..p.mesh.triangles().len() {
-            let [a, b, c] = p.mesh.corners(t);
-            let [a, b, c] = [a, b, c].map(Vec3::as_dvec3);
-            let n = (b - a).cross(c - a);
-            let area2 = n.length();
-            if area2.is_nan() || area2 <= 0.0 {
-                continue;
-            }
-            total += area2;
-            let centroid = (a + b + c) / 3.0;
-            let unit = n / area2;
-            if unit.z < -0.95 && centroid.z - lo.z <= 0.02 * ext.z {
-                base_z += area2;
-            }
-            if unit.y < -0.95 && centroid.y - lo.y <= 0.02 * ext.y {
-                base_y += area2;
-            }
-        }
-    }
+    let Facets {
+        total, base_z, base_y, ..
+    } = *facets;
     // Long along `along`, round across the other two.
     let long = |along: f64, a: f64, b: f64| along >= 2.0 * a.max(b) && a.min(b) >= 0.5 * a.max(b);
     if long(ext.y, ext.x, ext.z) {
@@ -598,6 +575,62 @@ fn detect_up(parts: &[ModelPart]) -> (Axis, Option<&'static str>) {
     } else {
         (Axis::Y, None)
     }
+}
+
+/// The sums over a model's facets that the up and front detections read, found in one pass
+/// (in f64: a model's coordinates may be near f32's largest).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Facets {
+    /// The extent of the bounding box (`None`: no vertices).
+    extent: Option<DVec3>,
+    /// Twice the area of the facets of positive area, and of those among them facing within
+    /// 18° of −z (−y) with their centroid in the lowest 2% of the height along z (y).
+    total: f64,
+    base_z: f64,
+    base_y: f64,
+    /// The area vector (Σ area·n) and the area of every facet.
+    area: DVec3,
+    area_total: f64,
+}
+
+fn facets(parts: &[ModelPart]) -> Facets {
+    let Some((lo, hi)) = parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    else {
+        return Facets::default();
+    };
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let ext = hi - lo;
+    let mut sums = Facets {
+        extent: Some(ext),
+        ..Facets::default()
+    };
+    for p in parts {
+        let pos = p.mesh.positions();
+        for t in p.mesh.triangles() {
+            let [a, b, c] = t.map(|i| pos[i as usize].as_dvec3());
+            let n = (b - a).cross(c - a);
+            let half = n * 0.5;
+            sums.area += half;
+            sums.area_total += half.length();
+            let area2 = n.length();
+            if area2.is_nan() || area2 <= 0.0 {
+                continue;
+            }
+            sums.total += area2;
+            let centroid = (a + b + c) / 3.0;
+            let unit = n / area2;
+            if unit.z < -0.95 && centroid.z - lo.z <= 0.02 * ext.z {
+                sums.base_z += area2;
+            }
+            if unit.y < -0.95 && centroid.y - lo.y <= 0.02 * ext.y {
+                sums.base_y += area2;
+            }
+        }
+    }
+    sums
 }
 
 /// Whether a model is closed, and which way it is wound.

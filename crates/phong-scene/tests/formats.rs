@@ -148,6 +148,74 @@ fn ply_ascii_and_binary_in_both_byte_orders() {
     let _ = std::fs::remove_dir_all(d);
 }
 
+/// Triangle faces of `uchar` counts and 32-bit indices (the layout most writers use) in both
+/// byte orders, signed and unsigned, with a quad among them: the corners are the ones written,
+/// in order (the cube's faces, the quads cut as the general reader cuts them); a negative index
+/// is refused with its value, and a file that ends inside a face names the face element.
+#[test]
+fn ply_triangles_of_int_indices() {
+    let d = dir("ply-tris");
+    // The cube's faces as triangles, but its fourth face left a quad.
+    let mut faces: Vec<Vec<u32>> = Vec::new();
+    for (k, f) in CUBE_F.iter().enumerate() {
+        if k == 3 {
+            faces.push(f.to_vec());
+        } else {
+            faces.push(vec![f[0], f[1], f[2]]);
+            faces.push(vec![f[0], f[2], f[3]]);
+        }
+    }
+    let file = |big: bool, index: &str, faces: &[Vec<u32>], negative: bool| {
+        let order = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
+        let mut b = format!(
+            "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
+             property float z\nelement face {}\nproperty list uchar {index} vertex_indices\nend_header\n",
+            faces.len()
+        )
+        .into_bytes();
+        for v in CUBE_V {
+            for c in v {
+                b.extend(if big { c.to_be_bytes() } else { c.to_le_bytes() });
+            }
+        }
+        for (k, f) in faces.iter().enumerate() {
+            b.push(f.len() as u8);
+            for &i in f {
+                let i = if negative && k == 5 { u32::MAX } else { i };
+                b.extend(if big { i.to_be_bytes() } else { i.to_le_bytes() });
+            }
+        }
+        b
+    };
+    let want = cube_triangles();
+    for big in [false, true] {
+        for index in ["int", "uint", "int32"] {
+            let name = format!("{big}-{index}.ply");
+            let p = write(&d, &name, &file(big, index, &faces, false));
+            let parts = load_model(&p, &mut Vec::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(corners(&parts[0].mesh), want, "{name}");
+            // Index 2^32 − 1 in face 5: −1 as a signed int, past the vertices unsigned.
+            let p = write(&d, &name, &file(big, index, &faces, true));
+            let err = load_model(&p, &mut Vec::new()).unwrap_err().to_string();
+            let bad = if index == "uint" { "4294967295" } else { "-1" };
+            assert!(
+                err.contains(&format!("face 5: vertex index {bad} is out of range")),
+                "{name}: {err}"
+            );
+            // Cut inside face row 8 (after the quad).
+            let whole = file(big, index, &faces, false);
+            let p = write(&d, &name, &whole[..whole.len() - 2 * 13 - 6]);
+            let err = load_model(&p, &mut Vec::new()).unwrap_err().to_string();
+            assert!(err.contains("element face row 8"), "{name}: {err}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
+
 #[test]
 fn stl_binary_and_ascii() {
     let d = dir("stl");

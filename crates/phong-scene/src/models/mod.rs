@@ -107,6 +107,8 @@ pub struct ModelFile {
     pub sources: Vec<PathBuf>,
     /// Whether it is closed and how it is wound, found when it is first framed.
     pub(crate) closed: std::sync::OnceLock<crate::framing::Closed>,
+    /// The sums over its facets that its framing reads, found when it is first framed.
+    pub(crate) facets: std::sync::OnceLock<crate::framing::Facets>,
 }
 
 impl ModelFile {
@@ -197,6 +199,7 @@ impl ModelFile {
             warnings: Vec::new(),
             sources: Vec::new(),
             closed: Default::default(),
+            facets: Default::default(),
         }
     }
 }

@@ -502,7 +502,23 @@ fn binary_positions<R: Rows>(e: &Element, s: &VertexSlots, rows: &mut R, body: &
         return false;
     }
     let [(ox, tx), (oy, ty), (oz, tz)] = [x, y, z].map(|i| (offsets[i], types[i]));
-    for row in bytes[*at..*at + need].chunks_exact(stride) {
+    let rows_of = bytes[*at..*at + need].chunks_exact(stride);
+    if [tx, ty, tz] == [Scalar::F32; 3] {
+        // The common layout (float x, y, z): no dispatch on the type per value.
+        let f = |row: &[u8], o: usize| {
+            let a: [u8; 4] = row[o..o + 4].try_into().expect("inside the row");
+            f64::from(if big {
+                f32::from_be_bytes(a)
+            } else {
+                f32::from_le_bytes(a)
+            })
+        };
+        body.points
+            .extend(rows_of.map(|row| DVec3::new(f(row, ox), f(row, oy), f(row, oz))));
+        *at += need;
+        return true;
+    }
+    for row in rows_of {
         body.points.push(DVec3::new(
             tx.get(&row[ox..], big),
             ty.get(&row[oy..], big),
@@ -526,7 +542,10 @@ fn binary_lists<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> bool {
     let (indices, starts) = (body.indices.len(), body.starts.len());
     let (cs, ts) = (c.size(), t.size());
     let mut p = *at;
-    for _ in 0..e.count {
+    if c == Scalar::U8 && matches!(t, Scalar::I32 | Scalar::U32) {
+        p = int_triangles(bytes, p, e.count, t == Scalar::I32, big, body);
+    }
+    for _ in body.starts.len() - starts..e.count as usize {
         let Some(k) = bytes
             .get(p..p + cs)
             .map(|b| c.get(b, big))
@@ -550,6 +569,34 @@ fn binary_lists<R: Rows>(e: &Element, rows: &mut R, body: &mut Body) -> bool {
     body.indices.truncate(indices);
     body.starts.truncate(starts);
     false
+}
+
+/// The faces from `bytes[p..]` that are triangles of 32-bit indices after a `uchar` count (as
+/// most writers write them), up to `count` faces in all or the first other face; returns where
+/// it stopped (the caller reads the rest).
+fn int_triangles(bytes: &[u8], mut p: usize, count: u64, signed: bool, big: bool, body: &mut Body) -> usize {
+    let index = |b: &[u8]| {
+        let a: [u8; 4] = b.try_into().expect("4 bytes");
+        let u = if big {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        };
+        // A signed index below zero stays negative, to be refused with its value.
+        if signed { i64::from(u as i32) } else { i64::from(u) }
+    };
+    let mut left = count;
+    while left > 0 {
+        let Some(face) = bytes.get(p..p + 13).filter(|f| f[0] == 3) else {
+            break;
+        };
+        body.indices
+            .extend([index(&face[1..5]), index(&face[5..9]), index(&face[9..13])]);
+        body.starts.push(body.indices.len());
+        p += 13;
+        left -= 1;
+    }
+    p
 }
 
 /// A PLY file's `vertex` and `face` elements as one part (polygons triangulated; other
