@@ -703,18 +703,26 @@ fn closedness(parts: &[ModelPart]) -> Closed {
         under[fill[lo as usize] as usize] = (hi, sign);
         fill[lo as usize] += 1;
     }
+    // Per list, the faces on each edge counted in `on` (indexed by the higher id), then each
+    // edge judged once and its count cleared: linear, no sort.
     let (mut open_edges, mut inconsistent) = (0, 0);
+    let mut on = vec![(0u32, 0i32); ids.len()];
     for w in start.windows(2) {
-        let list = &mut under[w[0] as usize..w[1] as usize];
-        if list.len() > 1 {
-            list.sort_unstable_by_key(|e| e.0);
+        let list = &under[w[0] as usize..w[1] as usize];
+        for &(hi, sign) in list {
+            let e = &mut on[hi as usize];
+            e.0 += 1;
+            e.1 += sign;
         }
-        for run in list.chunk_by(|x, y| x.0 == y.0) {
-            if run.len() != 2 {
-                open_edges += 1;
-            } else if run[0].1 + run[1].1 != 0 {
-                inconsistent += 1;
+        for &(hi, _) in list {
+            let e = &mut on[hi as usize];
+            match *e {
+                (0, _) => continue,
+                (2, 0) => {}
+                (2, _) => inconsistent += 1,
+                _ => open_edges += 1,
             }
+            *e = (0, 0);
         }
     }
     match (open_edges + inconsistent, volume > 0.0) {
@@ -764,5 +772,33 @@ mod tests {
         let flipped: Vec<[u32; 3]> = c.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect();
         let inward = Mesh::from_triangles(c.positions().to_vec(), flipped).unwrap();
         assert_eq!(closedness(&[part(inward)]), Closed::Inward);
+        // One side turned over (its two triangles): its 4 edges wound alike with the
+        // neighbours', its diagonal still opposite.
+        let mut one: Vec<[u32; 3]> = c.triangles().to_vec();
+        assert!(
+            one[0].iter().filter(|v| one[1].contains(v)).count() == 2,
+            "the cube's triangles 0 and 1 make one side"
+        );
+        for t in &mut one[..2] {
+            *t = [t[0], t[2], t[1]];
+        }
+        let turned = Mesh::from_triangles(c.positions().to_vec(), one).unwrap();
+        let want = Closed::Open {
+            open_edges: 0,
+            inconsistent: 4,
+        };
+        assert_eq!(closedness(&[part(turned)]), want);
+        // A fin on one edge: that edge has 3 faces, the fin's other two have 1.
+        let mut positions = c.positions().to_vec();
+        positions.push(glam::Vec3::splat(5.0));
+        let mut fin: Vec<[u32; 3]> = c.triangles().to_vec();
+        let [a, b, _] = fin[0];
+        fin.push([b, a, positions.len() as u32 - 1]);
+        let finned = Mesh::from_triangles(positions, fin).unwrap();
+        let want = Closed::Open {
+            open_edges: 3,
+            inconsistent: 0,
+        };
+        assert_eq!(closedness(&[part(finned)]), want);
     }
 }
