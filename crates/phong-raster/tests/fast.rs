@@ -1477,14 +1477,52 @@ material = {{ base = "silver", diffuse_map = "assets/bricks.png" }}
     }
 }
 
-/// Multi-sample visibility (4 and 16 samples) of triangle soups that cross one another at
-/// random depths, one emissive colour per soup and nothing else lit: each pixel is the mean of
-/// its samples' triangles' colours, so the images show which triangle each sample kept. The
-/// AVX2 build's vector coverage must give the portable build's scalar loop and the reference
-/// path exactly.
+/// Visibility of triangle soups that cross one another at random depths, one emissive colour
+/// per soup and nothing else lit: each pixel is the mean of its samples' triangles' colours,
+/// so the images show which triangle each sample kept. With 4 and 16 samples a pixel (many
+/// small triangles) and with one (fewer, larger ones, as the AVX2 kernel takes them: 8 pixels a
+/// triangle in a tile or more), the AVX2 build's vector coverage must give the portable build's
+/// scalar loops and the reference path exactly.
 #[test]
-fn multi_sample_visibility_is_the_scalar_loops() {
+fn visibility_is_the_scalar_loops() {
     let mut r = Rng(5);
+    for (soup, grid, (w, h), samples) in [
+        (300, 150, (157, 93), vec![Samples::Four, Samples::Sixteen]),
+        (40, 24, (331, 203), vec![Samples::One, Samples::Four]),
+    ] {
+        let mut scene = soup_scene(&mut r, soup, grid, (w, h));
+        for samples in samples {
+            scene.image.samples = samples;
+            let image = |reference, kernels| {
+                let options = RenderOptions {
+                    reference,
+                    kernels,
+                    threads: Some(2),
+                    ..Default::default()
+                };
+                render(&scene, &options).unwrap().to_bytes(Encoding::Linear, false)
+            };
+            let avx2 = image(false, Kernels::Auto);
+            let lit = avx2.chunks(3).filter(|p| p.iter().any(|&c| c > 0)).count();
+            assert!(lit > (w * h / 3) as usize, "{samples:?}: only {lit} pixels drawn");
+            assert!(
+                avx2 == image(false, Kernels::Portable),
+                "{w}x{h} {samples:?}: AVX2 against portable"
+            );
+            assert!(
+                avx2 == image(true, Kernels::Auto),
+                "{w}x{h} {samples:?}: AVX2 against the reference"
+            );
+        }
+    }
+}
+
+/// Five emissive objects in a `w`×`h` image, each `soup` random triangles (a hundredth of the
+/// frame's width to a third of it, some of integer coordinates) and a `grid`×`grid` grid facing
+/// the camera at a random depth, shared edges on every side: its rows' and columns' edges
+/// project to lines of equal y or x, some of which meet the samples' rows and columns exactly
+/// (the top-left rule decides those samples).
+fn soup_scene(r: &mut Rng, soup: u32, grid: u32, (w, h): (u32, u32)) -> Scene {
     let mut objects = String::new();
     for _ in 0..5 {
         let c = r.c();
@@ -1495,14 +1533,12 @@ fn multi_sample_visibility_is_the_scalar_loops() {
         );
     }
     let src = format!(
-        "[image]\nwidth = 157\nheight = 93\n[camera]\nposition = [0.0, 0.0, 6.0]\n[shading]\nambient = [0.0, 0.0, 0.0]\n{objects}"
+        "[image]\nwidth = {w}\nheight = {h}\n[camera]\nposition = [0.0, 0.0, 6.0]\n[shading]\nambient = [0.0, 0.0, 0.0]\n{objects}"
     );
     let mut scene = phong_scene::parse_scene(&src, Path::new("soup.toml")).unwrap().scene;
     for o in &mut scene.objects {
-        // Triangles of all sizes (a tenth of a pixel to a third of the frame), some edges on
-        // sample positions' rows and columns (integer vertex coordinates).
         let mut positions = Vec::new();
-        for k in 0..300 {
+        for k in 0..soup as usize {
             let centre = r.v(2.5);
             let size = [0.01, 0.1, 1.5][k % 3];
             for _ in 0..3 {
@@ -1510,11 +1546,8 @@ fn multi_sample_visibility_is_the_scalar_loops() {
                 positions.push(if k % 7 == 0 { (p * 4.0).round() / 4.0 } else { p });
             }
         }
-        let mut triangles: Vec<[u32; 3]> = (0..300u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
-        // And a fine grid facing the camera, shared edges on every side: its rows' and columns'
-        // edges project to lines of equal y or x, some of which meet the samples' rows and
-        // columns exactly (the top-left rule decides those samples).
-        let (n, at) = (150u32, positions.len() as u32);
+        let mut triangles: Vec<[u32; 3]> = (0..soup).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        let (n, at) = (grid, positions.len() as u32);
         let z = r.r(-2.0, 0.0);
         for j in 0..=n {
             for i in 0..=n {
@@ -1532,27 +1565,5 @@ fn multi_sample_visibility_is_the_scalar_loops() {
         let normals = vec![Vec3::Z; positions.len()];
         o.mesh = Mesh::new(positions, normals, triangles).unwrap();
     }
-    for samples in [Samples::Four, Samples::Sixteen] {
-        scene.image.samples = samples;
-        let image = |reference, kernels| {
-            let options = RenderOptions {
-                reference,
-                kernels,
-                threads: Some(2),
-                ..Default::default()
-            };
-            render(&scene, &options).unwrap().to_bytes(Encoding::Linear, false)
-        };
-        let avx2 = image(false, Kernels::Auto);
-        let lit = avx2.chunks(3).filter(|p| p.iter().any(|&c| c > 0)).count();
-        assert!(lit > 157 * 93 / 3, "{samples:?}: only {lit} pixels drawn");
-        assert!(
-            avx2 == image(false, Kernels::Portable),
-            "{samples:?}: AVX2 against portable"
-        );
-        assert!(
-            avx2 == image(true, Kernels::Auto),
-            "{samples:?}: AVX2 against the reference"
-        );
-    }
+    scene
 }

@@ -15,23 +15,23 @@
 mod filter;
 pub mod kernel;
 mod lean;
-mod multi;
 mod planes;
 /// Private to the crate: the AVX2 vector type may only be used where AVX2 and FMA were detected.
 mod project;
 mod sampler;
 mod tile;
 mod vector;
+mod visible;
 
 use crate::Kernels;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term, VertexTerm};
 pub use lean::Lean;
-pub(crate) use multi::{SampleBuffers, multi_visible};
 pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
 pub use tile::{GouraudTri, TilePixel, gouraud_tile};
+pub(crate) use visible::{SampleBuffers, multi_visible, single_visible};
 
 /// Whether the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {

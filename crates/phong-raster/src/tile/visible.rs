@@ -12,9 +12,9 @@ use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
-use crate::simd::{Planes, SampleBuffers, TilePixel, covered_span, multi_visible, prefetch};
+use crate::simd::{Isa, Planes, SampleBuffers, TilePixel, covered_span, multi_visible, prefetch, single_visible};
 
-/// How many triangles of a bin ahead [`Tiles::tile_multi`] asks for: its triangles are a
+/// How many triangles of a bin ahead the tiles ask for: its triangles are a
 /// sparse subset of the frame's records, which the hardware does not predict.
 const PREFETCH_AHEAD: usize = 8;
 use crate::stats::Marks;
@@ -141,9 +141,19 @@ impl Tiles<'_> {
         ids.clear();
         ids.resize(tw * th, u32::MAX);
         let span = (tile.x0, tile.y0, tw, tile.y1);
+        // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop: where
+        // the tile has 8 pixels per triangle or more (as Gouraud's, BENCHMARKS.md, C4).
+        let isa = if tw * th >= 8 * tile.bin.len() {
+            self.plan.isa
+        } else {
+            Isa::PORTABLE
+        };
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque image.
         let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
+            if let Some(&ahead) = tile.bin.get(k + PREFETCH_AHEAD) {
+                prefetch(self.binned.tri(ahead));
+            }
             let scan = Scan::new(self.binned.tri(ti), k as u32, self.plan.pattern[0], (tile.x0, tile.x1));
             match self.plan.objects[self.binned.object(ti)].visibility {
                 Visibility::Blended => {
@@ -161,7 +171,16 @@ impl Tiles<'_> {
                     };
                     visible_single::<true, _>(scan, span, depth, ids, Some(forward), |_, _| true);
                 }
-                Visibility::Opaque => visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, |_, _| true),
+                Visibility::Opaque => {
+                    let mut buf = SampleBuffers {
+                        rect: (tile.x0, tile.y0, tile.x1, tile.y1),
+                        depth,
+                        ids,
+                    };
+                    if !single_visible(isa, scan.t, scan.id, scan.o, scan.cols, &mut buf) {
+                        visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, |_, _| true);
+                    }
+                }
             }
         }
         marks.shading();
