@@ -6,9 +6,12 @@
 //! are exact: a sample's sign test and its `e · inv_area` are the scalar loop's, bit for bit.
 
 use super::Isa;
+#[cfg(target_arch = "x86_64")]
 use super::tile::covered_span;
+#[cfg(target_arch = "x86_64")]
 use crate::fixed::each3;
 use crate::setup::Tri;
+#[cfg(target_arch = "x86_64")]
 use phong_core::limits::SUBPIXEL_BITS;
 
 /// A tile's sample buffers: per pixel (row-major, `x1 − x0` a row, origin `(x0, y0)`,
@@ -19,23 +22,31 @@ pub(crate) struct SampleBuffers<'a> {
     pub ids: &'a mut [u32],
 }
 
+impl SampleBuffers<'_> {
+    /// Panics unless the buffers hold `samples` a pixel over the whole tile: the kernels'
+    /// windows then stay inside them.
+    fn check(&self, samples: usize) {
+        let (x0, y0, x1, y1) = self.rect;
+        let n = (x1 - x0) as usize * (y1 - y0) as usize * samples;
+        assert!(
+            self.depth.len() >= n && self.ids.len() >= n,
+            "sample buffers smaller than the tile"
+        );
+    }
+}
+
 /// Triangle `t` (id `id`) drawn into `buf`'s samples: each covered sample (top-left rule)
 /// nearer than what it holds takes its depth and `id`. The AVX2 kernel, for patterns of 4, 8,
 /// 12 or 16 samples; returns false (nothing drawn) otherwise or with a portable `isa`.
 pub(crate) fn multi_visible(isa: Isa, t: &Tri, id: u32, pattern: &[(i64, i64)], buf: &mut SampleBuffers) -> bool {
+    buf.check(pattern.len());
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() && !pattern.is_empty() && pattern.len().is_multiple_of(4) && pattern.len() <= 16 {
-        let (x0, y0, x1, y1) = buf.rect;
-        let n = (x1 - x0) as usize * (y1 - y0) as usize * pattern.len();
-        assert!(
-            buf.depth.len() >= n && buf.ids.len() >= n,
-            "sample buffers smaller than the tile"
-        );
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         unsafe { multi_visible_avx2(t, id, pattern, buf) };
         return true;
     }
-    let _ = (isa, t, id, pattern, buf);
+    let _ = (isa, t, id, pattern);
     false
 }
 
@@ -124,19 +135,14 @@ pub(crate) fn single_visible(
     cols: (u32, u32),
     buf: &mut SampleBuffers,
 ) -> bool {
+    buf.check(1);
     #[cfg(target_arch = "x86_64")]
     if isa.is_avx2() {
-        let (x0, y0, x1, y1) = buf.rect;
-        let n = (x1 - x0) as usize * (y1 - y0) as usize;
-        assert!(
-            buf.depth.len() >= n && buf.ids.len() >= n,
-            "sample buffers smaller than the tile"
-        );
         // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA (`Isa::detect`).
         unsafe { single_visible_avx2(t, id, o, cols, buf) };
         return true;
     }
-    let _ = (isa, t, id, o, cols, buf);
+    let _ = (isa, t, id, o, cols);
     false
 }
 
