@@ -183,12 +183,7 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
                     let valid = 15u32 >> (col + 4 - row.len() as i64).max(0);
                     let inside = !outside & valid;
                     if inside != 0 {
-                        let l: [__m128; 3] =
-                            std::array::from_fn(|i| _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e[i], bias[i]), inv)));
-                        let zz = _mm_add_ps(
-                            _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
-                            _mm_mul_ps(l[2], z[2]),
-                        );
+                        let zz = window_depths(e, bias, inv, z);
                         let pass = depth_window(depth, line + col as usize, zz, inside, &mut covered);
                         if pass != 0 {
                             let c = col as usize;
@@ -219,6 +214,26 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
         }
     }
     covered
+}
+
+/// The depths of a window's 4 samples from their edge functions `e` (bias subtracted, exact
+/// integers in `f64`): barycentrics `(e + bias) · inv_area` rounded to `f32`, then
+/// `Σ l_i · z_i` unfused in the scalar loops' order, so the same bits as theirs.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+pub(super) fn window_depths(
+    e: [core::arch::x86_64::__m256d; 3],
+    bias: [core::arch::x86_64::__m256d; 3],
+    inv: core::arch::x86_64::__m256d,
+    z: [core::arch::x86_64::__m128; 3],
+) -> core::arch::x86_64::__m128 {
+    use core::arch::x86_64::*;
+    let l: [__m128; 3] = std::array::from_fn(|i| _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e[i], bias[i]), inv)));
+    _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
+        _mm_mul_ps(l[2], z[2]),
+    )
 }
 
 /// The depth test of the window of 4 pixels at `depth[at..]`: each `inside` lane whose depth

@@ -7,7 +7,7 @@
 
 use super::Isa;
 #[cfg(target_arch = "x86_64")]
-use super::tile::covered_span;
+use super::tile::{covered_span, window_depths};
 #[cfg(target_arch = "x86_64")]
 use crate::fixed::each3;
 use crate::setup::Tri;
@@ -90,29 +90,8 @@ fn multi_visible_avx2(t: &Tri, id: u32, pattern: &[(i64, i64)], buf: &mut Sample
                 if outside == 15 {
                     continue;
                 }
-                let l: [__m128; 3] =
-                    std::array::from_fn(|i| _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e[i], bias[i]), inv)));
-                // Unfused, in the scalar loop's order: the same bits.
-                let zz = _mm_add_ps(
-                    _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
-                    _mm_mul_ps(l[2], z[2]),
-                );
-                let at = base + 4 * g;
-                let (d4, i4) = (&mut buf.depth[at..at + 4], &mut buf.ids[at..at + 4]);
-                // Loaded by `lddqu` so that LLVM does not make the blends masked stores
-                // (BENCHMARKS.md, K1).
-                // SAFETY: `d4` is 4 readable f32.
-                let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
-                let pass = _mm_and_ps(_mm_cmplt_ps(zz, d), lanes(!outside & 15));
-                if _mm_movemask_ps(pass) != 0 {
-                    // SAFETY: `i4` is 4 readable u32.
-                    let old = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(i4.as_ptr().cast()) });
-                    // SAFETY: `d4` and `i4` are 4 writable f32 and u32.
-                    unsafe {
-                        _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, pass));
-                        _mm_storeu_ps(i4.as_mut_ptr().cast(), _mm_blendv_ps(old, idv, pass));
-                    }
-                }
+                let zz = window_depths(e, bias, inv, z);
+                window(buf, base + 4 * g, zz, !outside & 15, idv);
             }
             for i in 0..3 {
                 row[i] += step[i];
@@ -188,13 +167,7 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
             let outside = _mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(e[0], e[1]), e[2])) as u32;
             let inside = !outside & (15u32 >> (col + 4 - tw).max(0));
             if inside != 0 {
-                let l: [__m128; 3] =
-                    std::array::from_fn(|i| _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e[i], bias[i]), inv)));
-                let zz = _mm_add_ps(
-                    _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
-                    _mm_mul_ps(l[2], z[2]),
-                );
-                window(buf, line + col as usize, zz, inside, idv);
+                window(buf, line + col as usize, window_depths(e, bias, inv, z), inside, idv);
             }
             for i in 0..3 {
                 e[i] = _mm256_add_pd(e[i], step4[i]);
