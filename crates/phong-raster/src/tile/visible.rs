@@ -13,13 +13,13 @@ use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
 use crate::simd::{Isa, Planes, SampleBuffers, TilePixel, covered_span, multi_visible, prefetch, single_visible};
-
-/// How many triangles of a bin ahead the tiles ask for: its triangles are a
-/// sparse subset of the frame's records, which the hardware does not predict.
-const PREFETCH_AHEAD: usize = 8;
 use crate::stats::Marks;
 use crate::target::{Store, resolve};
 use phong_core::limits::SUBPIXEL_BITS;
+
+/// How many triangles of a bin ahead the tiles ask for their records: a bin's triangles are a
+/// sparse subset of the frame's, in an order the hardware does not predict.
+const PREFETCH_AHEAD: usize = 8;
 
 /// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
 pub(super) const FORWARD: u32 = u32::MAX - 1;
