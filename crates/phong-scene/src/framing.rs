@@ -150,10 +150,7 @@ pub fn scene_of_model(path: &Path, model: &ModelFile, options: &ModelOptions) ->
 /// diagonal; 1 for a model of one point), in the parts' coordinates: what `fit = true` maps to
 /// the origin and to 1.
 pub(crate) fn fit_of(parts: &[ModelPart]) -> Option<(DVec3, f64)> {
-    let (lo, hi) = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
+    let (lo, hi) = bounds_of(parts)?;
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let radius = (hi - lo).length() * 0.5;
     let radius = if radius > 0.0 && radius.is_finite() {
@@ -162,6 +159,14 @@ pub(crate) fn fit_of(parts: &[ModelPart]) -> Option<(DVec3, f64)> {
         1.0
     };
     Some(((lo + hi) * 0.5, radius))
+}
+
+/// The bounding box of a model's parts together (`None`: no vertices).
+fn bounds_of(parts: &[ModelPart]) -> Option<(Vec3, Vec3)> {
+    parts
+        .iter()
+        .filter_map(|p| p.mesh.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
 }
 
 /// The lights of a model alone, `(direction, grey level)` in the default view's camera frame
@@ -513,10 +518,7 @@ fn detect_front(
     closed: Closed,
 ) -> Option<(Vec3, &'static str)> {
     let r = u.cross(f);
-    let (lo, hi) = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))?;
+    let (lo, hi) = facets.bounds?;
     if !matches!(closed, Closed::Outward | Closed::Inward) {
         let Facets {
             area,
@@ -557,9 +559,10 @@ fn detect_front(
 /// its height hold at least 2% of its area, and 3 times the area that faces −y in its lowest
 /// 2% along y): z. Else y.
 fn detect_up(facets: &Facets) -> (Axis, Option<&'static str>) {
-    let Some(ext) = facets.extent else {
+    let Some((lo, hi)) = facets.bounds else {
         return (Axis::Y, None);
     };
+    let ext = hi.as_dvec3() - lo.as_dvec3();
     let Facets {
         total, base_z, base_y, ..
     } = *facets;
@@ -581,8 +584,8 @@ fn detect_up(facets: &Facets) -> (Axis, Option<&'static str>) {
 /// (in f64: a model's coordinates may be near f32's largest).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Facets {
-    /// The extent of the bounding box (`None`: no vertices).
-    extent: Option<DVec3>,
+    /// The bounding box ([`bounds_of`]).
+    bounds: Option<(Vec3, Vec3)>,
     /// Twice the area of the facets of positive area, and of those among them facing within
     /// 18° of −z (−y) with their centroid in the lowest 2% of the height along z (y).
     total: f64,
@@ -594,19 +597,15 @@ pub(crate) struct Facets {
 }
 
 fn facets(parts: &[ModelPart]) -> Facets {
-    let Some((lo, hi)) = parts
-        .iter()
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-    else {
+    let Some((lo, hi)) = bounds_of(parts) else {
         return Facets::default();
+    };
+    let mut sums = Facets {
+        bounds: Some((lo, hi)),
+        ..Facets::default()
     };
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let ext = hi - lo;
-    let mut sums = Facets {
-        extent: Some(ext),
-        ..Facets::default()
-    };
     for p in parts {
         let pos = p.mesh.positions();
         for t in p.mesh.triangles() {
