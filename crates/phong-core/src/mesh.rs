@@ -371,20 +371,7 @@ impl Mesh {
 
     /// [`Mesh::welded`] and, per vertex of `self`, its vertex in the welded mesh.
     fn weld(&self) -> (Mesh, Vec<u32>) {
-        let mut map: FxHashMap<[u32; 3], u32> =
-            FxHashMap::with_capacity_and_hasher(self.positions.len(), Default::default());
-        let mut positions = Vec::with_capacity(self.positions.len());
-        let remap: Vec<u32> = self
-            .positions
-            .iter()
-            .map(|p| {
-                let key = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
-                *map.entry(key).or_insert_with(|| {
-                    positions.push(*p);
-                    (positions.len() - 1) as u32
-                })
-            })
-            .collect();
+        let (positions, remap) = weld_positions(&self.positions);
         let triangles = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
         let normals = vec![Vec3::ZERO; positions.len()];
         let mesh = Mesh {
@@ -446,17 +433,17 @@ impl Mesh {
     /// [`Mesh::with_crease_normals`], and the work it did (facet comparisons), for the test
     /// that it is linear.
     fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
-        let w = self.weld().0;
+        let (positions, remap) = weld_positions(&self.positions);
+        let tris: Vec<[u32; 3]> = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
         let cos_crease = crease_deg.to_radians().cos();
-        let (facet, unit): (Vec<Vec3>, Vec<Vec3>) = w
-            .triangles
+        let facet: Vec<Vec3> = tris
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|i| w.positions[i as usize]);
-                let f = (b - a).cross(c - a);
-                (f, f.normalize_or_zero())
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                (b - a).cross(c - a)
             })
-            .unzip();
+            .collect();
+        let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
         // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
         // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
         // what the loop would.
@@ -465,94 +452,173 @@ impl Mesh {
             .then(|| ((crease_deg - 0.02) * 0.5).to_radians().cos());
         // Where corners carry nothing but their normal, a vertex of one normal is one vertex.
         let plain = self.uvs.is_empty() && self.uvs1.is_empty() && self.colors.is_empty();
-        let n = w.positions.len();
+        let n = positions.len();
         // Most vertices take `Rule::Same`, found in two passes over the faces; the faces
         // around each vertex and the other rules only for the rest.
-        let (same, count) = same_normals(&w, &facet, &unit, cos_half);
-        let mut work = 6 * w.triangles.len() as u64;
-        let rest = (0..n).filter(|&v| same[v] == Vec3::ZERO && count[v] > 0);
-        let around = (rest.clone().next().is_some()).then(|| Around::new(n, &w.triangles));
-        let mut slot = vec![u32::MAX; if around.is_some() { n } else { 0 }];
-        let mut rules = Vec::new();
+        let (same, count) = same_normals(n, &tris, &facet, &unit, cos_half);
+        let mut work = 6 * tris.len() as u64;
+        // Per vertex of the rest, its rule's index (u32::MAX: none).
+        let mut slot = vec![u32::MAX; n];
+        let mut rest = 0u32;
+        for ((s, m), &c) in slot.iter_mut().zip(&same).zip(&count) {
+            if *m == Vec3::ZERO && c > 0 {
+                *s = rest;
+                rest += 1;
+            }
+        }
+        let around = (rest > 0).then(|| Around::new(&slot, &count, rest as usize, &tris));
+        let mut rules = Vec::with_capacity(rest as usize);
         if let Some(around) = &around {
             let cosines = (cos_crease, cos_half);
-            for v in rest {
-                slot[v] = rules.len() as u32;
-                rules.push(vertex_rule(
-                    around.of(v),
-                    v as u32,
-                    &w.triangles,
-                    &facet,
-                    &unit,
-                    cosines,
-                    &mut work,
-                ));
+            for v in (0..n).filter(|&v| slot[v] != u32::MAX) {
+                let r = vertex_rule(around.of(slot[v]), v as u32, &tris, &facet, &unit, cosines, &mut work);
+                rules.push(r);
             }
         }
-        let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
+        let mut others = Others {
+            around,
+            rules,
+            slot,
+            memo: FxHashMap::default(),
+            facet: &facet,
+            unit: &unit,
+            cos_crease,
+            work,
+        };
         let mut out = CornerVertices::new(n);
-        let mut one = vec![u32::MAX; if plain { n } else { 0 }];
-        let mut triangles = Vec::with_capacity(w.triangles.len());
-        for (f, t) in w.triangles.iter().enumerate() {
-            if plain {
-                // The common case first: every corner's vertex already made.
-                let ids = t.map(|v| one[v as usize]);
-                if !ids.contains(&u32::MAX) {
-                    triangles.push(ids);
-                    continue;
-                }
-            }
-            let own = unit[f];
-            let mut tri = [0u32; 3];
-            // (A loop, not `t.map`: the closure was not inlined, its array moved per corner.)
-            for corner in 0..3 {
-                let v = t[corner];
-                // A corner keeps its own texture coordinates: vertices split where they differ.
-                let k = self.triangles[f][corner] as usize;
-                let mean = same[v as usize];
-                if mean != Vec3::ZERO {
-                    tri[corner] = if !plain {
-                        out.vertex(v, w.positions[v as usize], mean, self, k, false)
-                    } else {
-                        let i = &mut one[v as usize];
-                        if *i == u32::MAX {
-                            *i = out.alone(w.positions[v as usize], mean);
-                        }
-                        *i
-                    };
-                    continue;
-                }
-                let (around, rule) = match &around {
-                    Some(a) => (a, &rules[slot[v as usize] as usize]),
-                    None => unreachable!("a used vertex without Rule::Same has a rule"),
-                };
-                let n = match rule {
-                    Rule::Same(n) => *n,
-                    Rule::Plain => around
-                        .of(v as usize)
-                        .iter()
-                        .filter(|&&g| {
-                            work += 1;
-                            unit[g as usize].dot(own) >= cos_crease
-                        })
-                        .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
-                        .normalize_or_zero(),
-                    Rule::Directions(g) => *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
-                        work += g.len() as u64;
-                        g.iter()
-                            .filter(|(u, _)| u.dot(own) >= cos_crease)
-                            .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
-                            .normalize_or_zero()
-                    }),
-                    Rule::Edges(groups) => groups[&(f as u32)],
-                };
-                let many = matches!(rule, Rule::Directions(_) | Rule::Edges(_));
-                tri[corner] = out.vertex(v, w.positions[v as usize], n, self, k, many);
-            }
-            triangles.push(tri);
-        }
-        (out.mesh(triangles), work)
+        let triangles: Vec<[u32; 3]> = if plain {
+            // Per welded vertex of one normal, its vertex (u32::MAX: not yet made).
+            let mut one = vec![u32::MAX; n];
+            tris.iter()
+                .enumerate()
+                .map(|(f, t)| {
+                    let mut tri = [0u32; 3];
+                    // (A loop, not `t.map`: the closure was not inlined, its array moved per
+                    // corner.)
+                    for corner in 0..3 {
+                        let v = t[corner] as usize;
+                        tri[corner] = if one[v] != u32::MAX {
+                            one[v]
+                        } else if same[v] != Vec3::ZERO {
+                            one[v] = out.alone(positions[v], same[v]);
+                            one[v]
+                        } else {
+                            let (normal, many) = others.normal(v as u32, f);
+                            out.vertex(v as u32, positions[v], normal, self, 0, many)
+                        };
+                    }
+                    tri
+                })
+                .collect()
+        } else {
+            tris.iter()
+                .enumerate()
+                .map(|(f, t)| {
+                    let mut tri = [0u32; 3];
+                    for corner in 0..3 {
+                        let v = t[corner];
+                        let (normal, many) = match same[v as usize] {
+                            m if m != Vec3::ZERO => (m, false),
+                            _ => others.normal(v, f),
+                        };
+                        // A corner keeps its own texture coordinates: vertices split where
+                        // they differ.
+                        let k = self.triangles[f][corner] as usize;
+                        tri[corner] = out.vertex(v, positions[v as usize], normal, self, k, many);
+                    }
+                    tri
+                })
+                .collect()
+        };
+        (out.mesh(triangles), others.work)
     }
+}
+
+/// The vertices without `Rule::Same`: the faces around them, their rules, and what the
+/// rules need.
+struct Others<'a> {
+    around: Option<Around>,
+    rules: Vec<Rule>,
+    /// Per welded vertex, its rule's index in `rules` and its slot in `around` (u32::MAX:
+    /// a vertex of `Rule::Same`).
+    slot: Vec<u32>,
+    memo: FxHashMap<(u32, [u32; 3]), Vec3>,
+    facet: &'a [Vec3],
+    unit: &'a [Vec3],
+    cos_crease: f32,
+    /// Facet comparisons made.
+    work: u64,
+}
+
+impl Others<'_> {
+    /// The normal of face `f`'s corner at vertex `v`, and whether `v`'s vertices are many
+    /// (looked up by hash, not by chain).
+    fn normal(&mut self, v: u32, f: usize) -> (Vec3, bool) {
+        let own = self.unit[f];
+        let (around, rule) = match &self.around {
+            Some(a) => (a, &self.rules[self.slot[v as usize] as usize]),
+            None => unreachable!("a used vertex without Rule::Same has a rule"),
+        };
+        let (unit, facet, cos_crease, work) = (self.unit, self.facet, self.cos_crease, &mut self.work);
+        let n = match rule {
+            Rule::Same(n) => *n,
+            Rule::Plain => around
+                .of(self.slot[v as usize])
+                .iter()
+                .filter(|&&g| {
+                    *work += 1;
+                    unit[g as usize].dot(own) >= cos_crease
+                })
+                .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                .normalize_or_zero(),
+            Rule::Directions(g) => *self
+                .memo
+                .entry((v, own.to_array().map(f32::to_bits)))
+                .or_insert_with(|| {
+                    *work += g.len() as u64;
+                    g.iter()
+                        .filter(|(u, _)| u.dot(own) >= cos_crease)
+                        .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
+                        .normalize_or_zero()
+                }),
+            Rule::Edges(groups) => groups[&(f as u32)],
+        };
+        (n, matches!(rule, Rule::Directions(_) | Rule::Edges(_)))
+    }
+}
+
+/// Positions merged where they are equal (0 and −0 alike), in the order first met, and per
+/// position its merged index. An open-addressing table of indices sized for the positions
+/// (at most half full): a third of the instructions of a hash map's entry per position.
+fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+    let size = (points.len() * 2).next_power_of_two().max(16);
+    let shift = 64 - size.trailing_zeros();
+    let mut table = vec![u32::MAX; size];
+    let mut keys: Vec<[u32; 3]> = Vec::with_capacity(points.len());
+    let mut merged = Vec::with_capacity(points.len());
+    let mut remap = Vec::with_capacity(points.len());
+    for p in points {
+        let k = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let h = (u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        let mut i = (h.wrapping_mul(0x2545_F491_4F6C_DD1D) >> shift) as usize;
+        let index = loop {
+            let e = table[i];
+            if e == u32::MAX {
+                let e = keys.len() as u32;
+                table[i] = e;
+                keys.push(k);
+                merged.push(*p);
+                break e;
+            }
+            if keys[e as usize] == k {
+                break e;
+            }
+            i = (i + 1) & (size - 1);
+        };
+        remap.push(index);
+    }
+    (merged, remap)
 }
 
 /// Faces at a vertex up to which the mean direction may stand for all of them
@@ -563,17 +629,22 @@ const MANY: usize = 32;
 /// give it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
 /// `cos_half`), else zero; and its number of corners. The facets are summed per vertex in
 /// face order, as [`vertex_rule`] sums them: the same bits, without the faces-around lists.
-fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) -> (Vec<Vec3>, Vec<u32>) {
-    let n = w.positions.len();
+fn same_normals(
+    n: usize,
+    tris: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    cos_half: Option<f32>,
+) -> (Vec<Vec3>, Vec<u32>) {
     let mut mean = vec![Vec3::ZERO; n];
     let mut count = vec![0u32; n];
     let Some(cos_half) = cos_half else {
-        for &v in w.triangles.iter().flatten() {
+        for &v in tris.iter().flatten() {
             count[v as usize] += 1;
         }
         return (mean, count);
     };
-    for (t, f) in w.triangles.iter().zip(facet) {
+    for (t, f) in tris.iter().zip(facet) {
         for &v in t {
             mean[v as usize] += *f;
             count[v as usize] += 1;
@@ -586,7 +657,7 @@ fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) 
             m.normalize_or_zero()
         };
     }
-    for (t, u) in w.triangles.iter().zip(unit) {
+    for (t, u) in tris.iter().zip(unit) {
         for &v in t {
             let m = &mut mean[v as usize];
             // (`!(a >= b)`: a NaN fails the test, as in `vertex_rule`.)
@@ -599,37 +670,41 @@ fn same_normals(w: &Mesh, facet: &[Vec3], unit: &[Vec3], cos_half: Option<f32>) 
     (mean, count)
 }
 
-/// The faces around each vertex, in face order: `of(v)` is `faces[start[v]..start[v + 1]]`
-/// (one allocation, not one per vertex).
+/// The faces around some of the vertices, in face order: those of the vertex of slot `k`
+/// are `faces[start[k]..start[k + 1]]` (one allocation, not one per vertex).
 struct Around {
     start: Vec<u32>,
     faces: Vec<u32>,
 }
 
 impl Around {
-    fn new(vertices: usize, triangles: &[[u32; 3]]) -> Around {
-        let mut start = vec![0u32; vertices + 1];
-        for t in triangles {
-            for &i in t {
-                start[i as usize + 1] += 1;
+    /// The faces around each vertex `v` with `slot[v] != u32::MAX` (`slots` of them, in the
+    /// order of the vertices), each vertex with `count[v]` corners.
+    fn new(slot: &[u32], count: &[u32], slots: usize, triangles: &[[u32; 3]]) -> Around {
+        let mut start = Vec::with_capacity(slots + 1);
+        start.push(0u32);
+        for (&k, &c) in slot.iter().zip(count) {
+            if k != u32::MAX {
+                start.push(start[k as usize] + c);
             }
         }
-        for v in 0..vertices {
-            start[v + 1] += start[v];
-        }
-        let mut faces = vec![0u32; triangles.len() * 3];
+        let mut faces = vec![0u32; start[slots] as usize];
         let mut fill = start.clone();
         for (f, t) in triangles.iter().enumerate() {
             for &i in t {
-                faces[fill[i as usize] as usize] = f as u32;
-                fill[i as usize] += 1;
+                let k = slot[i as usize];
+                if k != u32::MAX {
+                    faces[fill[k as usize] as usize] = f as u32;
+                    fill[k as usize] += 1;
+                }
             }
         }
         Around { start, faces }
     }
 
-    fn of(&self, v: usize) -> &[u32] {
-        &self.faces[self.start[v] as usize..self.start[v + 1] as usize]
+    /// The faces around the vertex of slot `k`.
+    fn of(&self, k: u32) -> &[u32] {
+        &self.faces[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
     }
 }
 
@@ -688,10 +763,10 @@ struct CornerVertices {
     uvs: Vec<Vec2>,
     uvs1: Vec<Vec2>,
     colors: Vec<Color>,
-    keys: Vec<CornerKey>,
-    /// Per welded position, its first vertex (u32::MAX: none yet); per vertex, the next.
+    /// The chains: per link, the vertex's key, the vertex and the next link.
+    links: Vec<(CornerKey, u32, u32)>,
+    /// Per welded position, its chain's first link (u32::MAX: none yet).
     head: Vec<u32>,
-    next: Vec<u32>,
     many: FxHashMap<(u32, CornerKey), u32>,
 }
 
@@ -699,15 +774,16 @@ type CornerKey = ([u32; 3], [[u32; 2]; 2], [u32; 3]);
 
 impl CornerVertices {
     fn new(welded: usize) -> CornerVertices {
+        // Room for a few split vertices without a copy.
+        let room = welded + welded / 16;
         CornerVertices {
-            positions: Vec::with_capacity(welded),
-            normals: Vec::with_capacity(welded),
+            positions: Vec::with_capacity(room),
+            normals: Vec::with_capacity(room),
             uvs: Vec::new(),
             uvs1: Vec::new(),
             colors: Vec::new(),
-            keys: Vec::with_capacity(welded),
+            links: Vec::new(),
             head: vec![u32::MAX; welded],
-            next: Vec::with_capacity(welded),
             many: FxHashMap::default(),
         }
     }
@@ -718,8 +794,6 @@ impl CornerVertices {
         let i = self.positions.len() as u32;
         self.positions.push(p);
         self.normals.push(n);
-        self.keys.push(Default::default());
-        self.next.push(u32::MAX);
         i
     }
 
@@ -739,12 +813,13 @@ impl CornerVertices {
                 return i;
             }
         } else {
-            let mut i = self.head[v as usize];
-            while i != u32::MAX {
-                if self.keys[i as usize] == key {
-                    return i;
+            let mut l = self.head[v as usize];
+            while l != u32::MAX {
+                let (k, i, next) = &self.links[l as usize];
+                if *k == key {
+                    return *i;
                 }
-                i = self.next[i as usize];
+                l = *next;
             }
         }
         let i = self.positions.len() as u32;
@@ -753,13 +828,11 @@ impl CornerVertices {
         self.uvs.extend(uv);
         self.uvs1.extend(uv1);
         self.colors.extend(color);
-        self.keys.push(key);
         if many {
             self.many.insert((v, key), i);
-            self.next.push(u32::MAX);
         } else {
-            self.next.push(self.head[v as usize]);
-            self.head[v as usize] = i;
+            self.links.push((key, i, self.head[v as usize]));
+            self.head[v as usize] = (self.links.len() - 1) as u32;
         }
         i
     }
