@@ -590,7 +590,7 @@ impl Others<'_> {
 /// Positions merged where they are equal (0 and −0 alike), in the order first met, and per
 /// position its merged index. An open-addressing table of indices sized for the positions
 /// (at most half full): a third of the instructions of a hash map's entry per position.
-fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let size = (points.len() * 2).next_power_of_two().max(16);
     let shift = 64 - size.trailing_zeros();
     let mut table = vec![u32::MAX; size];

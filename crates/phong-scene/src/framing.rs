@@ -8,7 +8,6 @@
 
 use crate::{Error, Loaded, ModelFile, ModelFormat, ModelPart};
 use glam::{DVec3, Vec3};
-use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// An axis, signed: the model's up (`--up`).
@@ -661,22 +660,28 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     if count > MAX_CLOSED_CHECK {
         return Closed::Unchecked;
     }
-    let mut ids: FxHashMap<[u32; 3], u32> =
-        FxHashMap::with_capacity_and_hasher(parts.iter().map(|p| p.mesh.positions().len()).sum(), Default::default());
+    // Positions welded (one id where parts or vertices share a position), all parts at once.
+    let (welded, ids) = match parts {
+        [p] => phong_core::mesh::weld_positions(p.mesh.positions()),
+        _ => phong_core::mesh::weld_positions(
+            &parts
+                .iter()
+                .flat_map(|p| p.mesh.positions())
+                .copied()
+                .collect::<Vec<_>>(),
+        ),
+    };
+    let distinct = welded.len();
     // Each face's edges (x, y) as (higher id, +1 or -1), kept under the lower id; a closed,
     // consistent model has two faces on every edge, wound opposite ways. Lists under each id
     // (counted first, then filled), not a hash map of edges: linear, and a few times faster.
     let mut halves: Vec<(u32, u32, i32)> = Vec::with_capacity(count * 3);
     let mut volume = 0.0f64;
+    let mut first = 0;
     for p in parts {
         let pos = p.mesh.positions();
-        let id: Vec<u32> = pos
-            .iter()
-            .map(|v| {
-                let n = ids.len() as u32;
-                *ids.entry(v.to_array().map(|x| (x + 0.0).to_bits())).or_insert(n)
-            })
-            .collect();
+        let id = &ids[first..first + pos.len()];
+        first += pos.len();
         for t in p.mesh.triangles() {
             let [a, b, c] = t.map(|i| id[i as usize]);
             if a == b || b == c || c == a {
@@ -689,11 +694,11 @@ fn closedness(parts: &[ModelPart]) -> Closed {
             }
         }
     }
-    let mut start = vec![0u32; ids.len() + 1];
+    let mut start = vec![0u32; distinct + 1];
     for &(lo, _, _) in &halves {
         start[lo as usize + 1] += 1;
     }
-    for i in 0..ids.len() {
+    for i in 0..distinct {
         start[i + 1] += start[i];
     }
     let mut under = vec![(0u32, 0i32); halves.len()];
@@ -705,7 +710,7 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     // Per list, the faces on each edge counted in `on` (indexed by the higher id), then each
     // edge judged once and its count cleared: linear, no sort.
     let (mut open_edges, mut inconsistent) = (0, 0);
-    let mut on = vec![(0u32, 0i32); ids.len()];
+    let mut on = vec![(0u32, 0i32); distinct];
     for w in start.windows(2) {
         let list = &under[w[0] as usize..w[1] as usize];
         for &(hi, sign) in list {
