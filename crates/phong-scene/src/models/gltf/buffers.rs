@@ -62,10 +62,15 @@ pub(super) fn load_buffers<'b>(
 pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<[f32; 3]>> {
     let (bytes, kind) = packed(&prim.get(&::gltf::Semantic::Positions)?, buffers)?;
     (kind == ::gltf::accessor::DataType::F32).then(|| {
-        bytes
-            .chunks_exact(12)
-            .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
-            .collect()
+        if cfg!(target_endian = "little") {
+            // The file's bytes are the floats (a copy, aligned).
+            bytemuck::pod_collect_to_vec(bytes)
+        } else {
+            bytes
+                .chunks_exact(12)
+                .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
+                .collect()
+        }
     })
 }
 
@@ -73,6 +78,7 @@ pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Buffer]) -> 
 pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<u32>> {
     let (b, kind) = packed(&prim.indices()?, buffers)?;
     match kind {
+        ::gltf::accessor::DataType::U32 if cfg!(target_endian = "little") => Some(bytemuck::pod_collect_to_vec(b)),
         ::gltf::accessor::DataType::U32 => Some(
             b.chunks_exact(4)
                 .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))

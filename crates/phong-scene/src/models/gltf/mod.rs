@@ -312,9 +312,48 @@ fn check_primitive(
     Ok(normal.is_some())
 }
 
+/// A primitive's positions in world space.
+enum Placed {
+    /// The file's own, its node's transform the identity (most files).
+    File(Vec<Vec3>),
+    /// Moved by its node's transform, in f64.
+    World(Vec<DVec3>),
+}
+
+impl Placed {
+    /// A node without a transform: what the identity gives in f64, without the f64 (the same
+    /// numbers, a zero's sign made + as adding the matrix's translation makes it).
+    fn file(positions: &[[f32; 3]]) -> Placed {
+        Placed::File(positions.iter().map(|p| Vec3::from_array(*p) + Vec3::ZERO).collect())
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            Placed::File(p) => p.len(),
+            Placed::World(p) => p.len(),
+        }
+    }
+
+    fn f64s(&self) -> impl Iterator<Item = DVec3> + '_ {
+        let (file, world) = match self {
+            Placed::File(p) => (&p[..], &[][..]),
+            Placed::World(p) => (&[][..], &p[..]),
+        };
+        file.iter().map(|p| p.as_dvec3()).chain(world.iter().copied())
+    }
+
+    /// The positions less `origin`, in f32.
+    fn less(self, origin: DVec3) -> Vec<Vec3> {
+        match self {
+            Placed::File(p) if origin == DVec3::ZERO => p,
+            p => p.f64s().map(|w| (w - origin).as_vec3()).collect(),
+        }
+    }
+}
+
 /// A primitive's geometry in world space.
 struct Geometry {
-    world_pos: Vec<DVec3>,
+    world_pos: Placed,
     normals: Vec<Vec3>,
     has_normals: bool,
     tris: Vec<[u32; 3]>,
@@ -387,10 +426,16 @@ fn geometry(
     if mirrored {
         tris.iter_mut().for_each(|t| t.swap(1, 2));
     }
-    let world_pos: Vec<DVec3> = positions
-        .iter()
-        .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
-        .collect();
+    let placed = if *world == DMat4::IDENTITY {
+        Placed::file(&positions)
+    } else {
+        Placed::World(
+            positions
+                .iter()
+                .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
+                .collect(),
+        )
+    };
     let (normals, has_normals) = match reader.read_normals().filter(|_| has_normal_accessor) {
         Some(ns) => {
             let ns: Vec<Vec3> = ns
@@ -430,7 +475,7 @@ fn geometry(
         _ => Vec::new(),
     };
     Ok(Geometry {
-        world_pos,
+        world_pos: placed,
         normals,
         has_normals,
         tris,
@@ -563,11 +608,11 @@ impl Textures<'_> {
 /// The parts of the read primitives, the whole model re-centred together (one origin for
 /// every part).
 fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<Vec<ModelPart>, Error> {
-    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.iter().copied()));
+    let origin = far_origin(pending.iter().flat_map(|p| p.world_pos.f64s()));
     pending
         .into_iter()
         .map(|p| {
-            let positions: Vec<Vec3> = p.world_pos.iter().map(|w| (*w - origin).as_vec3()).collect();
+            let positions = p.world_pos.less(origin);
             let mesh = Mesh::new(positions, p.normals, p.tris)
                 .and_then(|m| m.with_uvs(p.uvs))
                 .and_then(|m| m.with_uvs1(p.uvs1))
@@ -631,7 +676,7 @@ struct Pending {
     uvs1: Vec<Vec2>,
     colors: Vec<Color>,
     maps: Maps,
-    world_pos: Vec<DVec3>,
+    world_pos: Placed,
     normals: Vec<Vec3>,
     tris: Vec<[u32; 3]>,
     material: Option<Material>,
@@ -823,4 +868,36 @@ fn texture_request(tex: &Tex, buffers: &[Buffer], what: &str) -> Option<MapReque
         green_down: false,
         set: u8::from(tex.set == 1),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node without a transform keeps the file's floats as the f64 transform gives them,
+    /// a zero's sign included, re-centred or not.
+    #[test]
+    fn identity_placement_is_the_f64_transform() {
+        let file = [
+            [-0.0f32, 0.0, -0.0],
+            [1.5, -2.25e-7, 3.0e30],
+            [-0.0, -0.0, -0.0],
+            [f32::MIN_POSITIVE / 4.0, -1.0e-38, 7.0],
+        ];
+        let f64_way = |origin: DVec3| -> Vec<[u32; 3]> {
+            file.iter()
+                .map(|p| (DMat4::IDENTITY.transform_point3(DVec3::from_array(p.map(f64::from))) - origin).as_vec3())
+                .map(|v| v.to_array().map(f32::to_bits))
+                .collect()
+        };
+        let placed = || Placed::file(&file);
+        for origin in [DVec3::ZERO, DVec3::new(1.0e6, -2.0, 0.5)] {
+            let ours: Vec<[u32; 3]> = placed()
+                .less(origin)
+                .iter()
+                .map(|v| v.to_array().map(f32::to_bits))
+                .collect();
+            assert_eq!(ours, f64_way(origin), "origin {origin}");
+        }
+    }
 }
