@@ -436,14 +436,7 @@ impl Mesh {
         let (positions, remap) = weld_positions(&self.positions);
         let tris: Vec<[u32; 3]> = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
         let cos_crease = crease_deg.to_radians().cos();
-        let facet: Vec<Vec3> = tris
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| positions[i as usize]);
-                (b - a).cross(c - a)
-            })
-            .collect();
-        let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+        let (facet, unit) = facets_of(&positions, &tris);
         // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
         // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
         // what the loop would.
@@ -629,6 +622,20 @@ const MANY: usize = 32;
 /// give it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
 /// `cos_half`), else zero; and its number of corners. The facets are summed per vertex in
 /// face order, as [`vertex_rule`] sums them: the same bits, without the faces-around lists.
+/// Each face's facet normal `(b − a) × (c − a)` (its length twice its area) and that
+/// normal's unit vector (zero for a degenerate face).
+fn facets_of(positions: &[Vec3], tris: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
+    let facet: Vec<Vec3> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            (b - a).cross(c - a)
+        })
+        .collect();
+    let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+    (facet, unit)
+}
+
 fn same_normals(
     n: usize,
     tris: &[[u32; 3]],
