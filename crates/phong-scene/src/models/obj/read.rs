@@ -139,38 +139,57 @@ struct Groups {
 /// 10^22 for f64, 2^24 and 10^10 for f32), so one division rounds correctly (Clinger's fast
 /// path); the f32 is parsed apart where its fast path does not hold.
 fn plain_decimal(word: &str) -> Option<(f64, f32)> {
+    plain_decimal_bytes(word.as_bytes())
+}
+
+/// [`plain_decimal`] of a word's bytes.
+fn plain_decimal_bytes(b: &[u8]) -> Option<(f64, f32)> {
     const POW10: [f64; 23] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
         1e20, 1e21, 1e22,
     ];
     const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
-    let b = word.as_bytes();
     let negative = b.first() == Some(&b'-');
     let body = &b[usize::from(negative || b.first() == Some(&b'+'))..];
     if body.is_empty() || body.len() > 20 {
         return None;
     }
-    let (mut m, mut digits, mut fraction, mut point) = (0u64, 0u32, 0usize, false);
-    for &c in body {
-        match c {
-            b'0'..=b'9' => {
-                m = m * 10 + u64::from(c - b'0');
-                digits += 1;
-                fraction += usize::from(point);
-            }
-            b'.' if !point => point = true,
-            _ => return None,
-        }
+    // The digits before the point, then those after it, into one mantissa (at most 20
+    // digits: wrapping where 20 overflow, and refused below).
+    let digit = |c: u8| c.wrapping_sub(b'0');
+    let mut m = 0u64;
+    let mut i = 0;
+    while i < body.len() && digit(body[i]) < 10 {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+        i += 1;
     }
-    if digits == 0 || digits > 19 || m > 1 << 53 || fraction >= POW10.len() {
+    let whole = i;
+    let mut fraction = 0;
+    if i < body.len() && body[i] == b'.' {
+        i += 1;
+        let start = i;
+        while i < body.len() && digit(body[i]) < 10 {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+            i += 1;
+        }
+        fraction = i - start;
+    }
+    let digits = whole + fraction;
+    if i < body.len() || digits == 0 || digits > 19 || m > 1 << 53 || fraction >= POW10.len() {
         return None;
     }
     let sign = if negative { -1.0 } else { 1.0 };
     let x = sign * (m as f64 / POW10[fraction]);
     let f = if m <= 1 << 24 && fraction < POW10_F32.len() {
         sign as f32 * (m as f32 / POW10_F32[fraction])
+    } else if (x.to_bits() & 0x1FFF_FFFF).abs_diff(0x1000_0000) > 1 {
+        // The f64 is the value correctly rounded (within half its last place); rounding it
+        // to f32 rounds the value itself unless the 29 bits it drops lie at a halfway point,
+        // give or take that half place.
+        x as f32
     } else {
-        word.parse::<f32>().ok()?
+        // (ASCII: a sign, digits and a point.)
+        std::str::from_utf8(b).ok()?.parse::<f32>().ok()?
     };
     Some((x, f))
 }
@@ -390,6 +409,58 @@ impl<'a> Reader<'a> {
         }
         self.arities.push((w.len() - 1) as u32);
         Ok(())
+    }
+
+    /// A `v` of three plain decimals (`rest`: after `v `, words apart by spaces) as
+    /// [`Reader::vertex`] reads it; false, nothing read, for any other.
+    fn plain_vertex(&mut self, rest: &[u8]) -> bool {
+        let mut xs = [0.0f64; 3];
+        let mut own = [0.0f32; 3];
+        let mut n = 0;
+        for word in rest.split(|&c| c == b' ').filter(|w| !w.is_empty()) {
+            if n == 3 {
+                return false;
+            }
+            match plain_decimal_bytes(word) {
+                Some((x, f)) => (xs[n], own[n]) = (x, f),
+                None => return false,
+            }
+            n += 1;
+        }
+        if n < 3 {
+            return false;
+        }
+        self.seven = false;
+        self.xyz.push(DVec3::from_array(xs));
+        self.direct.push(own);
+        self.colours.push([0.0; 3]);
+        true
+    }
+
+    /// An `f` of three to eight plain positive vertex indices, each naming a vertex defined
+    /// so far (`rest`: after `f `, words apart by spaces), as [`Reader::face`] reads it;
+    /// false, nothing read, for any other.
+    fn plain_face(&mut self, rest: &[u8]) -> bool {
+        let count = self.base[0] + self.xyz.len() as i64;
+        let mut corners = [0u32; 8];
+        let mut n = 0;
+        for word in rest.split(|&c| c == b' ').filter(|w| !w.is_empty()) {
+            if n == corners.len() || word.len() > 18 || !word.iter().all(u8::is_ascii_digit) {
+                return false;
+            }
+            let v = word.iter().fold(0i64, |v, &c| v * 10 + i64::from(c - b'0'));
+            if v < 1 || v > count {
+                return false;
+            }
+            corners[n] = (v - 1) as u32;
+            n += 1;
+        }
+        if n < 3 {
+            return false;
+        }
+        self.corners.extend(corners[..n].iter().map(|&v| [v, MISSING, MISSING]));
+        self.arities.push(n as u32);
+        true
     }
 
     /// A group or material statement, kept for the replay.
@@ -628,7 +699,9 @@ fn read_in_chunks(
     } else {
         // The vertex statements before each run, then the runs read side by side (the first
         // on this thread).
-        let counts = side_by_side(&runs, |run| vertex_counts(&src[run.0..run.1]));
+        // (The last run's count is no run's base.)
+        let mut counts = side_by_side(&runs[..runs.len() - 1], |run| vertex_counts(&src[run.0..run.1]));
+        counts.push([0; 3]);
         let mut base = [0i64; 3];
         let bases: Vec<(usize, usize, [i64; 3])> = runs
             .iter()
@@ -772,6 +845,17 @@ fn statements<'a>(r: &mut Reader<'a>, run: (usize, usize)) -> Result<(), Error> 
     let src = r.src;
     let mut w: Vec<(usize, &str)> = Vec::with_capacity(16);
     for (start, line) in lines(&src[run.0..run.1]) {
+        // The commonest lines (`v x y z` of plain decimals, `f a b c` of plain indices) read
+        // without splitting them into words: what the general path would read.
+        if let [kw @ (b'v' | b'f'), b' ', rest @ ..] = line.as_bytes()
+            && (if *kw == b'v' {
+                r.plain_vertex(rest)
+            } else {
+                r.plain_face(rest)
+            })
+        {
+            continue;
+        }
         words(line, &mut w);
         if w.is_empty() {
             continue;
@@ -972,12 +1056,44 @@ mod tests {
             }
         }
 
+        /// Decimals of up to 19 digits, the f32 by way of the f64 where its fast path does
+        /// not hold, as `parse` reads them.
+        #[test]
+        fn long_plain_decimals_read_as_parse_reads_them(m in 0u64..(1 << 53), point in 0usize..20, negative in any::<bool>()) {
+            let digits = m.to_string();
+            let point = point.min(digits.len());
+            let word = format!("{}{}.{}", if negative { "-" } else { "" }, &digits[..digits.len() - point], &digits[digits.len() - point..]);
+            if let Some((x, f)) = plain_decimal(&word) {
+                prop_assert_eq!(x.to_bits(), word.parse::<f64>().unwrap().to_bits(), "{}", word);
+                prop_assert_eq!(f.to_bits(), word.parse::<f32>().unwrap().to_bits(), "{}", word);
+            }
+        }
+
         /// The plain indices' shortcut gives what `parse` gives.
         #[test]
         fn plain_indices_read_as_parse_reads_them(word in "-?[0-9]{1,20}") {
             if let Some(v) = plain_index(&word) {
                 prop_assert_eq!(Some(v), word.parse::<i64>().ok());
             }
+        }
+    }
+
+    /// Decimals halfway between two f32 (2^24 + 1 and its like), where the f64 cannot say
+    /// which way the f32 rounds: as `parse` reads them.
+    #[test]
+    fn halfway_decimals_read_as_parse_reads_them() {
+        for word in [
+            "16777217",
+            "16777219",
+            "-33554434",
+            "1677721.7",
+            "0.16777217",
+            "8388608.5",
+            "100000001",
+        ] {
+            let (x, f) = plain_decimal(word).expect(word);
+            assert_eq!(x.to_bits(), word.parse::<f64>().unwrap().to_bits(), "{word}");
+            assert_eq!(f.to_bits(), word.parse::<f32>().unwrap().to_bits(), "{word}");
         }
     }
 

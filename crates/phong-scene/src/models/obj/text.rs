@@ -82,13 +82,16 @@ pub(super) fn join_continuations(src: &str) -> std::borrow::Cow<'_, str> {
 }
 
 pub(super) fn lines(src: &str) -> impl Iterator<Item = (usize, &str)> {
+    // One searcher over the text (a search per line set itself up per line), and the last
+    // line where the text does not end in a newline.
+    let mut ends = memchr::memchr_iter(b'\n', src.as_bytes()).map(|i| i + 1);
     let mut off = 0;
     std::iter::from_fn(move || {
         if off >= src.len() {
             return None;
         }
         let start = off;
-        off = memchr::memchr(b'\n', &src.as_bytes()[start..]).map_or(src.len(), |i| start + i + 1);
+        off = ends.next().unwrap_or(src.len());
         Some((start, src[start..off].trim_end_matches(['\n', '\r'])))
     })
 }
