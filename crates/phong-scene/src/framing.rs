@@ -674,39 +674,43 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     let distinct = welded.len();
     // Each face's edges (x, y) as (higher id, +1 or -1), kept under the lower id; a closed,
     // consistent model has two faces on every edge, wound opposite ways. Lists under each id
-    // (counted first, then filled), not a hash map of edges: linear, and a few times faster.
-    let mut halves: Vec<(u32, u32, i32)> = Vec::with_capacity(count * 3);
-    let mut volume = 0.0f64;
-    let mut first = 0;
-    for p in parts {
-        let pos = p.mesh.positions();
-        let id = &ids[first..first + pos.len()];
-        first += pos.len();
-        for t in p.mesh.triangles() {
-            let [a, b, c] = t.map(|i| id[i as usize]);
-            if a == b || b == c || c == a {
-                continue;
-            }
-            let [pa, pb, pc] = t.map(|i| pos[i as usize].as_dvec3());
-            volume += pa.dot(pb.cross(pc));
-            for (x, y) in [(a, b), (b, c), (c, a)] {
-                halves.push(if x < y { (x, y, 1) } else { (y, x, -1) });
+    // (counted in a first pass over the faces, filled in a second), not a hash map of edges:
+    // linear, and a few times faster.
+    // Each face with three distinct ids: its ids and its positions.
+    let faces = |f: &mut dyn FnMut([u32; 3], [Vec3; 3])| {
+        let mut first = 0;
+        for p in parts {
+            let pos = p.mesh.positions();
+            let id = &ids[first..first + pos.len()];
+            first += pos.len();
+            for t in p.mesh.triangles() {
+                let [a, b, c] = t.map(|i| id[i as usize]);
+                if a != b && b != c && c != a {
+                    f([a, b, c], t.map(|i| pos[i as usize]));
+                }
             }
         }
-    }
+    };
     let mut start = vec![0u32; distinct + 1];
-    for &(lo, _, _) in &halves {
-        start[lo as usize + 1] += 1;
-    }
+    let mut volume = 0.0f64;
+    faces(&mut |[a, b, c], [pa, pb, pc]| {
+        volume += pa.as_dvec3().dot(pb.as_dvec3().cross(pc.as_dvec3()));
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            start[x.min(y) as usize + 1] += 1;
+        }
+    });
     for i in 0..distinct {
         start[i + 1] += start[i];
     }
-    let mut under = vec![(0u32, 0i32); halves.len()];
+    let mut under = vec![(0u32, 0i32); start[distinct] as usize];
     let mut fill = start.clone();
-    for &(lo, hi, sign) in &halves {
-        under[fill[lo as usize] as usize] = (hi, sign);
-        fill[lo as usize] += 1;
-    }
+    faces(&mut |[a, b, c], _| {
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            let (lo, hi, sign) = if x < y { (x, y, 1) } else { (y, x, -1) };
+            under[fill[lo as usize] as usize] = (hi, sign);
+            fill[lo as usize] += 1;
+        }
+    });
     // Per list, the faces on each edge counted in `on` (indexed by the higher id), then each
     // edge judged once and its count cleared: linear, no sort.
     let (mut open_edges, mut inconsistent) = (0, 0);
