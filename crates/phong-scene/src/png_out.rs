@@ -104,7 +104,8 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     Ok(())
 }
 
-/// The PNG file of `bytes`: fast compression (encoding time dominated the write).
+/// The PNG file of `bytes`: fast compression (encoding time dominated the write), every row
+/// filtered by Paeth (BENCHMARKS.md, C13).
 fn encode(
     (width, height): (u32, u32),
     bytes: &[u8],
@@ -122,6 +123,7 @@ fn encode(
         });
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Fast);
+        enc.set_filter(png::Filter::Paeth);
         if encoding == Encoding::Srgb {
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         }
