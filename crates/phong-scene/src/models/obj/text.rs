@@ -1,5 +1,5 @@
-//! What the OBJ reader shares: lines, continuation lines, numbers as `strtod` reads them,
-//! located errors; and, for the tests, the reader as first written (the text checked and
+//! What the OBJ reader shares: lines, continuation lines, words, numbers as `strtod` reads
+//! them and plain decimals and indices without it, located errors; and, for the tests, the reader as first written (the text checked and
 //! rewritten line for line for tobj to parse), which `read.rs` must agree with.
 
 use crate::Error;
@@ -130,6 +130,167 @@ pub(super) fn strtod(s: &str) -> Option<(f64, bool)> {
         }
     }
     s[..i].parse().ok().map(|x| (x, true))
+}
+
+/// The whitespace-separated words of a statement (before any `#`), with their offsets in
+/// `line`, into `out`.
+pub(super) fn words<'a>(line: &'a str, out: &mut Vec<(usize, &'a str)>) {
+    out.clear();
+    if line.is_ascii() {
+        // ASCII whitespace as `char::is_whitespace` has it: tab to carriage return, and space;
+        // a `#` ends the statement.
+        let white = |c: u8| matches!(c, b'\t'..=b'\r' | b' ');
+        let b = line.as_bytes();
+        let mut i = 0;
+        while i < b.len() && b[i] != b'#' {
+            while i < b.len() && white(b[i]) {
+                i += 1;
+            }
+            let s = i;
+            while i < b.len() && !white(b[i]) && b[i] != b'#' {
+                i += 1;
+            }
+            if i > s {
+                out.push((s, &line[s..i]));
+            }
+        }
+        return;
+    }
+    let content = line.split('#').next().unwrap_or("");
+    let mut start = None;
+    for (i, ch) in content.char_indices().chain([(content.len(), ' ')]) {
+        match (ch.is_whitespace(), start) {
+            (true, Some(s)) => {
+                out.push((s, &content[s..i]));
+                start = None;
+            }
+            (false, None) => start = Some(i),
+            _ => {}
+        }
+    }
+}
+
+/// A word that is a plain decimal (`-0.0378297`: a sign, at most 19 digits with at most one
+/// point, no exponent) as `(f64, f32)`, each the correctly rounded value of its digits, as
+/// `parse` gives them; `None` for anything else (or where the f64 is not exact by this
+/// route). The mantissa and the power of ten are both exact in the float (at most 2^53 and
+/// 10^22 for f64, 2^24 and 10^10 for f32), so one division rounds correctly (Clinger's fast
+/// path); the f32 is parsed apart where its fast path does not hold.
+pub(super) fn plain_decimal(word: &str) -> Option<(f64, f32)> {
+    plain_decimal_bytes(word.as_bytes())
+}
+
+/// [`plain_decimal`] of a word's bytes.
+pub(super) fn plain_decimal_bytes(b: &[u8]) -> Option<(f64, f32)> {
+    const POW10: [f64; 23] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
+        1e20, 1e21, 1e22,
+    ];
+    const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
+    let negative = b.first() == Some(&b'-');
+    let body = &b[usize::from(negative || b.first() == Some(&b'+'))..];
+    if body.is_empty() || body.len() > 20 {
+        return None;
+    }
+    // The digits before the point, then those after it, into one mantissa (at most 20
+    // digits: wrapping where 20 overflow, and refused below).
+    let digit = |c: u8| c.wrapping_sub(b'0');
+    let mut m = 0u64;
+    let mut i = 0;
+    while i < body.len() && digit(body[i]) < 10 {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+        i += 1;
+    }
+    let whole = i;
+    let mut fraction = 0;
+    if i < body.len() && body[i] == b'.' {
+        i += 1;
+        let start = i;
+        while i < body.len() && digit(body[i]) < 10 {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+            i += 1;
+        }
+        fraction = i - start;
+    }
+    let digits = whole + fraction;
+    if i < body.len() || digits == 0 || digits > 19 || m > 1 << 53 || fraction >= POW10.len() {
+        return None;
+    }
+    let sign = if negative { -1.0 } else { 1.0 };
+    let x = sign * (m as f64 / POW10[fraction]);
+    let f = if m <= 1 << 24 && fraction < POW10_F32.len() {
+        sign as f32 * (m as f32 / POW10_F32[fraction])
+    } else if (x.to_bits() & 0x1FFF_FFFF).abs_diff(0x1000_0000) > 1 {
+        // The f64 is the value correctly rounded (within half its last place); rounding it
+        // to f32 rounds the value itself unless the 29 bits it drops lie at a halfway point,
+        // give or take that half place.
+        x as f32
+    } else {
+        // (ASCII: a sign, digits and a point.)
+        std::str::from_utf8(b).ok()?.parse::<f32>().ok()?
+    };
+    Some((x, f))
+}
+
+/// A corner's fields between its slashes (`r.split('/')`, without a generic searcher).
+pub(super) fn slashed(r: &str) -> impl Iterator<Item = &str> {
+    let mut rest = Some(r);
+    std::iter::from_fn(move || {
+        let s = rest?;
+        match s.bytes().position(|b| b == b'/') {
+            Some(i) => {
+                rest = Some(&s[i + 1..]);
+                Some(&s[..i])
+            }
+            None => {
+                rest = None;
+                Some(s)
+            }
+        }
+    })
+}
+
+/// A word of ASCII digits, perhaps after a `-`, at most 18 of them, as the integer it is.
+pub(super) fn plain_index(word: &str) -> Option<i64> {
+    let b = word.as_bytes();
+    let negative = b.first() == Some(&b'-');
+    let digits = &b[usize::from(negative)..];
+    if digits.is_empty() || digits.len() > 18 {
+        return None;
+    }
+    let mut v = 0i64;
+    for &c in digits {
+        if !c.is_ascii_digit() {
+            return None;
+        }
+        v = v * 10 + i64::from(c - b'0');
+    }
+    Some(if negative { -v } else { v })
+}
+
+/// Which vertex statement a line is (0: `v`, 1: `vt`, 2: `vn`; `None`: another or none), by
+/// its first word as [`words`] finds it; `None` outside where the line's start is not plain
+/// ASCII (then ask [`words`]).
+pub(super) fn vertex_kind(line: &str) -> Option<Option<usize>> {
+    let b = line.as_bytes();
+    let white = |c: u8| matches!(c, b'\t'..=b'\r' | b' ');
+    let i = b.iter().position(|&c| !white(c)).unwrap_or(b.len());
+    // Whether a word ends at `j` (`None`: a byte outside ASCII there).
+    let ends = |j: usize| match b.get(j) {
+        None => Some(true),
+        Some(&c) if white(c) || c == b'#' => Some(true),
+        Some(c) => c.is_ascii().then_some(false),
+    };
+    match b.get(i) {
+        None | Some(b'#') => Some(None),
+        Some(b'v') => match b.get(i + 1) {
+            Some(b't') => Some(ends(i + 2)?.then_some(1)),
+            Some(b'n') => Some(ends(i + 2)?.then_some(2)),
+            _ => Some(ends(i + 1)?.then_some(0)),
+        },
+        Some(c) if c.is_ascii() => Some(None),
+        _ => None,
+    }
 }
 
 /// An OBJ's text prepared for tobj, with what the preparation found (the reader as first

@@ -1,0 +1,804 @@
+//! Normals by crease angle ([`Mesh::with_crease_normals`]): the positions welded, each
+//! vertex's rule (one normal for all its corners, or its faces compared), and the mesh split at
+//! its corners where their normals differ.
+
+use super::Mesh;
+use crate::Color;
+use glam::{Vec2, Vec3};
+use rustc_hash::FxHashMap;
+use std::collections::HashMap;
+
+impl Mesh {
+    /// [`Mesh::with_crease_normals`], and the work it did (facet comparisons), for the test
+    /// that it is linear.
+    pub(super) fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
+        let (positions, remap) = weld_positions(&self.positions);
+        let tris: Vec<[u32; 3]> = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
+        let cos_crease = crease_deg.to_radians().cos();
+        let (facet, unit) = facets_of(&positions, &tris);
+        // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
+        // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
+        // what the loop would.
+        let cos_half = (1.0..=179.0)
+            .contains(&crease_deg)
+            .then(|| ((crease_deg - 0.02) * 0.5).to_radians().cos());
+        // Where corners carry nothing but their normal, a vertex of one normal is one vertex.
+        let plain = self.uvs.is_empty() && self.uvs1.is_empty() && self.colors.is_empty();
+        let n = positions.len();
+        // Most vertices take `Rule::Same`, found in two passes over the faces; the faces
+        // around each vertex and the other rules only for the rest.
+        let (same, count) = same_normals(n, &tris, &facet, &unit, cos_half);
+        let mut work = 6 * tris.len() as u64;
+        // Per vertex of the rest, its rule's index (u32::MAX: none).
+        let mut slot = vec![u32::MAX; n];
+        let mut rest = 0u32;
+        for ((s, m), &c) in slot.iter_mut().zip(&same).zip(&count) {
+            if *m == Vec3::ZERO && c > 0 {
+                *s = rest;
+                rest += 1;
+            }
+        }
+        let around = (rest > 0).then(|| Around::new(&slot, &count, rest as usize, &tris));
+        let mut rules = Vec::with_capacity(rest as usize);
+        if let Some(around) = &around {
+            let cosines = (cos_crease, cos_half);
+            for v in (0..n).filter(|&v| slot[v] != u32::MAX) {
+                let r = vertex_rule(around.of(slot[v]), v as u32, &tris, &facet, &unit, cosines, &mut work);
+                rules.push(r);
+            }
+        }
+        let mut others = Others {
+            around,
+            rules,
+            slot,
+            memo: FxHashMap::default(),
+            facet: &facet,
+            unit: &unit,
+            cos_crease,
+            work,
+        };
+        let mut out = CornerVertices::new(n);
+        let triangles: Vec<[u32; 3]> = if plain {
+            // Per welded vertex of one normal, its vertex (u32::MAX: not yet made).
+            let mut one = vec![u32::MAX; n];
+            tris.iter()
+                .enumerate()
+                .map(|(f, t)| {
+                    let mut tri = [0u32; 3];
+                    // (A loop, not `t.map`: the closure was not inlined, its array moved per
+                    // corner.)
+                    for corner in 0..3 {
+                        let v = t[corner] as usize;
+                        tri[corner] = if one[v] != u32::MAX {
+                            one[v]
+                        } else if same[v] != Vec3::ZERO {
+                            one[v] = out.alone(positions[v], same[v]);
+                            one[v]
+                        } else {
+                            let (normal, many) = others.normal(v as u32, f);
+                            out.vertex(v as u32, positions[v], normal, self, 0, many)
+                        };
+                    }
+                    tri
+                })
+                .collect()
+        } else {
+            tris.iter()
+                .enumerate()
+                .map(|(f, t)| {
+                    let mut tri = [0u32; 3];
+                    for corner in 0..3 {
+                        let v = t[corner];
+                        let (normal, many) = match same[v as usize] {
+                            m if m != Vec3::ZERO => (m, false),
+                            _ => others.normal(v, f),
+                        };
+                        // A corner keeps its own texture coordinates: vertices split where
+                        // they differ.
+                        let k = self.triangles[f][corner] as usize;
+                        tri[corner] = out.vertex(v, positions[v as usize], normal, self, k, many);
+                    }
+                    tri
+                })
+                .collect()
+        };
+        (out.mesh(triangles), others.work)
+    }
+}
+
+/// The vertices without `Rule::Same`: the faces around them, their rules, and what the
+/// rules need.
+struct Others<'a> {
+    around: Option<Around>,
+    rules: Vec<Rule>,
+    /// Per welded vertex, its rule's index in `rules` and its slot in `around` (u32::MAX:
+    /// a vertex of `Rule::Same`).
+    slot: Vec<u32>,
+    memo: FxHashMap<(u32, [u32; 3]), Vec3>,
+    facet: &'a [Vec3],
+    unit: &'a [Vec3],
+    cos_crease: f32,
+    /// Facet comparisons made.
+    work: u64,
+}
+
+impl Others<'_> {
+    /// The normal of face `f`'s corner at vertex `v`, and whether `v`'s vertices are many
+    /// (looked up by hash, not by chain).
+    fn normal(&mut self, v: u32, f: usize) -> (Vec3, bool) {
+        let own = self.unit[f];
+        let (around, rule) = match &self.around {
+            Some(a) => (a, &self.rules[self.slot[v as usize] as usize]),
+            None => unreachable!("a used vertex without Rule::Same has a rule"),
+        };
+        let (unit, facet, cos_crease, work) = (self.unit, self.facet, self.cos_crease, &mut self.work);
+        let n = match rule {
+            Rule::Same(n) => *n,
+            Rule::Plain => around
+                .of(self.slot[v as usize])
+                .iter()
+                .filter(|&&g| {
+                    *work += 1;
+                    unit[g as usize].dot(own) >= cos_crease
+                })
+                .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                .normalize_or_zero(),
+            Rule::Directions(g) => *self
+                .memo
+                .entry((v, own.to_array().map(f32::to_bits)))
+                .or_insert_with(|| {
+                    *work += g.len() as u64;
+                    g.iter()
+                        .filter(|(u, _)| u.dot(own) >= cos_crease)
+                        .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
+                        .normalize_or_zero()
+                }),
+            Rule::Edges(groups) => groups[&(f as u32)],
+        };
+        (n, matches!(rule, Rule::Directions(_) | Rule::Edges(_)))
+    }
+}
+
+/// Positions merged where they are equal (0 and −0 alike), in the order first met, and per
+/// position its merged index. An open-addressing table of indices sized for the positions
+/// (at most half full): a third of the instructions of a hash map's entry per position.
+pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+    let size = (points.len() * 2).next_power_of_two().max(16);
+    let shift = 64 - size.trailing_zeros();
+    let mut table = vec![u32::MAX; size];
+    let mut keys: Vec<[u32; 3]> = Vec::with_capacity(points.len());
+    let mut merged = Vec::with_capacity(points.len());
+    let mut remap = Vec::with_capacity(points.len());
+    for p in points {
+        let k = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let h = (u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        let mut i = (h.wrapping_mul(0x2545_F491_4F6C_DD1D) >> shift) as usize;
+        let index = loop {
+            let e = table[i];
+            if e == u32::MAX {
+                let e = keys.len() as u32;
+                table[i] = e;
+                keys.push(k);
+                merged.push(*p);
+                break e;
+            }
+            if keys[e as usize] == k {
+                break e;
+            }
+            i = (i + 1) & (size - 1);
+        };
+        remap.push(index);
+    }
+    (merged, remap)
+}
+
+/// Faces at a vertex up to which the mean direction may stand for all of them
+/// ([`vertex_rule`]).
+const MANY: usize = 32;
+
+/// Per vertex of the welded mesh `w`, the normal of `Rule::Same` where [`vertex_rule`] would
+/// give it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
+/// `cos_half`), else zero; and its number of corners. The facets are summed per vertex in
+/// face order, as [`vertex_rule`] sums them: the same bits, without the faces-around lists.
+/// Each face's facet normal `(b − a) × (c − a)` (its length twice its area) and that
+/// normal's unit vector (zero for a degenerate face).
+fn facets_of(positions: &[Vec3], tris: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
+    let facet: Vec<Vec3> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            (b - a).cross(c - a)
+        })
+        .collect();
+    let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+    (facet, unit)
+}
+
+fn same_normals(
+    n: usize,
+    tris: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    cos_half: Option<f32>,
+) -> (Vec<Vec3>, Vec<u32>) {
+    let mut mean = vec![Vec3::ZERO; n];
+    let mut count = vec![0u32; n];
+    let Some(cos_half) = cos_half else {
+        for &v in tris.iter().flatten() {
+            count[v as usize] += 1;
+        }
+        return (mean, count);
+    };
+    for (t, f) in tris.iter().zip(facet) {
+        for &v in t {
+            mean[v as usize] += *f;
+            count[v as usize] += 1;
+        }
+    }
+    for (m, &c) in mean.iter_mut().zip(&count) {
+        *m = if c as usize > MANY {
+            Vec3::ZERO
+        } else {
+            m.normalize_or_zero()
+        };
+    }
+    for (t, u) in tris.iter().zip(unit) {
+        for &v in t {
+            let m = &mut mean[v as usize];
+            // (`!(a >= b)`: a NaN fails the test, as in `vertex_rule`.)
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if *m != Vec3::ZERO && !(u.dot(*m) >= cos_half) {
+                *m = Vec3::ZERO;
+            }
+        }
+    }
+    (mean, count)
+}
+
+/// The faces around some of the vertices, in face order: those of the vertex of slot `k`
+/// are `faces[start[k]..start[k + 1]]` (one allocation, not one per vertex).
+struct Around {
+    start: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Around {
+    /// The faces around each vertex `v` with `slot[v] != u32::MAX` (`slots` of them, in the
+    /// order of the vertices), each vertex with `count[v]` corners.
+    fn new(slot: &[u32], count: &[u32], slots: usize, triangles: &[[u32; 3]]) -> Around {
+        let mut start = Vec::with_capacity(slots + 1);
+        start.push(0u32);
+        for (&k, &c) in slot.iter().zip(count) {
+            if k != u32::MAX {
+                start.push(start[k as usize] + c);
+            }
+        }
+        let mut faces = vec![0u32; start[slots] as usize];
+        let mut fill = start.clone();
+        for (f, t) in triangles.iter().enumerate() {
+            for &i in t {
+                let k = slot[i as usize];
+                if k != u32::MAX {
+                    faces[fill[k as usize] as usize] = f as u32;
+                    fill[k as usize] += 1;
+                }
+            }
+        }
+        Around { start, faces }
+    }
+
+    /// The faces around the vertex of slot `k`.
+    fn of(&self, k: u32) -> &[u32] {
+        &self.faces[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
+    }
+}
+
+/// At a vertex with many faces, faces of the same facet direction are one group (summed
+/// once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
+/// of one triangle are one group); past MANY_GROUPS directions, the edge rule. Vertices with
+/// few faces keep the plain loop, whose summation order the images were made with, or, where
+/// every face lies within half the crease angle of their mean direction (so every pair is
+/// within the crease), that loop's result once for all the vertex's corners.
+fn vertex_rule(
+    fs: &[u32],
+    v: u32,
+    triangles: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    (cos_crease, cos_half): (f32, Option<f32>),
+    work: &mut u64,
+) -> Rule {
+    const MANY_GROUPS: usize = 64;
+    if fs.len() <= MANY {
+        if let Some(cos_half) = cos_half {
+            *work += 2 * fs.len() as u64;
+            let sum = fs.iter().fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize]);
+            let mean = sum.normalize_or_zero();
+            if mean != Vec3::ZERO && fs.iter().all(|&g| unit[g as usize].dot(mean) >= cos_half) {
+                return Rule::Same(mean);
+            }
+        }
+        return Rule::Plain;
+    }
+    let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+    for &f in fs {
+        *work += 1;
+        let u = unit[f as usize];
+        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+            g.push((u, Vec3::ZERO));
+            g.len() - 1
+        });
+        g[k].1 += facet[f as usize];
+    }
+    if g.len() <= MANY_GROUPS {
+        Rule::Directions(g)
+    } else {
+        Rule::Edges(edge_groups(v, fs, triangles, facet, unit, cos_crease, work))
+    }
+}
+
+/// The vertices of a mesh being split at its corners: one per position, normal, texture
+/// coordinates and colour, numbered in the order they are first met. A position's vertices
+/// are a chain searched in turn (a few at most where the position has few faces), those of a
+/// position with many faces a hash map.
+struct CornerVertices {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    uvs1: Vec<Vec2>,
+    colors: Vec<Color>,
+    /// The chains: per link, the vertex's key, the vertex and the next link.
+    links: Vec<(CornerKey, u32, u32)>,
+    /// Per welded position, its chain's first link (u32::MAX: none yet).
+    head: Vec<u32>,
+    many: FxHashMap<(u32, CornerKey), u32>,
+}
+
+type CornerKey = ([u32; 3], [[u32; 2]; 2], [u32; 3]);
+
+impl CornerVertices {
+    fn new(welded: usize) -> CornerVertices {
+        // Room for a few split vertices without a copy.
+        let room = welded + welded / 16;
+        CornerVertices {
+            positions: Vec::with_capacity(room),
+            normals: Vec::with_capacity(room),
+            uvs: Vec::new(),
+            uvs1: Vec::new(),
+            colors: Vec::new(),
+            links: Vec::new(),
+            head: vec![u32::MAX; welded],
+            many: FxHashMap::default(),
+        }
+    }
+
+    /// A vertex at `p` with normal `n` and no other attribute that no other corner will look
+    /// up (a plain mesh's vertex of one normal).
+    fn alone(&mut self, p: Vec3, n: Vec3) -> u32 {
+        let i = self.positions.len() as u32;
+        self.positions.push(p);
+        self.normals.push(n);
+        i
+    }
+
+    /// The vertex at welded position `v` (at `p`) with normal `n` and the attributes of vertex
+    /// `k` of `source`.
+    fn vertex(&mut self, v: u32, p: Vec3, n: Vec3, source: &Mesh, k: usize, many: bool) -> u32 {
+        let uv = source.uvs.get(k).copied();
+        let uv1 = source.uvs1.get(k).copied();
+        let color = source.colors.get(k).copied();
+        let key: CornerKey = (
+            n.to_array().map(f32::to_bits),
+            [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
+            color.unwrap_or_default().to_array().map(f32::to_bits),
+        );
+        if many {
+            if let Some(&i) = self.many.get(&(v, key)) {
+                return i;
+            }
+        } else {
+            let mut l = self.head[v as usize];
+            while l != u32::MAX {
+                let (k, i, next) = &self.links[l as usize];
+                if *k == key {
+                    return *i;
+                }
+                l = *next;
+            }
+        }
+        let i = self.positions.len() as u32;
+        self.positions.push(p);
+        self.normals.push(n);
+        self.uvs.extend(uv);
+        self.uvs1.extend(uv1);
+        self.colors.extend(color);
+        if many {
+            self.many.insert((v, key), i);
+        } else {
+            self.links.push((key, i, self.head[v as usize]));
+            self.head[v as usize] = (self.links.len() - 1) as u32;
+        }
+        i
+    }
+
+    fn mesh(self, triangles: Vec<[u32; 3]>) -> Mesh {
+        Mesh {
+            positions: self.positions,
+            normals: self.normals,
+            triangles,
+            uvs: self.uvs,
+            uvs1: self.uvs1,
+            colors: self.colors,
+            tangents: Vec::new(),
+        }
+    }
+}
+
+/// How a vertex's corners get their crease normals (see [`Mesh::with_crease_normals`]).
+enum Rule {
+    /// Every corner's normal is this one (its faces all lie within the crease of each other).
+    Same(Vec3),
+    /// Every face around the vertex compared with the corner's own.
+    Plain,
+    /// The vertex's face directions, each with its facets' sum.
+    Directions(Vec<(Vec3, Vec3)>),
+    /// Each face's normal at the vertex, from the faces joined to it across shared edges.
+    Edges(HashMap<u32, Vec3>),
+}
+
+/// The normal at vertex `v` of each face of `faces` (the faces around it): faces that share
+/// an edge at `v` and meet within the crease angle are joined (union-find; on an edge with more
+/// than two faces, each to the next), and each face gets its group's summed facets. Linear in
+/// `faces` (`work` counts the comparisons).
+fn edge_groups(
+    v: u32,
+    faces: &[u32],
+    triangles: &[[u32; 3]],
+    facet: &[Vec3],
+    unit: &[Vec3],
+    cos_crease: f32,
+    work: &mut u64,
+) -> HashMap<u32, Vec3> {
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    // The last face seen on each edge (v, other vertex).
+    let mut last_on_edge: HashMap<u32, usize> = HashMap::new();
+    for (k, &f) in faces.iter().enumerate() {
+        for &other in triangles[f as usize].iter().filter(|&&o| o != v) {
+            if let Some(&j) = last_on_edge.get(&other) {
+                *work += 1;
+                if unit[faces[j] as usize].dot(unit[f as usize]) >= cos_crease {
+                    let (a, b) = (find(&mut parent, j), find(&mut parent, k));
+                    parent[a] = b;
+                }
+            }
+            last_on_edge.insert(other, k);
+        }
+    }
+    let mut sums = vec![Vec3::ZERO; faces.len()];
+    for (k, &f) in faces.iter().enumerate() {
+        let r = find(&mut parent, k);
+        sums[r] += facet[f as usize];
+    }
+    faces
+        .iter()
+        .enumerate()
+        .map(|(k, &f)| {
+            let r = find(&mut parent, k);
+            (f, sums[r].normalize_or_zero())
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod crease_tests {
+    use super::*;
+
+    impl Mesh {
+        /// The crease normals as first written (one hash lookup a corner): the fast version must
+        /// give these bits.
+        pub(super) fn reference_crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
+            let w = self.weld().0;
+            let cos_crease = crease_deg.to_radians().cos();
+            let facet: Vec<Vec3> = w
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| w.positions[i as usize]);
+                    (b - a).cross(c - a)
+                })
+                .collect();
+            let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
+            // The faces around each vertex, in face order: `around[v]` is
+            // `faces[start[v]..start[v + 1]]` (one allocation, not one per vertex).
+            let mut start = vec![0u32; w.positions.len() + 1];
+            for t in &w.triangles {
+                for &i in t {
+                    start[i as usize + 1] += 1;
+                }
+            }
+            for v in 0..w.positions.len() {
+                start[v + 1] += start[v];
+            }
+            let mut faces = vec![0u32; w.triangles.len() * 3];
+            let mut fill = start.clone();
+            for (f, t) in w.triangles.iter().enumerate() {
+                for &i in t {
+                    faces[fill[i as usize] as usize] = f as u32;
+                    fill[i as usize] += 1;
+                }
+            }
+            let around = |v: usize| &faces[start[v] as usize..start[v + 1] as usize];
+            let mut work = 0u64;
+            // At a vertex with many faces, faces of the same facet direction are one group (summed
+            // once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
+            // of one triangle are one group); past MANY_GROUPS directions, the edge rule above.
+            // Vertices with few faces keep the plain loop, whose summation order the images were
+            // made with.
+            const MANY: usize = 32;
+            const MANY_GROUPS: usize = 64;
+            let vertex_rule: Vec<Rule> = (0..w.positions.len())
+                .map(|v| {
+                    let fs = around(v);
+                    if fs.len() <= MANY {
+                        return Rule::Plain;
+                    }
+                    let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+                    let mut g: Vec<(Vec3, Vec3)> = Vec::new();
+                    for &f in fs {
+                        work += 1;
+                        let u = unit[f as usize];
+                        let k = *index.entry(u.to_array().map(f32::to_bits)).or_insert_with(|| {
+                            g.push((u, Vec3::ZERO));
+                            g.len() - 1
+                        });
+                        g[k].1 += facet[f as usize];
+                    }
+                    if g.len() <= MANY_GROUPS {
+                        Rule::Directions(g)
+                    } else {
+                        Rule::Edges(edge_groups(
+                            v as u32,
+                            fs,
+                            &w.triangles,
+                            &facet,
+                            &unit,
+                            cos_crease,
+                            &mut work,
+                        ))
+                    }
+                })
+                .collect();
+            let mut memo: FxHashMap<(u32, [u32; 3]), Vec3> = FxHashMap::default();
+            let mut positions = Vec::new();
+            let mut normals = Vec::new();
+            let mut uvs = Vec::new();
+            let mut uvs1 = Vec::new();
+            let mut colors = Vec::new();
+            type Key = (u32, [u32; 3], [[u32; 2]; 2], [u32; 3]);
+            let mut dedup: FxHashMap<Key, u32> = FxHashMap::default();
+            let mut triangles = Vec::with_capacity(w.triangles.len());
+            for (f, t) in w.triangles.iter().enumerate() {
+                let own = unit[f];
+                let mut corner = 0;
+                let tri = t.map(|v| {
+                    // A corner keeps its own texture coordinates: vertices split where they differ.
+                    let uv = self.uvs.get(self.triangles[f][corner] as usize).copied();
+                    let uv1 = self.uvs1.get(self.triangles[f][corner] as usize).copied();
+                    let color = self.colors.get(self.triangles[f][corner] as usize).copied();
+                    corner += 1;
+                    let n = match &vertex_rule[v as usize] {
+                        Rule::Plain => around(v as usize)
+                            .iter()
+                            .filter(|&&g| {
+                                work += 1;
+                                unit[g as usize].dot(own) >= cos_crease
+                            })
+                            .fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize])
+                            .normalize_or_zero(),
+                        Rule::Directions(g) => {
+                            *memo.entry((v, own.to_array().map(f32::to_bits))).or_insert_with(|| {
+                                work += g.len() as u64;
+                                g.iter()
+                                    .filter(|(u, _)| u.dot(own) >= cos_crease)
+                                    .fold(Vec3::ZERO, |acc, (_, sum)| acc + *sum)
+                                    .normalize_or_zero()
+                            })
+                        }
+                        Rule::Edges(groups) => groups[&(f as u32)],
+                        Rule::Same(n) => *n,
+                    };
+                    let key = (
+                        v,
+                        n.to_array().map(f32::to_bits),
+                        [uv, uv1].map(|uv| uv.unwrap_or_default().to_array().map(f32::to_bits)),
+                        color.unwrap_or_default().to_array().map(f32::to_bits),
+                    );
+                    *dedup.entry(key).or_insert_with(|| {
+                        positions.push(w.positions[v as usize]);
+                        normals.push(n);
+                        uvs.extend(uv);
+                        uvs1.extend(uv1);
+                        colors.extend(color);
+                        (positions.len() - 1) as u32
+                    })
+                });
+                triangles.push(tri);
+            }
+            let mesh = Mesh {
+                positions,
+                normals,
+                triangles,
+                uvs,
+                uvs1,
+                colors,
+                tangents: Vec::new(),
+            };
+            (mesh, work)
+        }
+    }
+
+    /// A fan of 100 000 faces around one apex, every one in its own direction (a cone's tip):
+    /// the work grows linearly with the faces (counted, not timed); neighbours meet at a soft
+    /// edge, so the apex has one normal, the normalised sum of every facet (here +z).
+    #[test]
+    fn many_directions_at_a_vertex_cost_linear_work() {
+        let fan = |n: usize| {
+            let mut p = vec![Vec3::new(0.0, 0.0, 1.0)];
+            for i in 0..n {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+            }
+            let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [0, 1 + i, 1 + (i + 1) % n as u32]).collect();
+            Mesh::from_triangles(p, tris).expect("mesh")
+        };
+        let (_, work_small) = fan(10_000).crease_normals(30.0);
+        let (large, work_large) = fan(100_000).crease_normals(30.0);
+        assert!(
+            work_large < 12 * work_small,
+            "work {work_small} -> {work_large} for 10x the faces"
+        );
+        assert!(work_large < 20 * 100_000, "{work_large}");
+        let apex: Vec<Vec3> = large
+            .positions()
+            .iter()
+            .zip(large.normals())
+            .filter(|(p, _)| p.z == 1.0)
+            .map(|(_, n)| *n)
+            .collect();
+        assert_eq!(apex.len(), 1, "one apex vertex");
+        assert!((apex[0] - Vec3::Z).length() < 1e-3, "{}", apex[0]);
+    }
+
+    #[test]
+    fn many_copies_of_one_triangle_are_one_group() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tris = vec![[0, 1, 2]; 80_000];
+        let m = Mesh::from_triangles(p, tris).expect("mesh").with_crease_normals(60.0);
+        assert_eq!(m.positions().len(), 3);
+        assert!(m.normals().iter().all(|n| (*n - Vec3::Z).length() < 1e-6));
+    }
+
+    #[test]
+    fn grouped_vertices_give_the_plain_loops_normals() {
+        // A fan of 40 triangles around the origin, tilted so that neighbours are within the
+        // crease angle and opposite sides are not: the apex has more than MANY faces.
+        let n = 40;
+        let mut p = vec![Vec3::new(0.0, 0.0, 0.3)];
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+        }
+        let tris: Vec<[u32; 3]> = (0..n as u32).map(|i| [0, 1 + i, 1 + (i + 1) % n as u32]).collect();
+        let mesh = Mesh::from_triangles(p, tris).expect("mesh");
+        let m = mesh.with_crease_normals(30.0);
+        // The plain loop, written out: for each face at the apex, the sum of facets within 30°.
+        let facets: Vec<Vec3> = (0..n)
+            .map(|f| {
+                let [a, b, c] = mesh.corners(f);
+                (b - a).cross(c - a)
+            })
+            .collect();
+        for (f, t) in m.triangles().iter().enumerate() {
+            let own = facets[f].normalize();
+            let want = facets
+                .iter()
+                .filter(|g| g.normalize().dot(own) >= 30f32.to_radians().cos())
+                .fold(Vec3::ZERO, |a, g| a + *g)
+                .normalize();
+            let got = m.normals()[t[0] as usize];
+            assert!((got - want).length() < 1e-5, "face {f}: {got} vs {want}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod crease_equivalence {
+    use super::*;
+    use crate::primitives;
+    use proptest::prelude::*;
+
+    /// A height field of `n`×`n` cells with heights `h` (steps and slopes: creases of every
+    /// angle), texture coordinates that jump on one row (seams) and, optionally, colours.
+    fn field(n: usize, h: &[f32], seam: bool, colored: bool) -> Mesh {
+        let mut p = Vec::new();
+        let mut uv = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                p.push(Vec3::new(x as f32, y as f32, h[(y * (n + 1) + x) % h.len()]));
+                let v = if seam && y == n / 2 { 0.9 } else { y as f32 / n as f32 };
+                uv.push(Vec2::new(x as f32 / n as f32, v));
+            }
+        }
+        let mut t = Vec::new();
+        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+        for y in 0..n {
+            for x in 0..n {
+                t.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                t.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        // A degenerate face and a repeated one.
+        t.push([at(0, 0), at(0, 0), at(1, 1)]);
+        t.push(t[0]);
+        let colors = p
+            .iter()
+            .map(|q| Color::new(q.x / n as f32, q.y / n as f32, 0.5))
+            .collect();
+        let m = Mesh::from_triangles(p, t).expect("mesh").with_uvs(uv).expect("uvs");
+        if colored {
+            m.with_colors(colors).expect("colours")
+        } else {
+            m
+        }
+    }
+
+    fn same_bits(a: &Mesh, b: &Mesh) {
+        let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(a.triangles, b.triangles);
+        assert_eq!(bits(&a.positions), bits(&b.positions));
+        assert_eq!(bits(&a.normals), bits(&b.normals));
+        assert_eq!(a.uvs, b.uvs);
+        assert_eq!(a.colors, b.colors);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        /// The shortcut (one normal a vertex where its faces are all within half the crease of
+        /// their mean) gives the plain loop's bits, vertex order and splits.
+        #[test]
+        fn fast_crease_normals_are_the_plain_loops(
+            n in 1usize..9,
+            h in proptest::collection::vec(prop_oneof![-3.0f32..3.0, Just(0.0f32), Just(1.0f32)], 1..40),
+            crease in prop_oneof![0.0f32..180.0, Just(1.0f32), Just(30.0f32), Just(45.0f32), Just(90.0f32), Just(179.0f32), Just(180.0f32)],
+            seam in any::<bool>(),
+            colored in any::<bool>(),
+        ) {
+            let m = field(n, &h, seam, colored);
+            same_bits(&m.crease_normals(crease).0, &m.reference_crease_normals(crease).0);
+        }
+    }
+
+    #[test]
+    fn fast_crease_normals_on_the_shapes() {
+        for mesh in [
+            primitives::sphere(24),
+            primitives::cube(),
+            primitives::teapot(8),
+            primitives::cone(16),
+            primitives::torus(16, 1.0, 0.3),
+        ] {
+            for crease in [1.0, 10.0, 30.0, 60.0, 89.0, 90.0, 91.0, 120.0, 179.0, 180.0] {
+                same_bits(&mesh.crease_normals(crease).0, &mesh.reference_crease_normals(crease).0);
+            }
+        }
+    }
+}
