@@ -919,8 +919,8 @@ mod tests {
         }
     }
 
-    /// Decimals halfway between two f32 (2^24 + 1 and its like), where the f64 cannot say
-    /// which way the f32 rounds: as `parse` reads them.
+    /// Decimals exactly halfway between two f32 (2^24 + 1 and its like): to even, as `parse`
+    /// reads them.
     #[test]
     fn halfway_decimals_read_as_parse_reads_them() {
         for word in [
@@ -936,6 +936,33 @@ mod tests {
             assert_eq!(x.to_bits(), word.parse::<f64>().unwrap().to_bits(), "{word}");
             assert_eq!(f.to_bits(), word.parse::<f32>().unwrap().to_bits(), "{word}");
         }
+    }
+
+    /// Decimals that the f64 rounds onto a point halfway between two f32 (16 digits near 8 + an
+    /// odd multiple of 2^-21): rounding that f64 to f32 would round some of them the wrong way
+    /// (the test finds such cases), the reader rounds them as `parse` does.
+    #[test]
+    fn decimals_rounded_onto_halfway_points_read_as_parse_reads_them() {
+        let (mut hazards, mut wrong_by_f64) = (0, 0);
+        for k in 0..20_000u32 {
+            let halfway = 8.0 + f64::from(2 * k + 1) * (-21f64).exp2();
+            // 15 decimals: within half the f64's last place of the halfway point, not on it.
+            let word = format!("{halfway:.15}");
+            let x = word.parse::<f64>().unwrap();
+            if x != halfway {
+                continue;
+            }
+            let exact = word.parse::<f32>().unwrap();
+            hazards += 1;
+            wrong_by_f64 += usize::from((x as f32).to_bits() != exact.to_bits());
+            let (ours_x, ours) = plain_decimal(&word).expect("a plain decimal of 16 digits");
+            assert_eq!(ours_x.to_bits(), x.to_bits(), "{word}");
+            assert_eq!(ours.to_bits(), exact.to_bits(), "{word}");
+        }
+        assert!(
+            hazards > 100 && wrong_by_f64 > 0,
+            "{hazards} cases, {wrong_by_f64} that the f64 alone rounds wrong"
+        );
     }
 
     fn number() -> impl Strategy<Value = String> {
