@@ -84,7 +84,8 @@ fn write_bytes(path: &Path, size: (u32, u32), bytes: &[u8], alpha: bool, encodin
 /// Not flushed to the disk (no `fsync`): a reader never sees a half-written file, and a file
 /// that a machine's crash leaves short is found incomplete and redone by `phong batch`; an
 /// `fsync` a file was 3–10% of a batch of thumbnails on a local disk (301 of them: 29–89 ms of
-/// 0.74–1.0 s, 2026-12-05), a round trip to the server each on a network filesystem.
+/// 0.74–1.0 s, 2026-12-05); on a network filesystem each is a round trip to the server (not
+/// measured here).
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let err = |source: std::io::Error| Error::Write {
         path: path.to_path_buf(),

@@ -161,7 +161,8 @@ impl Others<'_> {
 
 /// Positions merged where they are equal (0 and −0 alike), in the order first met, and per
 /// position its merged index. An open-addressing table of indices sized for the positions
-/// (at most half full): a third of the instructions of a hash map's entry per position.
+/// (at most half full): about half the instructions of a hash map's entry per position (the
+/// bunny's 35k positions: 5.8M → 3.1M).
 pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let size = (points.len() * 2).next_power_of_two().max(16);
     let shift = 64 - size.trailing_zeros();

@@ -546,7 +546,8 @@ pub(super) fn read_obj(
     src: &str,
     load_mtl: &mut dyn FnMut(&Path) -> tobj::MTLLoadResult,
 ) -> Result<Read, Error> {
-    /// Bytes a chunk has at least (below it, a thread costs more than it saves).
+    /// Bytes a chunk has at least: a 256 KiB chunk reads in about 1 ms here, against a thread's
+    /// start of tens of µs (the threshold itself not tuned by measurement).
     const CHUNK: usize = 1 << 18;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
     read_in_chunks(path, src, load_mtl, (src.len() / CHUNK).clamp(1, threads))

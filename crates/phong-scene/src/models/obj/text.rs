@@ -268,9 +268,9 @@ pub(super) fn plain_index(word: &str) -> Option<i64> {
     Some(if negative { -v } else { v })
 }
 
-/// Which vertex statement a line is (0: `v`, 1: `vt`, 2: `vn`; `None`: another or none), by
-/// its first word as [`words`] finds it; `None` outside where the line's start is not plain
-/// ASCII (then ask [`words`]).
+/// Which vertex statement a line is, by its first word as [`words`] finds it: `Some(Some(k))`
+/// for `v`, `vt` and `vn` (k = 0, 1, 2), `Some(None)` for another statement or none, `None` where
+/// the line's start is not plain ASCII (then [`words`] must be asked).
 pub(super) fn vertex_kind(line: &str) -> Option<Option<usize>> {
     let b = line.as_bytes();
     let white = |c: u8| matches!(c, b'\t'..=b'\r' | b' ');
