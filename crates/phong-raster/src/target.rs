@@ -160,7 +160,7 @@ impl<P: Pixel> TileTarget<'_, '_, P> {
 
     /// Draws the tile by `draw` straight into the rows of an 8-bit frame that `Encoding::Linear`
     /// encodes; `None` (nothing drawn) for other frames.
-    pub fn draw_linear8(&mut self, draw: impl FnOnce(&mut [&mut [[u8; 4]]]) -> u64) -> Option<u64> {
+    pub fn draw_linear8<R>(&mut self, draw: impl FnOnce(&mut [&mut [[u8; 4]]]) -> R) -> Option<R> {
         let mut rows = self
             .rows
             .iter_mut()

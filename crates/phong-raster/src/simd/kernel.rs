@@ -541,7 +541,7 @@ pub(crate) fn lean_points<V: Vf32<A = [f32; LANES]>>(
         y: col(a, |v| v.y),
         z: col(a, |v| v.z),
     };
-    super::lean::shade_color_lean(p, lean, v3(position), v3(normal)).map(V::to_array)
+    super::lean::shade_color_lean::<V, false>(p, lean, v3(position), v3(normal)).map(V::to_array)
 }
 
 /// What Gouraud's vertex lighting computes: a term by the general kernel, or the colour by
@@ -573,7 +573,7 @@ pub(crate) fn light_vertices<V: Vf32>(
     {
         let (pos, nrm) = vertex_lanes::<V>(ps, ns, flip);
         let colour = match term {
-            VertexTerm::Lean(lean) => super::lean::shade_color_lean(p, lean, pos, nrm),
+            VertexTerm::Lean(lean) => super::lean::shade_color_lean::<V, false>(p, lean, pos, nrm),
             VertexTerm::General(term) => shade(p, pos, nrm).get(term),
         };
         store_lanes(colour, os);
@@ -671,9 +671,10 @@ pub(super) fn position_normal<V: Vf32>(q: [V; 6]) -> (V3<V>, V3<V>) {
 }
 
 /// The colour of a batch's interpolated attributes `q`: Phong shades position `q[0..3]` and
-/// normal `q[3..6]` and keeps its term; Gouraud's colour is `q[0..3]`.
+/// normal `q[3..6]` and keeps its term; Gouraud's colour is `q[0..3]`. With `RAW`, the lean
+/// kernel's colour is left unclamped, NaN included, for an 8-bit encoding that clamps it.
 #[inline(always)]
-fn batch_color<V: Vf32>(batch: Batch, q: [V; 6]) -> [V; 3] {
+fn batch_color<V: Vf32, const RAW: bool>(batch: Batch, q: [V; 6]) -> [V; 3] {
     match batch {
         Batch::Phong(prep, term) => {
             let (pos, nrm) = position_normal(q);
@@ -681,7 +682,7 @@ fn batch_color<V: Vf32>(batch: Batch, q: [V; 6]) -> [V; 3] {
         }
         Batch::Lean(prep, lean) => {
             let (pos, nrm) = position_normal(q);
-            super::lean::shade_color_lean(prep, lean, pos, nrm)
+            super::lean::shade_color_lean::<V, RAW>(prep, lean, pos, nrm)
         }
         Batch::Gouraud => [q[0], q[1], q[2]],
     }
@@ -703,7 +704,7 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(&lane, start, n, attrs);
-        let rgb = batch_color(batch, q).map(V::to_array);
+        let rgb = batch_color::<V, false>(batch, q).map(V::to_array);
         for i in 0..m {
             out(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
         }
@@ -786,9 +787,82 @@ pub(crate) fn shade_batch_lit<'p, V: Vf32>(
 pub(crate) fn shade_group<V: Vf32>(
     batch: Batch,
     planes: &Planes,
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, [&[f32]; 3]),
+) -> usize {
+    group_vectors::<V, _>(batch, planes, origin, pixels, &mut F32Out(out))
+}
+
+/// [`shade_group`] with the colours encoded to 8-bit RGBA as `Encoding::Linear` encodes them
+/// (alpha 255), in the vector registers: `out(pixel, pixels)` takes a run of a row or one
+/// pixel.
+#[inline(always)]
+pub(crate) fn shade_group8<V: Vf32>(
+    batch: Batch,
+    planes: &Planes,
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, &[[u8; 4]]),
+) -> usize {
+    group_vectors::<V, _>(batch, planes, origin, pixels, &mut Rgba8Out(out))
+}
+
+/// Where [`group_vectors`] puts each vector's colours: `put(chunk, run, rgb)` takes its
+/// pixels, whether they are a run of one row, and their colours. (A trait, not a closure: a
+/// closure is not compiled with the caller's AVX2, and its intrinsics become calls: C11.)
+trait Sink<V: Vf32> {
+    /// The sink encodes to 8 bits, which clamps to `[0, 1]` and maps NaN to 0: the lean
+    /// kernel's own clamp and NaN step are left to it.
+    const ENCODES: bool;
+    fn put(&mut self, chunk: &[u32], run: bool, rgb: [V; 3]);
+}
+
+/// Colours as `f32`, per run or per pixel.
+struct F32Out<F>(F);
+
+impl<V: Vf32, F: FnMut(u32, [&[f32]; 3])> Sink<V> for F32Out<F> {
+    const ENCODES: bool = false;
+    #[inline(always)]
+    fn put(&mut self, chunk: &[u32], run: bool, rgb: [V; 3]) {
+        let rgb = rgb.map(V::to_array);
+        let [r, g, b] = [rgb[0].as_ref(), rgb[1].as_ref(), rgb[2].as_ref()];
+        if run {
+            (self.0)(chunk[0], [r, g, b]);
+        } else {
+            for (i, &p) in chunk.iter().enumerate() {
+                (self.0)(p, [&r[i..=i], &g[i..=i], &b[i..=i]]);
+            }
+        }
+    }
+}
+
+/// Colours as 8-bit RGBA, per run or per pixel.
+struct Rgba8Out<F>(F);
+
+impl<V: Vf32, F: FnMut(u32, &[[u8; 4]])> Sink<V> for Rgba8Out<F> {
+    const ENCODES: bool = true;
+    #[inline(always)]
+    fn put(&mut self, chunk: &[u32], run: bool, rgb: [V; 3]) {
+        let px = V::encode_rgba8(rgb);
+        if run {
+            (self.0)(chunk[0], px.as_ref());
+        } else {
+            for (i, &p) in chunk.iter().enumerate() {
+                (self.0)(p, &px.as_ref()[i..=i]);
+            }
+        }
+    }
+}
+
+/// The whole vectors of [`shade_group`], their colours given to `sink`.
+#[inline(always)]
+fn group_vectors<V: Vf32, S: Sink<V>>(
+    batch: Batch,
+    planes: &Planes,
     (x0, y0): (u32, u32),
     pixels: &[u32],
-    mut out: impl FnMut(u32, [&[f32]; 3]),
+    sink: &mut S,
 ) -> usize {
     let full = pixels.len() / V::N * V::N;
     if full == 0 {
@@ -806,7 +880,7 @@ pub(crate) fn shade_group<V: Vf32>(
     let lanes = V::from_array(lanes);
     for chunk in pixels[..full].chunks_exact(V::N) {
         // A run of a row (the common case inside a triangle): its centres from the first,
-        // its colours given to `out` at once.
+        // its colours given at once.
         // (`pixels` ascend: N of them spanning N columns are consecutive.)
         debug_assert!(chunk.windows(2).all(|w| w[0] < w[1]));
         let run = chunk[V::N - 1].wrapping_sub(chunk[0]) == (V::N - 1) as u32;
@@ -817,15 +891,12 @@ pub(crate) fn shade_group<V: Vf32>(
             centres::<V>((x0, y0), chunk)
         };
         let (q, _) = planes.at(x, y, attrs);
-        let rgb = batch_color(batch, q).map(V::to_array);
-        let [r, g, b] = [rgb[0].as_ref(), rgb[1].as_ref(), rgb[2].as_ref()];
-        if run {
-            out(chunk[0], [r, g, b]);
+        let rgb = if S::ENCODES {
+            batch_color::<V, true>(batch, q)
         } else {
-            for (i, &p) in chunk.iter().enumerate() {
-                out(p, [&r[i..=i], &g[i..=i], &b[i..=i]]);
-            }
-        }
+            batch_color::<V, false>(batch, q)
+        };
+        sink.put(chunk, run, rgb);
     }
     full
 }

@@ -459,6 +459,46 @@ pub fn shade_group(
     kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
 }
 
+avx2_and_wide! {
+    fn shade_group8_avx2 / shade_group8_wide [] (
+        batch: Batch,
+        planes: &Planes,
+        origin: (u32, u32),
+        pixels: &[u32],
+        out: impl FnMut(u32, &[[u8; 4]]),
+    ) -> usize {
+        kernel::shade_group8::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+    }
+}
+
+/// [`shade_group`] with the colours encoded to 8-bit RGBA in the kernel, as
+/// `Encoding::Linear` encodes them (alpha 255): `out(pixel, pixels)` takes a run of a row or
+/// one pixel.
+#[inline]
+pub fn shade_group8(
+    isa: Isa,
+    batch: Batch,
+    planes: &Planes,
+    origin: (u32, u32),
+    pixels: &[u32],
+    out: impl FnMut(u32, &[[u8; 4]]),
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
+        return unsafe {
+            if isa.wide() {
+                shade_group8_wide(batch, planes, origin, pixels, out)
+            } else {
+                shade_group8_avx2(batch, planes, origin, pixels, out)
+            }
+        };
+    }
+    let _ = isa;
+    kernel::shade_group8::<vector::Portable>(batch, planes, origin, pixels, out)
+}
+
 /// The fast setup's vertex stage (see `project.rs`): `out[i] = make(vertex)` for each vertex
 /// of `positions`, its window position (in 1/`one` pixel, for a `w × h` window), depth, `1/w`
 /// and outcode after `clip_from_world`, bit for bit `scalar(position)`'s, which makes the

@@ -23,6 +23,8 @@ pub trait Vf32: Copy {
     type A: Copy + Default + AsRef<[f32]> + AsMut<[f32]>;
     /// A lane mask.
     type M: Copy;
+    /// `[[u8; 4]; N]`: a vector's 8-bit RGBA pixels.
+    type Px: Copy + Default + AsRef<[[u8; 4]]>;
     /// Every lane `x`.
     fn splat(x: f32) -> Self;
     /// The texels `texels[y·width + x]` of the lanes (`x`, `y` whole numbers, clamped into
@@ -49,8 +51,14 @@ pub trait Vf32: Copy {
     fn mul_add(self, b: Self, c: Self) -> Self;
     /// `1/√a`, relative error below 1e-6 (exact in [`Portable`]); `+∞` at 0.
     fn rsqrt(self) -> Self;
+    /// `1/√a` for finite `a > 0` (no care for 0: the caller keeps it out), relative error
+    /// below 1e-6 (exact in [`Portable`]).
+    fn rsqrt_positive(self) -> Self;
     /// `1/a`, relative error below 1e-6 (exact in [`Portable`]).
     fn recip(self) -> Self;
+    /// Every lane `s`'s value, loaded whole (a memory operand of the instruction that uses it,
+    /// where a broadcast of one `f32` would be an instruction of its own).
+    fn load_splat(s: &Splat) -> Self;
     /// `if a < b { a } else { b }`.
     fn min(self, b: Self) -> Self;
     /// `if a > b { a } else { b }`.
@@ -81,15 +89,41 @@ pub trait Vf32: Copy {
     fn frexp(self) -> (Self, Self);
     /// `2^k` for lanes holding integers `k` in `[−126, 127]`.
     fn pow2i(self) -> Self;
+    /// For finite `a > 0` (normal): `(e, m)` with `a = m · 2^e`, `m` in `[√½, √2)`, `e` as a
+    /// float (the mantissa folded around 1, for a logarithm without cancellation near 1).
+    fn frexp_folded(self) -> (Self, Self);
+    /// `a · 2^k` for lanes holding integers `k`, by adding `k` to the exponent's bits: for
+    /// normal `a` whose result is normal.
+    fn scale_pow2(self, k: Self) -> Self;
     /// Round to the nearest integer, ties to even.
     fn round(self) -> Self;
     /// Round down (`|x| < 2^22`: larger values are whole already, or kept).
     fn floor(self) -> Self;
+    /// The lanes' colours `rgb` as 8-bit RGBA pixels: each channel as
+    /// [`phong_core::Encoding::Linear`] encodes it (`clamp(c, 0, 1)·255 + 0.5` truncated, NaN
+    /// as 0), alpha 255.
+    fn encode_rgba8(rgb: [Self; 3]) -> Self::Px;
     /// Transposes `N` rows of 8 floats (lane `i` takes row `i`) into 8 vectors: vector `j`
     /// holds element `j` of every row. How a batch gathers its lanes' plane coefficients
     /// (8 loads and 24 shuffles per 8 lanes in the AVX2 build, instead of 64 scalar stores and
     /// reloads through an array).
     fn transpose(rows: &[&[f32; 8]]) -> [Self; 8];
+}
+
+/// The bits of `√½` rounded down to an `f32`: [`Vf32::frexp_folded`] takes the exponent of
+/// `a / √½`.
+const SQRT_HALF_BITS: i32 = 0x3f35_04f3;
+
+/// One constant repeated in every lane of the widest vector, for [`Vf32::load_splat`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct Splat(pub [f32; 16]);
+
+impl Splat {
+    /// `x` in every lane.
+    pub const fn new(x: f32) -> Splat {
+        Splat([x; 16])
+    }
 }
 
 /// The portable twin: `[f32; 8]`, plain loops, exact `rsqrt` and `recip`.
@@ -108,6 +142,7 @@ fn lanes<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; 8] {
 impl Vf32 for Portable {
     const N: usize = 8;
     type A = [f32; 8];
+    type Px = [[u8; 4]; 8];
     type M = [bool; 8];
     // The portable gathers are calls: 8 scalar loads a channel gain nothing from inlining,
     // and inlined into the textured kernels they made them minutes to compile (BENCHMARKS.md, C10).
@@ -176,6 +211,19 @@ impl Vf32 for Portable {
         Portable(lanes(|i| 1.0 / self.0[i].sqrt()))
     }
     #[inline(always)]
+    fn rsqrt_positive(self) -> Self {
+        self.rsqrt()
+    }
+    #[inline(always)]
+    fn encode_rgba8(rgb: [Self; 3]) -> [[u8; 4]; 8] {
+        let e = |c: f32| phong_core::Encoding::Linear.encode(c);
+        lanes(|i| [e(rgb[0].0[i]), e(rgb[1].0[i]), e(rgb[2].0[i]), 255])
+    }
+    #[inline(always)]
+    fn load_splat(s: &Splat) -> Self {
+        Portable(lanes(|i| s.0[i]))
+    }
+    #[inline(always)]
     fn recip(self) -> Self {
         Portable(lanes(|i| 1.0 / self.0[i]))
     }
@@ -242,6 +290,18 @@ impl Vf32 for Portable {
         Portable(lanes(|i| f32::from_bits(((self.0[i] as i32 + 127) as u32) << 23)))
     }
     #[inline(always)]
+    fn frexp_folded(self) -> (Self, Self) {
+        let e = lanes(|i| (self.0[i].to_bits() as i32).wrapping_sub(SQRT_HALF_BITS) >> 23);
+        let m = lanes(|i| f32::from_bits((self.0[i].to_bits() as i32).wrapping_sub(e[i] << 23) as u32));
+        (Portable(e.map(|e| e as f32)), Portable(m))
+    }
+    #[inline(always)]
+    fn scale_pow2(self, k: Self) -> Self {
+        Portable(lanes(|i| {
+            f32::from_bits((self.0[i].to_bits() as i32).wrapping_add((k.0[i] as i32) << 23) as u32)
+        }))
+    }
+    #[inline(always)]
     fn round(self) -> Self {
         // 1.5·2^23: adding and subtracting it rounds to nearest even for |x| < 2^22.
         const MAGIC: f32 = 12_582_912.0;
@@ -294,7 +354,7 @@ pub use avx2::{Avx2, Avx2x2};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::Vf32;
+    use super::{Splat, Vf32};
     use core::arch::x86_64::*;
 
     /// One `__m256`. Only used inside functions compiled with `avx2,fma` and called after the
@@ -327,6 +387,22 @@ mod avx2 {
         }
     }
 
+    /// `Encoding::Linear`'s 8-bit value of each lane, as a 32-bit integer: `min(max(c, 0), 1)`
+    /// (`maxps` with 0 second maps NaN to 0), times 255, plus 0.5, truncated, each step
+    /// rounded as the scalar code rounds it (no fused multiply-add). Needs AVX (callers are
+    /// inside `avx2,fma` functions).
+    #[inline(always)]
+    fn encode_channel(c: __m256) -> __m256i {
+        // SAFETY: AVX is present (the callers' contract); register arithmetic only.
+        unsafe {
+            let v = _mm256_min_ps(_mm256_max_ps(c, _mm256_setzero_ps()), _mm256_set1_ps(1.0));
+            _mm256_cvttps_epi32(_mm256_add_ps(
+                _mm256_mul_ps(v, _mm256_set1_ps(255.0)),
+                _mm256_set1_ps(0.5),
+            ))
+        }
+    }
+
     /// Eight RGBA8 texels' red, green and blue as floats. Needs AVX2 (callers are the gathers
     /// below, inside `avx2,fma` functions).
     #[inline(always)]
@@ -345,6 +421,7 @@ mod avx2 {
     impl Vf32 for Avx2 {
         const N: usize = 8;
         type A = [f32; 8];
+        type Px = [[u8; 4]; 8];
         type M = __m256;
         #[inline(always)]
         fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
@@ -465,6 +542,39 @@ mod avx2 {
             }
         }
         #[inline(always)]
+        fn rsqrt_positive(self) -> Self {
+            // `rsqrt`'s estimate and Newton step, without its care for 0.
+            // SAFETY: AVX and FMA are present (see above).
+            unsafe {
+                let y = _mm256_rsqrt_ps(self.0);
+                let hy = _mm256_mul_ps(_mm256_mul_ps(self.0, _mm256_set1_ps(0.5)), y);
+                Avx2(_mm256_mul_ps(y, _mm256_fnmadd_ps(hy, y, _mm256_set1_ps(1.5))))
+            }
+        }
+        #[inline(always)]
+        fn load_splat(s: &Splat) -> Self {
+            // SAFETY: AVX is present (see above); `s` holds 16 readable f32, 64-byte aligned.
+            Avx2(unsafe { _mm256_load_ps(s.0.as_ptr()) })
+        }
+        #[inline(always)]
+        fn encode_rgba8(rgb: [Self; 3]) -> [[u8; 4]; 8] {
+            let mut out = [[0u8; 4]; 8];
+            // Channels as 32-bit integers, packed to 16 then 8 bits (per 128-bit half: four
+            // reds, greens, blues, alphas), then each half's 4×4 bytes transposed into pixels.
+            // SAFETY: AVX2 is present (see above); `out` is 32 writable bytes.
+            unsafe {
+                let rg = _mm256_packs_epi32(encode_channel(rgb[0].0), encode_channel(rgb[1].0));
+                let ba = _mm256_packs_epi32(encode_channel(rgb[2].0), _mm256_set1_epi32(255));
+                let planar = _mm256_packus_epi16(rg, ba);
+                let order = _mm256_setr_epi8(
+                    0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15, 0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7,
+                    11, 15,
+                );
+                _mm256_storeu_si256(out.as_mut_ptr().cast(), _mm256_shuffle_epi8(planar, order));
+            }
+            out
+        }
+        #[inline(always)]
         fn recip(self) -> Self {
             // The 12-bit estimate and one Newton step y·(2 − a·y): relative error about 2^−22.
             // SAFETY: AVX and FMA are present (see above).
@@ -566,6 +676,27 @@ mod avx2 {
             }
         }
         #[inline(always)]
+        fn frexp_folded(self) -> (Self, Self) {
+            // SAFETY: AVX2 is present (see above).
+            unsafe {
+                let bits = _mm256_castps_si256(self.0);
+                let e = _mm256_srai_epi32::<23>(_mm256_sub_epi32(bits, _mm256_set1_epi32(super::SQRT_HALF_BITS)));
+                let m = _mm256_sub_epi32(bits, _mm256_slli_epi32::<23>(e));
+                (Avx2(_mm256_cvtepi32_ps(e)), Avx2(_mm256_castsi256_ps(m)))
+            }
+        }
+        #[inline(always)]
+        fn scale_pow2(self, k: Self) -> Self {
+            // SAFETY: AVX2 is present (see above).
+            unsafe {
+                let shift = _mm256_slli_epi32::<23>(_mm256_cvtps_epi32(k.0));
+                Avx2(_mm256_castsi256_ps(_mm256_add_epi32(
+                    _mm256_castps_si256(self.0),
+                    shift,
+                )))
+            }
+        }
+        #[inline(always)]
         fn round(self) -> Self {
             // SAFETY: AVX is present (see above).
             Avx2(unsafe { _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0) })
@@ -631,6 +762,7 @@ mod avx2 {
     impl Vf32 for Avx2x2 {
         const N: usize = 16;
         type A = [f32; 16];
+        type Px = [[u8; 4]; 16];
         type M = (__m256, __m256);
         #[inline(always)]
         fn gather_rgb8(texels: &[[u8; 4]], width: u32, height: u32, x: Self, y: Self) -> [Self; 3] {
@@ -697,6 +829,24 @@ mod avx2 {
             both!(self, rsqrt)
         }
         #[inline(always)]
+        fn rsqrt_positive(self) -> Self {
+            both!(self, rsqrt_positive)
+        }
+        #[inline(always)]
+        fn load_splat(s: &Splat) -> Self {
+            let v = Avx2::load_splat(s);
+            Avx2x2(v, v)
+        }
+        #[inline(always)]
+        fn encode_rgba8(rgb: [Self; 3]) -> [[u8; 4]; 16] {
+            let lo = Avx2::encode_rgba8([rgb[0].0, rgb[1].0, rgb[2].0]);
+            let hi = Avx2::encode_rgba8([rgb[0].1, rgb[1].1, rgb[2].1]);
+            let mut out = [[0u8; 4]; 16];
+            out[..8].copy_from_slice(&lo);
+            out[8..].copy_from_slice(&hi);
+            out
+        }
+        #[inline(always)]
         fn recip(self) -> Self {
             both!(self, recip)
         }
@@ -761,6 +911,16 @@ mod avx2 {
         #[inline(always)]
         fn pow2i(self) -> Self {
             both!(self, pow2i)
+        }
+        #[inline(always)]
+        fn frexp_folded(self) -> (Self, Self) {
+            let (e0, m0) = self.0.frexp_folded();
+            let (e1, m1) = self.1.frexp_folded();
+            (Avx2x2(e0, e1), Avx2x2(m0, m1))
+        }
+        #[inline(always)]
+        fn scale_pow2(self, k: Self) -> Self {
+            both!(self, scale_pow2, k)
         }
         #[inline(always)]
         fn round(self) -> Self {

@@ -172,7 +172,13 @@ impl Tiles<'_> {
                 0
             }
             TilePlan::Reference => target.draw(local, |rows, _| self.tile_reference(tile, rows)),
-            TilePlan::Covered => target.draw(local, |rows, store| self.tile_covered(tile, rows, store, ids)),
+            TilePlan::Covered => {
+                if let Some(Some(n)) = target.draw_linear8(|rows| self.tile_covered8(tile, rows, ids)) {
+                    n
+                } else {
+                    target.draw(local, |rows, store| self.tile_covered(tile, rows, store, ids))
+                }
+            }
             TilePlan::Gouraud { kernel } => {
                 if kernel && let Some(n) = target.draw_linear8(|rows| self.tile_gouraud(tile, rows, depth, true)) {
                     n

@@ -17,14 +17,15 @@ use crate::setup::{Corners, Tri};
 use crate::simd::kernel::pixel_centre;
 use crate::simd::{
     Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group, shade_group_textured,
+    shade_group8,
 };
 use crate::stats::Marks;
-use crate::target::{Store, fill, resolve};
+use crate::target::{Store, encode, fill, resolve};
 use glam::{Vec2, Vec3};
 use phong_core::limits::SUBPIXEL_BITS;
 use phong_core::{
-    Color, Interpolation, Lit, Maps, Output, ShadingOptions, SurfacePoint, depth_color, normal_color, perturb,
-    shade_textured,
+    Color, Encoding, Interpolation, Lit, Maps, Output, ShadingOptions, SurfacePoint, depth_color, normal_color,
+    perturb, shade_textured,
 };
 
 /// How many of `ids` from the start equal `k`: 8 compared at a time (a branch-free mask LLVM
@@ -224,6 +225,50 @@ impl Tiles<'_> {
         }
         tile.clock.add(marks);
         u64::from(shaded)
+    }
+
+    /// [`TilePlan::Covered`](super::TilePlan::Covered) into the rows of an 8-bit frame that
+    /// `Encoding::Linear` encodes, for an object the vector kernels shade untextured: the
+    /// tile's pixels in row order, in the vectors [`Tiles::shade_single`] makes of them (so
+    /// the same colours), encoded in the kernel and written straight into the frame. `None`
+    /// (nothing drawn) for other objects. `pixels` is working memory.
+    pub(super) fn tile_covered8(&self, tile: &Tile, rows: &mut [&mut [[u8; 4]]], pixels: &mut Vec<u32>) -> Option<u64> {
+        let id = tile.bin[0];
+        let kind = self.plan.objects[self.binned.object(id)].mode.batch()?;
+        let mut marks = Marks::start();
+        marks.shading();
+        let (x0, y0) = (tile.x0, tile.y0);
+        let (tw, th) = (tile.width() as u32, tile.height() as u32);
+        pixels.clear();
+        for r in 0..th {
+            pixels.extend(r << 16..r << 16 | tw);
+        }
+        let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
+        let planes = self.binned.planes(id);
+        let done = if pixels.len() < group_lanes(self.plan.isa) {
+            0
+        } else {
+            shade_group8(self.plan.isa, kind, planes, (x0, y0), pixels, |p, px| {
+                let (r, c) = at(p);
+                rows[r][c..c + px.len()].copy_from_slice(px);
+            })
+        };
+        let rest = &pixels[done..];
+        shade_batch(
+            self.plan.isa,
+            kind,
+            rest.len(),
+            |i| {
+                let (x, y) = pixel_centre((x0, y0), rest[i]);
+                (x, y, planes)
+            },
+            |i, rgb| {
+                let (r, c) = at(rest[i]);
+                rows[r][c] = encode([rgb[0], rgb[1], rgb[2], 1.0], Encoding::Linear);
+            },
+        );
+        tile.clock.add(marks);
+        Some(u64::from(tw * th))
     }
 
     /// Shades a textured object's pixels `items` (`(row << 16 | column, triangle id)` in the
