@@ -258,6 +258,10 @@ pub(crate) struct FramePlan<'a> {
     pub tiles_x: u32,
     /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
     pub gouraud_only: bool,
+    /// The fast path with one sample and every object opaque and shaded by the vector kernels
+    /// per pixel, untextured ([`Mode::Phong`]): one-sample tiles of 8-bit frames are then
+    /// shaded and encoded straight into the frame (`Tiles::tile_single8`).
+    pub phong_only: bool,
     /// Per object, in the scene's order.
     pub objects: Vec<ObjectPlan<'a>>,
 }
@@ -286,6 +290,11 @@ impl<'a> FramePlan<'a> {
             background: resolve(std::iter::repeat_n(bg, ns), ns, bg),
             tiles_x: w.div_ceil(TILE_SIZE),
             gouraud_only: path == Path::Fast && objects.iter().all(|o| matches!(o.mode, Mode::Gouraud)),
+            phong_only: path == Path::Fast
+                && ns == 1
+                && objects
+                    .iter()
+                    .all(|o| matches!(o.mode, Mode::Phong(..)) && o.visibility == Visibility::Opaque),
             objects,
         }
     }

@@ -712,6 +712,30 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     }
 }
 
+/// [`shade_batch`] with the colours encoded to 8-bit RGBA in the vector registers, as
+/// `Encoding::Linear` encodes them (alpha 255): `out(i, pixel)`.
+#[inline(always)]
+pub(crate) fn shade_batch8<'p, V: Vf32>(
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    mut out: impl FnMut(usize, [u8; 4]),
+) {
+    let attrs = match batch {
+        Batch::Phong(..) | Batch::Lean(..) => 6,
+        Batch::Gouraud => 3,
+    };
+    let mut start = 0;
+    while start < n {
+        let (m, q) = lanes::<V>(&lane, start, n, attrs);
+        let px = V::encode_rgba8(batch_color::<V, true>(batch, q));
+        for (i, &p) in px.as_ref()[..m].iter().enumerate() {
+            out(start + i, p);
+        }
+        start += m;
+    }
+}
+
 /// Pixels `start..` (at most [`V::N`](Vf32::N), `m` of them; the last repeated to fill the
 /// vector) gathered by `lane`, and their first `attrs` attributes interpolated.
 #[inline(always)]

@@ -318,6 +318,44 @@ avx2_and_wide! {
     }
 }
 
+avx2_and_wide! {
+    fn shade_batch8_avx2 / shade_batch8_wide ['p] (
+        batch: Batch,
+        n: usize,
+        lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+        out: impl FnMut(usize, [u8; 4]),
+    ) {
+        kernel::shade_batch8::<vector::Avx2x2>(batch, n, lane, out)
+    }
+}
+
+/// [`shade_batch`] with the colours encoded to 8-bit RGBA in the kernel, as
+/// `Encoding::Linear` encodes them (alpha 255): `out(i, pixel)`.
+#[inline]
+pub fn shade_batch8<'p>(
+    isa: Isa,
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [u8; 4]),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if isa.is_avx2() {
+        // SAFETY: an AVX2 `Isa` exists only where the CPU has AVX2 and FMA, a wide one only
+        // where it has AVX-512F, VL, BW and DQ too (`Isa::detect`).
+        unsafe {
+            if isa.wide() {
+                shade_batch8_wide(batch, n, lane, out)
+            } else {
+                shade_batch8_avx2(batch, n, lane, out)
+            }
+        };
+        return;
+    }
+    let _ = isa;
+    kernel::shade_batch8::<vector::Portable>(batch, n, lane, out)
+}
+
 /// Interpolates and shades `n` pixels, 8 at a time: `lane(i)` gives pixel `i`'s centre and its
 /// triangle's [`Planes`], `out(i, rgb)` takes its colour.
 #[inline]

@@ -186,7 +186,15 @@ impl Tiles<'_> {
                     target.draw(local, |rows, _| self.tile_gouraud(tile, rows, depth, kernel))
                 }
             }
-            TilePlan::Single => target.draw(local, |rows, store| self.tile_single(tile, rows, store, depth, ids)),
+            TilePlan::Single => {
+                if self.plan.phong_only
+                    && let Some(n) = target.draw_linear8(|rows| self.tile_single8(tile, rows, depth, ids))
+                {
+                    n
+                } else {
+                    target.draw(local, |rows, store| self.tile_single(tile, rows, store, depth, ids))
+                }
+            }
             TilePlan::Multi => target.draw(local, |rows, _| self.tile_multi(tile, rows, multi)),
         }
     }

@@ -16,8 +16,8 @@ use crate::plan::{Mode, lit_term};
 use crate::setup::{Corners, Tri};
 use crate::simd::kernel::pixel_centre;
 use crate::simd::{
-    Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_group, shade_group_textured,
-    shade_group8,
+    Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_batch8, shade_group,
+    shade_group_textured, shade_group8,
 };
 use crate::stats::Marks;
 use crate::target::{Store, encode, fill, resolve};
@@ -45,6 +45,52 @@ pub(super) fn run_length(ids: &[u32], k: u32) -> usize {
         n += 8;
     }
     n + chunks.remainder().iter().take_while(|&&id| id == k).count()
+}
+
+/// The counting sort of a one-sample tile's visible pixels by triangle: `ids` is, per pixel,
+/// the index in the bin of its visible triangle, or [`FORWARD`], or `u32::MAX`; runs of equal
+/// ids along rows are counted, and `other(row, columns, id)` takes the runs of the last two.
+/// Returns `starts` (where triangle `k`'s pixels begin in `order`, `starts[bin.len()]` all of
+/// them) and `order`, the pixels as `row << 16 | column`, each triangle's in row order.
+fn sort_by_triangle(
+    tile: &Tile,
+    ids: &[u32],
+    mut other: impl FnMut(usize, std::ops::Range<usize>, u32),
+) -> (Vec<u32>, Vec<u32>) {
+    let (tw, th) = (tile.width(), tile.height());
+    let n = tile.bin.len();
+    // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
+    // where its pixels end in `order`. Runs are `(row << 16 | first column, length, k)`.
+    let mut starts = vec![0u32; n + 1];
+    let mut runs: Vec<(u32, u32, u32)> = Vec::with_capacity(tw * th / 4);
+    for row in 0..th {
+        let ids = &ids[row * tw..(row + 1) * tw];
+        let mut col = 0;
+        while col < tw {
+            let k = ids[col];
+            let len = run_length(&ids[col..], k);
+            if k == u32::MAX || k == FORWARD {
+                other(row, col..col + len, k);
+            } else {
+                starts[k as usize + 1] += len as u32;
+                runs.push(((row as u32) << 16 | col as u32, len as u32, k));
+            }
+            col += len;
+        }
+    }
+    for k in 0..n {
+        starts[k + 1] += starts[k];
+    }
+    let mut order = vec![0u32; starts[n] as usize];
+    let mut next = starts.clone();
+    for &(first, len, k) in &runs {
+        let at = next[k as usize] as usize;
+        for (i, o) in order[at..at + len as usize].iter_mut().enumerate() {
+            *o = first + i as u32;
+        }
+        next[k as usize] += len;
+    }
+    (starts, order)
 }
 
 /// A textured object's jobs of a multi-sample tile: `(pixel, triangle)`, and each one's index
@@ -90,46 +136,18 @@ impl Tiles<'_> {
         marks: Marks,
     ) -> u64 {
         let (bin, x0, y0) = (tile.bin, tile.x0, tile.y0);
-        let (tw, th) = (tile.width(), tile.height());
         let background = resolve(std::iter::once(self.plan.bg), 1, self.plan.bg);
-        // starts[k + 1]: how many visible pixels triangle k of the bin has, then (prefix sums)
-        // where its pixels end in `order`. Runs are `(row << 16 | first column, length, k)`.
-        let mut starts = vec![0u32; bin.len() + 1];
-        let mut shaded = 0u32;
-        let mut runs: Vec<(u32, u32, u32)> = Vec::with_capacity(tw * th / 4);
-        for (row, line) in out.iter_mut().enumerate().take(th) {
-            let ids = &ids[row * tw..(row + 1) * tw];
-            let mut col = 0;
-            while col < tw {
-                let k = ids[col];
-                let len = run_length(&ids[col..], k);
-                if k == u32::MAX {
-                    fill(&mut line[col..col + len], background, store);
-                } else if k == FORWARD {
-                    // Coloured during visibility.
-                    shaded += len as u32;
-                } else {
-                    starts[k as usize + 1] += len as u32;
-                    runs.push(((row as u32) << 16 | col as u32, len as u32, k));
-                }
-                col += len;
+        let mut forward = 0u32;
+        let (starts, order) = sort_by_triangle(tile, ids, |row, cols, k| {
+            if k == u32::MAX {
+                fill(&mut out[row][cols], background, store);
+            } else {
+                // Coloured during visibility.
+                forward += cols.len() as u32;
             }
-        }
+        });
         crate::simd::stream_fence();
-        for k in 0..bin.len() {
-            starts[k + 1] += starts[k];
-        }
-        let sorted = starts[bin.len()];
-        shaded += sorted;
-        let mut order = vec![0u32; sorted as usize];
-        let mut next = starts.clone();
-        for &(first, len, k) in &runs {
-            let at = next[k as usize] as usize;
-            for (i, o) in order[at..at + len as usize].iter_mut().enumerate() {
-                *o = first + i as u32;
-            }
-            next[k as usize] += len;
-        }
+        let shaded = forward + starts[bin.len()];
         // Per object, the pixels left over from whole vectors, with their triangles; and the
         // pixels of textured objects.
         let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
@@ -227,6 +245,67 @@ impl Tiles<'_> {
         u64::from(shaded)
     }
 
+    /// [`Tiles::shade_single`] into the rows of an 8-bit frame that `Encoding::Linear`
+    /// encodes, for a frame of opaque per-pixel Phong objects only
+    /// ([`FramePlan::phong_only`](crate::plan::FramePlan::phong_only)): the same vectors (so
+    /// the same colours), encoded in the kernel and written straight into the frame.
+    pub(super) fn shade_single8(&self, tile: &Tile, ids: &[u32], rows: &mut [&mut [[u8; 4]]], marks: Marks) -> u64 {
+        let (bin, x0, y0) = (tile.bin, tile.x0, tile.y0);
+        let background = encode(
+            resolve(std::iter::once(self.plan.bg), 1, self.plan.bg),
+            Encoding::Linear,
+        );
+        let (starts, order) = sort_by_triangle(tile, ids, |row, cols, _| rows[row][cols].fill(background));
+        let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
+        let group = group_lanes(self.plan.isa);
+        let mut rest: Vec<Vec<(u32, u32)>> = vec![Vec::new(); self.scene.objects.len()];
+        for (k, &id) in bin.iter().enumerate() {
+            let pixels = &order[starts[k] as usize..starts[k + 1] as usize];
+            let object = self.binned.object(id);
+            let Some(kind) = self.plan.objects[object].mode.batch() else {
+                debug_assert!(false, "a phong_only frame has vector-shaded objects only");
+                continue;
+            };
+            let done = if pixels.len() < group {
+                0
+            } else {
+                shade_group8(
+                    self.plan.isa,
+                    kind,
+                    self.binned.planes(id),
+                    (x0, y0),
+                    pixels,
+                    |p, px| {
+                        let (r, c) = at(p);
+                        rows[r][c..c + px.len()].copy_from_slice(px);
+                    },
+                )
+            };
+            rest[object].extend(pixels[done..].iter().map(|&p| (p, id)));
+        }
+        for (object, batch) in rest.iter().enumerate() {
+            let Some(kind) = self.plan.objects[object].mode.batch() else {
+                continue;
+            };
+            shade_batch8(
+                self.plan.isa,
+                kind,
+                batch.len(),
+                |i| {
+                    let (p, id) = batch[i];
+                    let (x, y) = pixel_centre((x0, y0), p);
+                    (x, y, self.binned.planes(id))
+                },
+                |i, px| {
+                    let (r, c) = at(batch[i].0);
+                    rows[r][c] = px;
+                },
+            );
+        }
+        tile.clock.add(marks);
+        u64::from(starts[bin.len()])
+    }
+
     /// [`TilePlan::Covered`](super::TilePlan::Covered) into the rows of an 8-bit frame that
     /// `Encoding::Linear` encodes, for an object the vector kernels shade untextured: the
     /// tile's pixels in row order, in the vectors [`Tiles::shade_single`] makes of them (so
@@ -254,7 +333,7 @@ impl Tiles<'_> {
             })
         };
         let rest = &pixels[done..];
-        shade_batch(
+        shade_batch8(
             self.plan.isa,
             kind,
             rest.len(),
@@ -262,9 +341,9 @@ impl Tiles<'_> {
                 let (x, y) = pixel_centre((x0, y0), rest[i]);
                 (x, y, planes)
             },
-            |i, rgb| {
+            |i, px| {
                 let (r, c) = at(rest[i]);
-                rows[r][c] = encode([rgb[0], rgb[1], rgb[2], 1.0], Encoding::Linear);
+                rows[r][c] = px;
             },
         );
         tile.clock.add(marks);

@@ -171,21 +171,46 @@ impl Tiles<'_> {
                     };
                     visible_single::<true, _>(scan, span, depth, ids, Some(forward), |_, _| true);
                 }
-                Visibility::Opaque => {
-                    let mut buf = SampleBuffers {
-                        rect: (tile.x0, tile.y0, tile.x1, tile.y1),
-                        depth,
-                        ids,
-                    };
-                    if !single_visible(isa, scan.t, scan.id, scan.o, scan.cols, &mut buf) {
-                        visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, |_, _| true);
-                    }
-                }
+                Visibility::Opaque => opaque_single(isa, tile, scan, depth, ids),
             }
         }
         marks.shading();
         let shaded = self.shade_single(tile, ids, rows, store, marks);
         shaded + self.blend_single(tile, &tile.bin[blended..], depth, rows)
+    }
+
+    /// [`Tiles::tile_single`] into the rows of an 8-bit frame that `Encoding::Linear` encodes,
+    /// for a frame whose objects are all opaque and per-pixel Phong ([`FramePlan::phong_only`]
+    /// (crate::plan::FramePlan::phong_only)): the same visibility, then
+    /// [`Tiles::shade_single8`].
+    pub(super) fn tile_single8(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [[u8; 4]]],
+        depth: &mut Vec<f32>,
+        ids: &mut Vec<u32>,
+    ) -> u64 {
+        let mut marks = Marks::start();
+        let (tw, th) = (tile.width(), tile.height());
+        depth.clear();
+        depth.resize(tw * th, f32::INFINITY);
+        ids.clear();
+        ids.resize(tw * th, u32::MAX);
+        // (As `tile_single`.)
+        let isa = if tw * th >= 8 * tile.bin.len() {
+            self.plan.isa
+        } else {
+            Isa::PORTABLE
+        };
+        for (k, &ti) in tile.bin.iter().enumerate() {
+            if let Some(&ahead) = tile.bin.get(k + PREFETCH_AHEAD) {
+                prefetch(self.binned.tri(ahead));
+            }
+            let scan = Scan::new(self.binned.tri(ti), k as u32, self.plan.pattern[0], (tile.x0, tile.x1));
+            opaque_single(isa, tile, scan, depth, ids);
+        }
+        marks.shading();
+        self.shade_single8(tile, ids, rows, marks)
     }
 
     /// Blends `bin`'s triangles (blended objects', in drawing order) over the shaded tile
@@ -347,6 +372,20 @@ impl Tiles<'_> {
                 }
             }
         }
+    }
+}
+
+/// The visibility of an opaque triangle in a one-sample tile: by the vector kernel where
+/// `isa` has it, else the scalar loop.
+fn opaque_single(isa: Isa, tile: &Tile, scan: Scan, depth: &mut [f32], ids: &mut [u32]) {
+    let span = (tile.x0, tile.y0, tile.width(), tile.y1);
+    let mut buf = SampleBuffers {
+        rect: (tile.x0, tile.y0, tile.x1, tile.y1),
+        depth,
+        ids,
+    };
+    if !single_visible(isa, scan.t, scan.id, scan.o, scan.cols, &mut buf) {
+        visible_single::<true, [f32; 4]>(scan, span, depth, ids, None, |_, _| true);
     }
 }
 
