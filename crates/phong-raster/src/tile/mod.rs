@@ -68,6 +68,29 @@ impl Tile<'_> {
 struct TileBuffers {
     local: Vec<[f32; 4]>,
     multi: Multi,
+    covered: CoveredPixels,
+}
+
+/// The pixels of a covered tile in row order, `row << 16 | column`: the same for every tile
+/// of one size, so kept from tile to tile.
+#[derive(Default)]
+pub(crate) struct CoveredPixels {
+    size: (u32, u32),
+    pixels: Vec<u32>,
+}
+
+impl CoveredPixels {
+    /// The pixels of a `width × height` tile.
+    pub fn of(&mut self, width: u32, height: u32) -> &[u32] {
+        if self.size != (width, height) || self.pixels.is_empty() {
+            self.size = (width, height);
+            self.pixels.clear();
+            for r in 0..height {
+                self.pixels.extend(r << 16..r << 16 | width);
+            }
+        }
+        &self.pixels
+    }
 }
 
 /// The depth and triangle of each sample, and (several samples) the shading jobs.
@@ -162,7 +185,7 @@ impl Tiles<'_> {
                 || (tile.bin.len() == 1
                     && self.plan.objects[self.binned.object(tile.bin[0])].visibility != Visibility::Blended),
         };
-        let TileBuffers { local, multi } = buffers;
+        let TileBuffers { local, multi, covered } = buffers;
         let Multi { depth, ids, .. } = multi;
         match plan {
             TilePlan::Empty => {
@@ -173,7 +196,7 @@ impl Tiles<'_> {
             }
             TilePlan::Reference => target.draw(local, |rows, _| self.tile_reference(tile, rows)),
             TilePlan::Covered => {
-                if let Some(Some(n)) = target.draw_linear8(|rows| self.tile_covered8(tile, rows, ids)) {
+                if let Some(Some(n)) = target.draw_linear8(|rows| self.tile_covered8(tile, rows, covered)) {
                     n
                 } else {
                     target.draw(local, |rows, store| self.tile_covered(tile, rows, store, ids))

@@ -310,18 +310,20 @@ impl Tiles<'_> {
     /// `Encoding::Linear` encodes, for an object the vector kernels shade untextured: the
     /// tile's pixels in row order, in the vectors [`Tiles::shade_single`] makes of them (so
     /// the same colours), encoded in the kernel and written straight into the frame. `None`
-    /// (nothing drawn) for other objects. `pixels` is working memory.
-    pub(super) fn tile_covered8(&self, tile: &Tile, rows: &mut [&mut [[u8; 4]]], pixels: &mut Vec<u32>) -> Option<u64> {
+    /// (nothing drawn) for other objects. `covered` keeps the pixel list from tile to tile.
+    pub(super) fn tile_covered8(
+        &self,
+        tile: &Tile,
+        rows: &mut [&mut [[u8; 4]]],
+        covered: &mut super::CoveredPixels,
+    ) -> Option<u64> {
         let id = tile.bin[0];
         let kind = self.plan.objects[self.binned.object(id)].mode.batch()?;
         let mut marks = Marks::start();
         marks.shading();
         let (x0, y0) = (tile.x0, tile.y0);
         let (tw, th) = (tile.width() as u32, tile.height() as u32);
-        pixels.clear();
-        for r in 0..th {
-            pixels.extend(r << 16..r << 16 | tw);
-        }
+        let pixels = covered.of(tw, th);
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
         let planes = self.binned.planes(id);
         let done = if pixels.len() < group_lanes(self.plan.isa) {
