@@ -1,5 +1,5 @@
 //! SIMD: the 8-lane kernels and their runtime dispatch. The only module of phong with
-//! `unsafe`: the AVX2 vector type's intrinsics (`vector.rs`) and the calls below into functions
+//! `unsafe`: the AVX2 vector type's intrinsics (`vector/avx2.rs`) and the calls below into functions
 //! compiled with AVX2 and FMA.
 //!
 //! The kernels ([`kernel`]) are written once over the `vector::Vf32` trait. Each entry point
@@ -13,6 +13,7 @@
 //! AVX2 build's, bit for bit.
 
 mod filter;
+mod group;
 pub mod kernel;
 mod lean;
 mod planes;
@@ -464,7 +465,7 @@ avx2_and_wide! {
         pixels: &[u32],
         out: impl FnMut(u32, [&[f32]; 3]),
     ) -> usize {
-        kernel::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+        group::shade_group::<vector::Avx2x2>(batch, planes, origin, pixels, out)
     }
 }
 
@@ -494,7 +495,7 @@ pub fn shade_group(
         };
     }
     let _ = isa;
-    kernel::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
+    group::shade_group::<vector::Portable>(batch, planes, origin, pixels, out)
 }
 
 avx2_and_wide! {
@@ -505,7 +506,7 @@ avx2_and_wide! {
         pixels: &[u32],
         out: impl FnMut(u32, &[[u8; 4]]),
     ) -> usize {
-        kernel::shade_group8::<vector::Avx2x2>(batch, planes, origin, pixels, out)
+        group::shade_group8::<vector::Avx2x2>(batch, planes, origin, pixels, out)
     }
 }
 
@@ -534,7 +535,7 @@ pub fn shade_group8(
         };
     }
     let _ = isa;
-    kernel::shade_group8::<vector::Portable>(batch, planes, origin, pixels, out)
+    group::shade_group8::<vector::Portable>(batch, planes, origin, pixels, out)
 }
 
 /// The fast setup's vertex stage (see `project.rs`): `out[i] = make(vertex)` for each vertex

@@ -769,7 +769,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_
 }
 
 /// [`shade_batch_textured`] for the pixels of one triangle, its `planes` and coordinates'
-/// planes `uv` broadcast (as [`super::kernel::shade_group`]): `pixels` are `row << 16 |
+/// planes `uv` broadcast (as [`super::group::shade_group`]): `pixels` are `row << 16 |
 /// column` from `origin`, `out(pixel, rgb)` takes each one's colour or `unsampled` its light.
 /// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline(always)]
