@@ -123,6 +123,23 @@ impl Tiles<'_> {
         self.shade_single(tile, ids, rows, store, marks)
     }
 
+    /// A one-sample tile's `depth` (all `+∞`) and `ids` (all `u32::MAX`), and the build of the
+    /// visibility kernels for it: the AVX2 kernel costs more per triangle and less per pixel
+    /// than the scalar loop, so it draws tiles of 8 pixels per triangle or more (as Gouraud's,
+    /// BENCHMARKS.md, C4).
+    fn single_buffers(&self, tile: &Tile, depth: &mut Vec<f32>, ids: &mut Vec<u32>) -> Isa {
+        let n = tile.width() * tile.height();
+        depth.clear();
+        depth.resize(n, f32::INFINITY);
+        ids.clear();
+        ids.resize(n, u32::MAX);
+        if n >= 8 * tile.bin.len() {
+            self.plan.isa
+        } else {
+            Isa::PORTABLE
+        }
+    }
+
     /// [`TilePlan::Single`](super::TilePlan::Single): one sample a pixel. `ids` gets, per
     /// pixel, the index in the bin of its visible triangle, or [`FORWARD`] where a Gouraud
     /// triangle coloured it, or `u32::MAX` (background); then [`Tiles::shade_single`].
@@ -135,19 +152,8 @@ impl Tiles<'_> {
         ids: &mut Vec<u32>,
     ) -> u64 {
         let mut marks = Marks::start();
-        let (tw, th) = (tile.width(), tile.height());
-        depth.clear();
-        depth.resize(tw * th, f32::INFINITY);
-        ids.clear();
-        ids.resize(tw * th, u32::MAX);
-        let span = (tile.x0, tile.y0, tw, tile.y1);
-        // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop: where
-        // the tile has 8 pixels per triangle or more (as Gouraud's, BENCHMARKS.md, C4).
-        let isa = if tw * th >= 8 * tile.bin.len() {
-            self.plan.isa
-        } else {
-            Isa::PORTABLE
-        };
+        let isa = self.single_buffers(tile, depth, ids);
+        let span = (tile.x0, tile.y0, tile.width(), tile.y1);
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque image.
         let mut blended = tile.bin.len();
         for (k, &ti) in tile.bin.iter().enumerate() {
@@ -180,9 +186,9 @@ impl Tiles<'_> {
     }
 
     /// [`Tiles::tile_single`] into the rows of an 8-bit frame that `Encoding::Linear` encodes,
-    /// for a frame whose objects are all opaque and per-pixel Phong ([`FramePlan::phong_only`]
-    /// (crate::plan::FramePlan::phong_only)): the same visibility, then
-    /// [`Tiles::shade_single8`].
+    /// for a frame whose objects are all opaque and per-pixel Phong
+    /// ([`FramePlan::phong_only`](crate::plan::FramePlan::phong_only)): the same visibility,
+    /// then [`Tiles::shade_single8`].
     pub(super) fn tile_single8(
         &self,
         tile: &Tile,
@@ -191,17 +197,7 @@ impl Tiles<'_> {
         ids: &mut Vec<u32>,
     ) -> u64 {
         let mut marks = Marks::start();
-        let (tw, th) = (tile.width(), tile.height());
-        depth.clear();
-        depth.resize(tw * th, f32::INFINITY);
-        ids.clear();
-        ids.resize(tw * th, u32::MAX);
-        // (As `tile_single`.)
-        let isa = if tw * th >= 8 * tile.bin.len() {
-            self.plan.isa
-        } else {
-            Isa::PORTABLE
-        };
+        let isa = self.single_buffers(tile, depth, ids);
         for (k, &ti) in tile.bin.iter().enumerate() {
             if let Some(&ahead) = tile.bin.get(k + PREFETCH_AHEAD) {
                 prefetch(self.binned.tri(ahead));
