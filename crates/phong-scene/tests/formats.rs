@@ -216,6 +216,93 @@ fn ply_triangles_of_int_indices() {
     let _ = std::fs::remove_dir_all(d);
 }
 
+/// The common binary layout read without the general reader's dispatch: float x, y, z among
+/// other scalar properties (a `uchar` between y and z, a `double` after), faces all triangles.
+/// In both byte orders and both index types, the corners are the ones written; a negative
+/// index, an index past the vertices, a position not finite, bytes after the faces and a file
+/// that ends early are read or refused as the general reader reads or refuses them.
+#[test]
+fn ply_plain_binary_triangles() {
+    let d = dir("ply-plain");
+    let want = cube_triangles();
+    let faces: Vec<[u32; 3]> = CUBE_F
+        .iter()
+        .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
+        .collect();
+    let file = |big: bool, index: &str, bad: Option<(usize, u32)>, nan: bool| {
+        let order = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
+        let mut b = format!(
+            "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
+             property uchar flags\nproperty float z\nproperty double quality\nelement face {}\n\
+             property list uchar {index} vertex_indices\nend_header\n",
+            faces.len()
+        )
+        .into_bytes();
+        for (k, v) in CUBE_V.iter().enumerate() {
+            let v = if nan && k == 2 { [v[0], f32::NAN, v[2]] } else { *v };
+            let f = |x: f32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
+            b.extend(f(v[0]));
+            b.extend(f(v[1]));
+            b.push(7);
+            b.extend(f(v[2]));
+            b.extend(if big {
+                0.5f64.to_be_bytes()
+            } else {
+                0.5f64.to_le_bytes()
+            });
+        }
+        for (k, f) in faces.iter().enumerate() {
+            b.push(3);
+            for (c, &i) in f.iter().enumerate() {
+                let i = match bad {
+                    Some((face, value)) if face == k && c == 1 => value,
+                    _ => i,
+                };
+                b.extend(if big { i.to_be_bytes() } else { i.to_le_bytes() });
+            }
+        }
+        b
+    };
+    let read = |name: &str, bytes: &[u8]| {
+        let p = write(&d, name, bytes);
+        load_model(&p, &mut Vec::new()).map(|parts| corners(&parts[0].mesh))
+    };
+    for big in [false, true] {
+        for index in ["int", "uint"] {
+            let name = format!("{big}-{index}.ply");
+            assert_eq!(read(&name, &file(big, index, None, false)).unwrap(), want, "{name}");
+            let mut longer = file(big, index, None, false);
+            longer.extend(b"\n\n");
+            assert_eq!(read(&name, &longer).unwrap(), want, "{name} with bytes after");
+            let err = read(&name, &file(big, index, Some((4, u32::MAX)), false))
+                .unwrap_err()
+                .to_string();
+            let shown = if index == "uint" { "4294967295" } else { "-1" };
+            assert!(
+                err.contains(&format!("face 4: vertex index {shown} is out of range")),
+                "{name}: {err}"
+            );
+            let err = read(&name, &file(big, index, Some((9, 8)), false))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("face 9: vertex index 8 is out of range (8 vertices)"),
+                "{name}: {err}"
+            );
+            let err = read(&name, &file(big, index, None, true)).unwrap_err().to_string();
+            assert!(err.contains("vertex 2 is not finite"), "{name}: {err}");
+            let whole = file(big, index, None, false);
+            let err = read(&name, &whole[..whole.len() - 5]).unwrap_err().to_string();
+            assert!(err.contains("element face row 11"), "{name}: {err}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(d);
+}
+
 #[test]
 fn stl_binary_and_ascii() {
     let d = dir("stl");

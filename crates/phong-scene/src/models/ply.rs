@@ -5,7 +5,7 @@
 //! error names the header line, or the element and row (and, in an ASCII file, the line).
 
 use super::ModelPart;
-use super::{model_error, part_name, polygon, recentred, vertex_color_material};
+use super::{far_origin, model_error, part_name, polygon, recentred, vertex_color_material};
 use crate::Error;
 use glam::{DVec3, Vec3};
 use phong_core::{Color, Mesh};
@@ -604,6 +604,53 @@ fn int_triangles(bytes: &[u8], mut p: usize, count: u64, signed: bool, big: bool
 pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Error> {
     let fail = |m: String| model_error(path, format!("malformed PLY: {m}"));
     let h = header(bytes).map_err(fail)?;
+    let (positions, origin, triangles, normals, colors) = match plain_binary(&h, bytes) {
+        Some((positions, triangles)) => {
+            let origin = far_origin(positions.iter().map(|p| p.as_dvec3()));
+            let positions = if origin == DVec3::ZERO {
+                positions
+            } else {
+                positions.iter().map(|p| (p.as_dvec3() - origin).as_vec3()).collect()
+            };
+            (positions, origin, triangles, None, None)
+        }
+        None => general(&h, bytes).map_err(fail)?,
+    };
+    if triangles.is_empty() {
+        return Err(model_error(
+            path,
+            format!(
+                "no faces: a point cloud of {} points, nothing to render",
+                positions.len()
+            ),
+        ));
+    }
+    let has_normals = normals.is_some() && !positions.is_empty();
+    let normals = normals.unwrap_or_else(|| vec![Vec3::ZERO; positions.len()]);
+    let mesh = Mesh::new(positions, normals, triangles)
+        .and_then(|m| m.with_colors(colors.unwrap_or_default()))
+        .map_err(|e| fail(e.to_string()))?;
+    // With colours, a white material: they are the ambient and diffuse colours.
+    let material = (!mesh.colors().is_empty()).then(vertex_color_material);
+    Ok(vec![ModelPart {
+        name: part_name(path),
+        mesh,
+        material,
+        maps: phong_core::Maps::default(),
+        has_normals,
+        origin,
+        prepared: None,
+    }])
+}
+
+/// The body of any PLY file read by the general reader (every format, type and layout; errors
+/// name the element and row): positions re-centred, their origin, the faces triangulated, and
+/// the normals and colours where the vertices have them.
+#[allow(clippy::type_complexity)]
+fn general(
+    h: &Header,
+    bytes: &[u8],
+) -> Result<(Vec<Vec3>, DVec3, Vec<[u32; 3]>, Option<Vec<Vec3>>, Option<Vec<Color>>), String> {
     let room = bytes.len() - h.body;
     let body = match h.format {
         Format::Ascii => {
@@ -613,7 +660,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
                 at: h.body,
                 line,
             };
-            read_body(&h, &mut rows, room)
+            read_body(h, &mut rows, room)
         }
         f => {
             let mut rows = Binary {
@@ -621,16 +668,15 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
                 at: h.body,
                 big: f == Format::Big,
             };
-            read_body(&h, &mut rows, room)
+            read_body(h, &mut rows, room)
         }
-    }
-    .map_err(fail)?;
+    }?;
     if body.faces_without_indices {
-        return Err(fail("face 0 has no vertex_indices".into()));
+        return Err("face 0 has no vertex_indices".into());
     }
     for (i, p) in body.points.iter().enumerate() {
         if !p.as_vec3().is_finite() {
-            return Err(fail(format!("vertex {i} is not finite in f32: {p}")));
+            return Err(format!("vertex {i} is not finite in f32: {p}"));
         }
     }
     let (positions, origin) = recentred(&body.points);
@@ -640,9 +686,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
     for (k, w) in body.starts.windows(2).enumerate() {
         let idx = &body.indices[w[0]..w[1]];
         if let Some(bad) = idx.iter().find(|&&i| i < 0 || i >= n) {
-            return Err(fail(format!(
-                "face {k}: vertex index {bad} is out of range ({n} vertices)"
-            )));
+            return Err(format!("face {k}: vertex index {bad} is out of range ({n} vertices)"));
         }
         if let [a, b, c] = *idx {
             triangles.push([a as u32, b as u32, c as u32]);
@@ -656,28 +700,87 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
                 .map(|t| t.map(|k| idx[k as usize] as u32)),
         );
     }
-    if triangles.is_empty() {
-        return Err(model_error(
-            path,
-            format!(
-                "no faces: a point cloud of {} points, nothing to render",
-                positions.len()
-            ),
-        ));
+    Ok((positions, origin, triangles, body.normals, body.colors))
+}
+
+/// The common binary file (trimesh's, Open3D's, most scanners'): a `vertex` element of scalar
+/// properties with `float` x, y and z and no normals or colours, then a `face` element of one
+/// list of triangles (`uchar` count, `int` or `uint` indices), nothing after. Its positions and
+/// triangles read in one pass each, without the general reader's per-value dispatch; `None`
+/// (nothing read) for any other file or anything amiss (a non-finite position, an index out of
+/// range, a face not a triangle, the file too short), which the general reader then reads or
+/// refuses with its message.
+fn plain_binary(h: &Header, bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
+    let big = match h.format {
+        Format::Ascii => return None,
+        f => f == Format::Big,
+    };
+    let [v, f] = &h.elements[..] else {
+        return None;
+    };
+    if v.name != "vertex" || f.name != "face" {
+        return None;
     }
-    let has_normals = body.normals.is_some() && !positions.is_empty();
-    let normals = body.normals.unwrap_or_else(|| vec![Vec3::ZERO; positions.len()]);
-    let mesh = Mesh::new(positions, normals, triangles)
-        .and_then(|m| m.with_colors(body.colors.unwrap_or_default()))
-        .map_err(|e| fail(e.to_string()))?;
-    // With colours, a white material: they are the ambient and diffuse colours.
-    let material = (!mesh.colors().is_empty()).then(vertex_color_material);
-    Ok(vec![ModelPart {
-        name: part_name(path),
-        mesh,
-        material,
-        maps: phong_core::Maps::default(),
-        has_normals,
-        origin,
-    }])
+    let s = VertexSlots::of(v);
+    if s.n.iter().all(Option::is_some) || s.c.iter().all(Option::is_some) {
+        return None;
+    }
+    let mut stride = 0;
+    let mut offsets = [0usize; 3];
+    for (i, p) in v.props.iter().enumerate() {
+        let Kind::Scalar(t) = p.kind else {
+            return None;
+        };
+        if let Some(k) = s.p.iter().position(|&slot| slot == Some(i)) {
+            if t != Scalar::F32 {
+                return None;
+            }
+            offsets[k] = stride;
+        }
+        stride += t.size();
+    }
+    if s.p.iter().any(Option::is_none) {
+        return None;
+    }
+    let [face] = &f.props[..] else {
+        return None;
+    };
+    let (Kind::List(Scalar::U8, Scalar::I32 | Scalar::U32), "vertex_indices" | "vertex_index") =
+        (face.kind, face.name.as_str())
+    else {
+        return None;
+    };
+    let (n, faces) = (usize::try_from(v.count).ok()?, usize::try_from(f.count).ok()?);
+    let vertex_bytes = n.checked_mul(stride)?;
+    let face_bytes = faces.checked_mul(13)?;
+    let body = bytes.get(h.body..)?;
+    // (At most 2^31 vertices: an `int` index below zero, read as a `uint`, is then past all.)
+    if body.len() != vertex_bytes.checked_add(face_bytes)? || n > i32::MAX as usize {
+        return None;
+    }
+    let word = |b: &[u8], o: usize| {
+        let a: [u8; 4] = b[o..o + 4].try_into().expect("4 bytes");
+        if big {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        }
+    };
+    let positions: Vec<Vec3> = body[..vertex_bytes]
+        .chunks_exact(stride)
+        .map(|row| Vec3::from_array(offsets.map(|o| f32::from_bits(word(row, o)))))
+        .collect();
+    if !positions.iter().all(|p| p.is_finite()) {
+        return None;
+    }
+    let mut ok = true;
+    let triangles: Vec<[u32; 3]> = body[vertex_bytes..]
+        .chunks_exact(13)
+        .map(|face| {
+            let tri = [1, 5, 9].map(|o| word(face, o));
+            ok &= face[0] == 3 && tri.iter().all(|&i| (i as usize) < n);
+            tri
+        })
+        .collect();
+    ok.then_some((positions, triangles))
 }

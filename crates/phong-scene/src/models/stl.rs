@@ -9,7 +9,6 @@ use super::{far_origin, model_error, part_name};
 use crate::Error;
 use glam::{DVec3, Vec3};
 use phong_core::Mesh;
-use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// One `solid` block: its name (possibly empty) and its facets' corners.
@@ -35,13 +34,21 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         }
     }
     // Every part is re-centred on one point, so that the parts keep their places.
-    let origin = far_origin(indexed.iter().flat_map(|(points, _)| points.iter().copied()));
+    let origin = far_origin(
+        indexed
+            .iter()
+            .flat_map(|(points, _)| points.iter().map(|p| p.as_dvec3())),
+    );
     let mut parts = Vec::new();
     for (i, ((name, _), (points, triangles))) in solids.into_iter().zip(indexed).enumerate() {
         if triangles.is_empty() {
             continue;
         }
-        let positions: Vec<Vec3> = points.iter().map(|p| (*p - origin).as_vec3()).collect();
+        let positions: Vec<Vec3> = if origin == DVec3::ZERO {
+            points
+        } else {
+            points.iter().map(|p| (p.as_dvec3() - origin).as_vec3()).collect()
+        };
         let normals = vec![Vec3::ZERO; positions.len()];
         let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
         let base = part_name(path);
@@ -56,6 +63,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
             maps: phong_core::Maps::default(),
             has_normals: false,
             origin,
+            prepared: None,
         });
     }
     if parts.is_empty() {
@@ -82,29 +90,28 @@ fn binary_facets(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, String> {
             body.len() / 50
         ));
     }
-    let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
     Ok(body
         .chunks_exact(50)
         .take(n)
-        .map(|b| [12, 24, 36].map(|o| Vec3::new(f(&b[o..]), f(&b[o + 4..]), f(&b[o + 8..]))))
+        .map(|b| {
+            let corners: &[u8; 36] = b[12..48].try_into().expect("36 bytes");
+            let mut v = [0.0f32; 9];
+            for (x, w) in v.iter_mut().zip(corners.chunks_exact(4)) {
+                *x = f32::from_le_bytes(w.try_into().expect("4 bytes"));
+            }
+            [
+                Vec3::new(v[0], v[1], v[2]),
+                Vec3::new(v[3], v[4], v[5]),
+                Vec3::new(v[6], v[7], v[8]),
+            ]
+        })
         .collect())
 }
 
 /// Corners with equal coordinates (bit for bit) as one vertex, in order of first use.
-fn indexed(corners: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let mut index: FxHashMap<[u32; 3], u32> = FxHashMap::with_capacity_and_hasher(corners.len(), Default::default());
-    let mut points = Vec::with_capacity(corners.len() / 2);
-    let triangles = corners
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                *index.entry(v.to_array().map(f32::to_bits)).or_insert_with(|| {
-                    points.push(v.as_dvec3());
-                    (points.len() - 1) as u32
-                })
-            })
-        })
-        .collect();
+fn indexed(corners: &[[Vec3; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let (points, remap) = phong_core::mesh::weld_exact(corners.as_flattened());
+    let triangles = remap.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
     (points, triangles)
 }
 
