@@ -303,14 +303,14 @@ impl SceneCore {
                 .with_uvs(uvs)
                 .map_err(|e| InputError::new_err(format!("uvs: {e}")))?;
         }
-        let part = phong_scene::ModelPart::new(
-            "mesh".into(),
+        let part = phong_scene::ModelPart {
+            name: "mesh".into(),
             mesh,
-            None,
-            Default::default(),
+            material: None,
+            maps: Default::default(),
             has_normals,
-            glam::DVec3::ZERO,
-        );
+            origin: glam::DVec3::ZERO,
+        };
         let model = ModelFile::from_parts(vec![part]);
         py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options, None)))
     }

@@ -131,41 +131,9 @@ pub fn scene_of_model(path: &Path, model: &ModelFile, options: &ModelOptions) ->
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let (json, notes) = crate::timing::timed(|t| &mut t.framing, || model_scene(&name, model, options));
     let parts = &model.parts;
-    // The model's object (`{"mesh", "fit": true}`, whatever the framing decides) has its
-    // normals made by crease angle where the file has none to use: made beside the framing,
-    // on another core, and handed to the scene reader with the parts.
-    let fit = fit_of(parts);
-    let ((json, notes), prepared) = crate::timing::timed_side_by_side(
-        (|t| &mut t.framing, || model_scene(&name, model, options)),
-        (
-            |t| &mut t.normals,
-            || {
-                parts
-                    .iter()
-                    .map(|p| {
-                        (!p.normals_usable())
-                            .then(|| p.prepare(fit, crate::toml_scene::DEFAULT_CREASE))
-                            .flatten()
-                            .map(std::sync::Arc::new)
-                    })
-                    .collect::<Vec<_>>()
-            },
-        ),
-    );
-    // Handed over once (the reader asks once for the scene's one object): its own to keep.
-    let prepared = std::cell::RefCell::new(prepared);
-    let lookup = |_: &str| {
-        let mut prepared = prepared.borrow_mut();
-        Ok(parts
-            .iter()
-            .zip(prepared.iter_mut())
-            .map(|(p, r)| ModelPart {
-                prepared: r.take(),
-                ..p.clone()
-            })
-            .collect())
-    };
+    let lookup = |_: &str| Ok(parts.clone());
     let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: 1,
@@ -788,57 +756,6 @@ mod tests {
             maps: Default::default(),
             has_normals: false,
             origin: DVec3::ZERO,
-            prepared: None,
-        }
-    }
-
-    /// A model alone's scene, whose object's normals are made beside the framing, is the scene
-    /// the reader makes of the same JSON with the parts as read (fitted and creased there):
-    /// the same meshes bit for bit, the same warnings. Models without normals, with usable
-    /// file normals (kept), with a zero file normal (creased, with the warning), far from the
-    /// origin, and of two parts.
-    #[test]
-    fn normals_made_beside_the_framing_are_the_readers() {
-        let with_normals = |mut m: Mesh, zero: bool| {
-            let normals: Vec<Vec3> = m.positions().iter().map(|p| p.normalize_or_zero()).collect();
-            m = m.with_flat_normals();
-            let n = m.positions().len();
-            let mut normals = normals.into_iter().cycle().take(n).collect::<Vec<_>>();
-            if zero {
-                normals[0] = Vec3::ZERO;
-            }
-            let mut p = part(Mesh::new(m.positions().to_vec(), normals, m.triangles().to_vec()).unwrap());
-            p.has_normals = true;
-            p
-        };
-        let far = {
-            let t = primitives::torus(24, 1.0, 0.3);
-            let moved: Vec<Vec3> = t
-                .positions()
-                .iter()
-                .map(|p| *p * 3.0 + Vec3::new(1e4, -2e4, 5e3))
-                .collect();
-            part(t.with_positions(moved).unwrap())
-        };
-        let models = [
-            vec![part(primitives::cylinder(12))],
-            vec![part(primitives::cube())],
-            vec![with_normals(primitives::sphere(12), false)],
-            vec![with_normals(primitives::sphere(12), true)],
-            vec![far],
-            vec![part(primitives::cone(10)), part(primitives::torus(16, 1.0, 0.25))],
-        ];
-        for (k, parts) in models.into_iter().enumerate() {
-            let model = ModelFile::from_parts(parts);
-            let path = Path::new("model.obj");
-            let made = scene_of_model(path, &model, &ModelOptions::default()).unwrap();
-            let (json, _) = model_scene("model.obj", &model, &ModelOptions::default());
-            let parts = &model.parts;
-            let reference = crate::parse_scene_json(&json, &|_: &str| Ok(parts.clone())).unwrap();
-            let meshes = |s: &phong_core::Scene| s.objects.iter().map(|o| o.mesh.clone()).collect::<Vec<_>>();
-            assert_eq!(meshes(&made.scene), meshes(&reference.scene), "model {k}");
-            assert_eq!(made.warnings, reference.warnings, "model {k}");
-            assert!(!made.scene.objects.is_empty());
         }
     }
 

@@ -41,35 +41,3 @@ pub(crate) fn timed<T>(add: fn(&mut LoadTimes) -> &mut Duration, f: impl FnOnce(
     });
     out
 }
-
-/// `a` on this thread and `b` on a thread of its own where the machine has two cores or more
-/// (else one after the other), each timed as [`timed`] times it into the stage `add_a` or
-/// `add_b` picks: the two stages then overlap in time.
-pub(crate) fn timed_side_by_side<A, B: Send>(
-    (add_a, a): (fn(&mut LoadTimes) -> &mut Duration, impl FnOnce() -> A),
-    (add_b, b): (fn(&mut LoadTimes) -> &mut Duration, impl FnOnce() -> B + Send),
-) -> (A, B) {
-    if std::thread::available_parallelism().map_or(1, |n| n.get()) < 2 {
-        return (timed(add_a, a), timed(add_b, b));
-    }
-    let (out_a, (out_b, times_b)) = std::thread::scope(|scope| {
-        let other = scope.spawn(|| {
-            let out = timed(add_b, b);
-            (out, take_times())
-        });
-        let out_a = timed(add_a, a);
-        match other.join() {
-            Ok(b) => (out_a, b),
-            Err(panic) => std::panic::resume_unwind(panic),
-        }
-    });
-    TIMES.with(|t| {
-        let mut times = t.get();
-        times.read += times_b.read;
-        times.parse += times_b.parse;
-        times.normals += times_b.normals;
-        times.framing += times_b.framing;
-        t.set(times);
-    });
-    (out_a, out_b)
-}

@@ -164,16 +164,6 @@ impl Others<'_> {
 /// (at most half full): about half the instructions of a hash map's entry per position (the
 /// bunny's 35k positions: 5.8M → 3.1M).
 pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    weld::<false>(points)
-}
-
-/// [`weld_positions`] where positions are merged only where they are equal bit for bit (0 and
-/// −0 apart): a file's corners made vertices without changing a coordinate's sign.
-pub fn weld_exact(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
-    weld::<true>(points)
-}
-
-fn weld<const EXACT: bool>(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let size = (points.len() * 2).next_power_of_two().max(16);
     let shift = 64 - size.trailing_zeros();
     let mut table = vec![u32::MAX; size];
@@ -181,7 +171,7 @@ fn weld<const EXACT: bool>(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
     let mut merged = Vec::with_capacity(points.len());
     let mut remap = Vec::with_capacity(points.len());
     for p in points {
-        let k = p.to_array().map(|c| if c == 0.0 && !EXACT { 0 } else { c.to_bits() });
+        let k = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
         let h = (u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
             ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
         let mut i = (h.wrapping_mul(0x2545_F491_4F6C_DD1D) >> shift) as usize;

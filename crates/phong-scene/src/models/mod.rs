@@ -15,7 +15,7 @@ mod stl;
 pub use gltf::{FileCamera, FileLight};
 pub(crate) use obj::decode_text;
 pub use part::ModelPart;
-pub(crate) use part::{far_origin, fitted, model_error, part_name, recentred, vertex_color_material};
+pub(crate) use part::{far_origin, model_error, part_name, recentred, vertex_color_material};
 
 use crate::{Error, read_bounded};
 use phong_core::limits::MAX_MODEL_BYTES;

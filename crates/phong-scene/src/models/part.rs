@@ -5,7 +5,6 @@ use crate::Error;
 use glam::{DVec3, Vec3};
 use phong_core::{Maps, Material, Mesh};
 use std::path::Path;
-use std::sync::Arc;
 
 /// One part of a model file, with one material: an OBJ group, a PLY file, an STL solid, a glTF
 /// primitive.
@@ -25,72 +24,6 @@ pub struct ModelPart {
     /// the origin for its size is re-centred in f64 before its positions become f32 (so that
     /// it keeps its detail); zero otherwise. Every part of a model has the same.
     pub origin: DVec3,
-    /// Its mesh fitted and with normals by crease angle, made ahead of the scene reader
-    /// ([`crate::scene_of_model`]), which takes it where its fit and crease are the ones asked.
-    pub(crate) prepared: Option<Arc<Prepared>>,
-}
-
-/// A part's mesh in a fitted frame with normals by crease angle ([`ModelPart::prepared`]).
-#[derive(Debug)]
-pub(crate) struct Prepared {
-    /// The fitted frame: centre and radius.
-    pub fit: Option<(DVec3, f64)>,
-    /// The crease angle, degrees.
-    pub crease: f32,
-    pub mesh: Mesh,
-}
-
-impl ModelPart {
-    /// A part of `mesh`, named `name`, with the file's material and maps where it has them;
-    /// `has_normals` where `mesh`'s normals are the file's, `origin` where the positions are
-    /// re-centred (see the fields).
-    pub fn new(
-        name: String,
-        mesh: Mesh,
-        material: Option<Material>,
-        maps: Maps,
-        has_normals: bool,
-        origin: DVec3,
-    ) -> ModelPart {
-        ModelPart {
-            name,
-            mesh,
-            material,
-            maps,
-            has_normals,
-            origin,
-            prepared: None,
-        }
-    }
-
-    /// Whether the file's normals are drawn as they are (given for every vertex, none zero).
-    pub(crate) fn normals_usable(&self) -> bool {
-        self.has_normals && self.mesh.normals().iter().all(|n| *n != Vec3::ZERO)
-    }
-
-    /// Its mesh [`fitted`] (where `fit` is given) with normals by crease angle, as the scene
-    /// reader makes a mesh object's; `None` where the fit fails (the reader then says why).
-    pub(crate) fn prepare(&self, fit: Option<(DVec3, f64)>, crease: f32) -> Option<Prepared> {
-        let mesh = match fit {
-            Some(f) => fitted(self.mesh.clone(), f, &self.name)
-                .ok()?
-                .with_crease_normals(crease),
-            None => self.mesh.with_crease_normals(crease),
-        };
-        Some(Prepared { fit, crease, mesh })
-    }
-}
-
-/// `mesh` (of the part `name`) moved into the frame of centre and radius `fit`, in f64
-/// (coordinates near f32's largest, a radius whose inverse is below its smallest normal
-/// number). A uniform scale and a move: the file's normals keep their directions.
-pub(crate) fn fitted(mesh: Mesh, (centre, radius): (DVec3, f64), name: &str) -> Result<Mesh, String> {
-    let positions = mesh
-        .positions()
-        .iter()
-        .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
-        .collect();
-    mesh.with_positions(positions).map_err(|e| format!("{name}: {e}"))
 }
 
 /// The name of a model's one part: its file name.

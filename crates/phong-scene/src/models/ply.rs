@@ -639,7 +639,6 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         maps: phong_core::Maps::default(),
         has_normals,
         origin,
-        prepared: None,
     }])
 }
 

@@ -9,6 +9,7 @@ use super::{far_origin, model_error, part_name};
 use crate::Error;
 use glam::{DVec3, Vec3};
 use phong_core::Mesh;
+use rustc_hash::FxHashMap;
 use std::path::Path;
 
 /// One `solid` block: its name (possibly empty) and its facets' corners.
@@ -63,7 +64,6 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
             maps: phong_core::Maps::default(),
             has_normals: false,
             origin,
-            prepared: None,
         });
     }
     if parts.is_empty() {
@@ -110,8 +110,19 @@ fn binary_facets(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, String> {
 
 /// Corners with equal coordinates (bit for bit) as one vertex, in order of first use.
 fn indexed(corners: &[[Vec3; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let (points, remap) = phong_core::mesh::weld_exact(corners.as_flattened());
-    let triangles = remap.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let mut index: FxHashMap<[u32; 3], u32> = FxHashMap::with_capacity_and_hasher(corners.len(), Default::default());
+    let mut points = Vec::with_capacity(corners.len() / 2);
+    let triangles = corners
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                *index.entry(v.to_array().map(f32::to_bits)).or_insert_with(|| {
+                    points.push(v);
+                    (points.len() - 1) as u32
+                })
+            })
+        })
+        .collect();
     (points, triangles)
 }
 

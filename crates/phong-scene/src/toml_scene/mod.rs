@@ -16,7 +16,6 @@ mod shading;
 
 pub use choices::{INTERPOLATIONS, MODELS, Model, OUTPUTS, apply_model, parse_choice};
 pub use ctx::MeshLookup;
-pub(crate) use object::DEFAULT_CREASE;
 
 use crate::overrides::Overrides;
 use crate::{Error, Loaded};

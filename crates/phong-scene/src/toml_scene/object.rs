@@ -11,7 +11,6 @@ use phong_core::limits::MAX_SEGMENTS;
 use phong_core::{Maps, Mesh, Object, ShadingSettings, primitives};
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::Arc;
 use toml::Spanned;
 
 pub(super) fn object(
@@ -42,14 +41,11 @@ pub(super) fn object(
     }
 }
 
-/// An object's `crease` where it has none, degrees.
-pub(crate) const DEFAULT_CREASE: f32 = 60.0;
-
-/// The object's `crease` (degrees, for `normals = "angle"`; [`DEFAULT_CREASE`] by default).
+/// The object's `crease` (degrees, for `normals = "angle"`; 60 by default).
 fn crease(ctx: &mut Ctx, o: &RawObject) -> Result<f32, Error> {
     match &o.crease {
         Some(c) => ctx.num(c, "crease", |x| (0.0..=180.0).contains(&x), "in [0, 180] degrees"),
-        None => Ok(DEFAULT_CREASE),
+        None => Ok(60.0),
     }
 }
 
@@ -255,6 +251,23 @@ fn mesh_objects(
     };
     let mut out = Vec::new();
     for mut p in parts {
+        if let Some((centre, radius)) = fit_frame {
+            // In f64 (coordinates near f32's largest, a radius whose inverse is below its
+            // smallest normal number). A uniform scale and a move: the file's normals keep
+            // their directions.
+            let positions = p
+                .mesh
+                .positions()
+                .iter()
+                .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
+                .collect();
+            p.mesh = std::mem::take(&mut p.mesh)
+                .with_positions(positions)
+                .map_err(|e| Error::Model {
+                    path: ctx.path.to_path_buf(),
+                    message: format!("{}: {e}", p.name),
+                })?;
+        }
         // File normals where every vertex has a usable one; else, or where `"file"`
         // is asked of a model without them, normals by angle, with a warning.
         let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
@@ -279,35 +292,15 @@ fn mesh_objects(
             Some(a) => a,
             None => "file",
         };
-        // Made ahead (beside the framing of a model alone) for this fit and crease: taken.
-        let prepared = p
-            .prepared
-            .take()
-            .filter(|r| choice == "angle" && r.fit == fit_frame && r.crease == crease);
-        let mesh = if let Some(r) = prepared {
-            crate::timing::timed(
-                |t| &mut t.normals,
-                || Arc::try_unwrap(r).map_or_else(|r| r.mesh.clone(), |r| r.mesh),
-            )
-        } else {
-            if let Some(frame) = fit_frame {
-                p.mesh = crate::models::fitted(std::mem::take(&mut p.mesh), frame, &p.name).map_err(|message| {
-                    Error::Model {
-                        path: ctx.path.to_path_buf(),
-                        message,
-                    }
-                })?;
-            }
-            crate::timing::timed(
-                |t| &mut t.normals,
-                || match choice {
-                    "flat" => p.mesh.with_flat_normals(),
-                    "smooth" => p.mesh.with_smooth_normals(),
-                    "angle" => p.mesh.with_crease_normals(crease),
-                    _ => p.mesh,
-                },
-            )
-        };
+        let mesh = crate::timing::timed(
+            |t| &mut t.normals,
+            || match choice {
+                "flat" => p.mesh.with_flat_normals(),
+                "smooth" => p.mesh.with_smooth_normals(),
+                "angle" => p.mesh.with_crease_normals(crease),
+                _ => p.mesh,
+            },
+        );
         // The scene's material replaces the file's, maps and all.
         let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
         let maps = if !maps.is_empty() && !mesh.has_uvs() {

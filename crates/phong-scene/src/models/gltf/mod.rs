@@ -626,7 +626,6 @@ fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<V
                 maps: p.maps,
                 has_normals: p.has_normals,
                 origin,
-                prepared: None,
             })
         })
         .collect()

@@ -408,7 +408,6 @@ fn part_of(
                 .unwrap_or_default(),
             has_normals,
             origin,
-            prepared: None,
         },
         m.material_id,
     )))
