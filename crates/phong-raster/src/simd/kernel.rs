@@ -688,14 +688,58 @@ pub(super) fn batch_color<V: Vf32, const RAW: bool>(batch: Batch, q: [V; 6]) -> 
     }
 }
 
-/// Shades `n` pixels 8 at a time: `lane(i)` gives pixel `i`'s centre `(x, y)` in pixels and its
-/// triangle's planes; `out(i, rgb)` receives its colour.
+/// Where [`shade_batch_into`] puts a vector's colours: as RGB floats, or encoded to 8 bits in
+/// the registers.
+trait BatchSink<V: Vf32> {
+    /// The colour of interpolated attributes `q` ([`batch_color`], clamped or not as the sink
+    /// needs).
+    fn color(batch: Batch, q: [V; 6]) -> [V; 3];
+    /// The colours `rgb` of pixels `start..start + m`.
+    fn put(&mut self, start: usize, m: usize, rgb: [V; 3]);
+}
+
+/// RGB floats: `out(i, rgb)`.
+struct RgbSink<F>(F);
+
+impl<V: Vf32, F: FnMut(usize, [f32; 3])> BatchSink<V> for RgbSink<F> {
+    #[inline(always)]
+    fn color(batch: Batch, q: [V; 6]) -> [V; 3] {
+        batch_color::<V, false>(batch, q)
+    }
+    #[inline(always)]
+    fn put(&mut self, start: usize, m: usize, rgb: [V; 3]) {
+        let rgb = rgb.map(V::to_array);
+        for i in 0..m {
+            (self.0)(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
+        }
+    }
+}
+
+/// 8-bit RGBA as `Encoding::Linear` encodes the colours (alpha 255): `out(i, pixel)`.
+struct Rgba8Sink<F>(F);
+
+impl<V: Vf32, F: FnMut(usize, [u8; 4])> BatchSink<V> for Rgba8Sink<F> {
+    #[inline(always)]
+    fn color(batch: Batch, q: [V; 6]) -> [V; 3] {
+        batch_color::<V, true>(batch, q)
+    }
+    #[inline(always)]
+    fn put(&mut self, start: usize, m: usize, rgb: [V; 3]) {
+        let px = V::encode_rgba8(rgb);
+        for (i, &p) in px.as_ref()[..m].iter().enumerate() {
+            (self.0)(start + i, p);
+        }
+    }
+}
+
+/// Shades `n` pixels a vector at a time: `lane(i)` gives pixel `i`'s centre `(x, y)` in pixels
+/// and its triangle's planes; `sink` takes their colours.
 #[inline(always)]
-pub(crate) fn shade_batch<'p, V: Vf32>(
+fn shade_batch_into<'p, V: Vf32, S: BatchSink<V>>(
     batch: Batch,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes),
-    mut out: impl FnMut(usize, [f32; 3]),
+    mut sink: S,
 ) {
     let attrs = match batch {
         Batch::Phong(..) | Batch::Lean(..) => 6,
@@ -704,12 +748,20 @@ pub(crate) fn shade_batch<'p, V: Vf32>(
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(&lane, start, n, attrs);
-        let rgb = batch_color::<V, false>(batch, q).map(V::to_array);
-        for i in 0..m {
-            out(start + i, [rgb[0].as_ref()[i], rgb[1].as_ref()[i], rgb[2].as_ref()[i]]);
-        }
+        sink.put(start, m, S::color(batch, q));
         start += m;
     }
+}
+
+/// [`shade_batch_into`] RGB floats: `out(i, rgb)` receives pixel `i`'s colour.
+#[inline(always)]
+pub(crate) fn shade_batch<'p, V: Vf32>(
+    batch: Batch,
+    n: usize,
+    lane: impl Fn(usize) -> (f32, f32, &'p Planes),
+    out: impl FnMut(usize, [f32; 3]),
+) {
+    shade_batch_into::<V, _>(batch, n, lane, RgbSink(out));
 }
 
 /// [`shade_batch`] with the colours encoded to 8-bit RGBA in the vector registers, as
@@ -719,21 +771,9 @@ pub(crate) fn shade_batch8<'p, V: Vf32>(
     batch: Batch,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes),
-    mut out: impl FnMut(usize, [u8; 4]),
+    out: impl FnMut(usize, [u8; 4]),
 ) {
-    let attrs = match batch {
-        Batch::Phong(..) | Batch::Lean(..) => 6,
-        Batch::Gouraud => 3,
-    };
-    let mut start = 0;
-    while start < n {
-        let (m, q) = lanes::<V>(&lane, start, n, attrs);
-        let px = V::encode_rgba8(batch_color::<V, true>(batch, q));
-        for (i, &p) in px.as_ref()[..m].iter().enumerate() {
-            out(start + i, p);
-        }
-        start += m;
-    }
+    shade_batch_into::<V, _>(batch, n, lane, Rgba8Sink(out));
 }
 
 /// Pixels `start..` (at most [`V::N`](Vf32::N), `m` of them; the last repeated to fill the
