@@ -62,13 +62,18 @@ fn ascii_ply_cube() -> String {
     s
 }
 
-/// A binary PLY of the cube with normals, in either byte order.
-fn binary_ply_cube(big: bool) -> Vec<u8> {
-    let order = if big {
+/// A binary PLY's `format` for the byte order.
+fn ply_order(big: bool) -> &'static str {
+    if big {
         "binary_big_endian"
     } else {
         "binary_little_endian"
-    };
+    }
+}
+
+/// A binary PLY of the cube with normals, in either byte order.
+fn binary_ply_cube(big: bool) -> Vec<u8> {
+    let order = ply_order(big);
     let mut b = format!(
         "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n\
          property float nx\nproperty float ny\nproperty float nz\nelement face 6\n\
@@ -166,11 +171,7 @@ fn ply_triangles_of_int_indices() {
         }
     }
     let file = |big: bool, index: &str, faces: &[Vec<u32>], negative: bool| {
-        let order = if big {
-            "binary_big_endian"
-        } else {
-            "binary_little_endian"
-        };
+        let order = ply_order(big);
         let mut b = format!(
             "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
              property float z\nelement face {}\nproperty list uchar {index} vertex_indices\nend_header\n",
@@ -230,11 +231,7 @@ fn ply_plain_binary_triangles() {
         .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
         .collect();
     let file = |big: bool, index: &str, bad: Option<(usize, u32)>, nan: bool| {
-        let order = if big {
-            "binary_big_endian"
-        } else {
-            "binary_little_endian"
-        };
+        let order = ply_order(big);
         let mut b = format!(
             "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
              property uchar flags\nproperty float z\nproperty double quality\nelement face {}\n\
