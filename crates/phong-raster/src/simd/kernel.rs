@@ -691,9 +691,9 @@ pub(super) fn batch_color<V: Vf32, const RAW: bool>(batch: Batch, q: [V; 6]) -> 
 /// Where [`shade_batch_into`] puts a vector's colours: as RGB floats, or encoded to 8 bits in
 /// the registers.
 trait BatchSink<V: Vf32> {
-    /// The colour of interpolated attributes `q` ([`batch_color`], clamped or not as the sink
-    /// needs).
-    fn color(batch: Batch, q: [V; 6]) -> [V; 3];
+    /// The sink encodes to 8 bits, which clamps: [`batch_color`]'s `RAW` (as the group
+    /// kernel's sink says it).
+    const ENCODES: bool;
     /// The colours `rgb` of pixels `start..start + m`.
     fn put(&mut self, start: usize, m: usize, rgb: [V; 3]);
 }
@@ -702,10 +702,7 @@ trait BatchSink<V: Vf32> {
 struct RgbSink<F>(F);
 
 impl<V: Vf32, F: FnMut(usize, [f32; 3])> BatchSink<V> for RgbSink<F> {
-    #[inline(always)]
-    fn color(batch: Batch, q: [V; 6]) -> [V; 3] {
-        batch_color::<V, false>(batch, q)
-    }
+    const ENCODES: bool = false;
     #[inline(always)]
     fn put(&mut self, start: usize, m: usize, rgb: [V; 3]) {
         let rgb = rgb.map(V::to_array);
@@ -719,10 +716,7 @@ impl<V: Vf32, F: FnMut(usize, [f32; 3])> BatchSink<V> for RgbSink<F> {
 struct Rgba8Sink<F>(F);
 
 impl<V: Vf32, F: FnMut(usize, [u8; 4])> BatchSink<V> for Rgba8Sink<F> {
-    #[inline(always)]
-    fn color(batch: Batch, q: [V; 6]) -> [V; 3] {
-        batch_color::<V, true>(batch, q)
-    }
+    const ENCODES: bool = true;
     #[inline(always)]
     fn put(&mut self, start: usize, m: usize, rgb: [V; 3]) {
         let px = V::encode_rgba8(rgb);
@@ -748,7 +742,12 @@ fn shade_batch_into<'p, V: Vf32, S: BatchSink<V>>(
     let mut start = 0;
     while start < n {
         let (m, q) = lanes::<V>(&lane, start, n, attrs);
-        sink.put(start, m, S::color(batch, q));
+        let rgb = if S::ENCODES {
+            batch_color::<V, true>(batch, q)
+        } else {
+            batch_color::<V, false>(batch, q)
+        };
+        sink.put(start, m, rgb);
         start += m;
     }
 }
