@@ -26,6 +26,32 @@ pub struct Mesh {
     tangents: Vec<Vec4>,
 }
 
+/// The first point with a coordinate that is not finite. The common case, none, is decided by
+/// one pass the compiler vectorises (the exponent bits of every coordinate or'd together);
+/// only a mesh that fails is searched.
+pub fn first_not_finite(points: &[Vec3]) -> Option<&Vec3> {
+    const EXPONENT: u32 = 0x7f80_0000;
+    let all = bytemuck::cast_slice::<Vec3, f32>(points)
+        .iter()
+        .fold(0u32, |acc, c| acc | u32::from(c.to_bits() & EXPONENT == EXPONENT));
+    if all == 0 {
+        None
+    } else {
+        points.iter().find(|p| !p.is_finite())
+    }
+}
+
+/// The first triangle with an index at or past `n`: the largest index found by one vectorised
+/// pass, the triangle searched only when it is out of range.
+pub fn first_out_of_range(triangles: &[[u32; 3]], n: usize) -> Option<&[u32; 3]> {
+    let max = triangles.as_flattened().iter().fold(0u32, |m, &i| m.max(i));
+    if triangles.is_empty() || (max as usize) < n {
+        None
+    } else {
+        triangles.iter().find(|t| t.iter().any(|&i| i as usize >= n))
+    }
+}
+
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
 #[inline]
 pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
@@ -43,14 +69,13 @@ impl Mesh {
                 value: normals.len() as f32,
             });
         }
-        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+        if let Some(p) = first_not_finite(&positions) {
             return Err(Error::InvalidPosition {
                 what: "mesh vertex",
                 value: p.to_array(),
             });
         }
-        let n = positions.len() as u64;
-        if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| u64::from(i) >= n)) {
+        if let Some(t) = first_out_of_range(&triangles, positions.len()) {
             return Err(Error::OutOfRange {
                 what: "triangle vertex index",
                 range: "less than the number of vertices",
@@ -302,30 +327,33 @@ impl Mesh {
     /// transpose of its upper 3×3, renormalised; a mirroring `m` (negative
     /// determinant) reverses the triangles so they stay counter-clockwise.
     pub fn transformed(&self, m: &Mat4) -> Mesh {
+        self.clone().into_transformed(m)
+    }
+
+    /// [`Mesh::transformed`] in place: the same arithmetic, without a copy of the mesh (a
+    /// loaded model's arrays are megabytes).
+    pub fn into_transformed(mut self, m: &Mat4) -> Mesh {
         let nm = Mat3::from_mat4(*m).inverse().transpose();
-        let flip = Mat3::from_mat4(*m).determinant() < 0.0;
-        Mesh {
-            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
-            normals: self.normals.iter().map(|&n| (nm * n).normalize_or_zero()).collect(),
-            triangles: if flip {
-                self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
-            } else {
-                self.triangles.clone()
-            },
-            uvs: self.uvs.clone(),
-            uvs1: self.uvs1.clone(),
-            colors: self.colors.clone(),
-            // A tangent is a direction in the surface: transformed by `m` itself; a mirror
-            // flips the bitangent.
-            tangents: self
-                .tangents
-                .iter()
-                .map(|t| {
-                    let d = (Mat3::from_mat4(*m) * t.truncate()).normalize_or_zero();
-                    d.extend(if flip { -t.w } else { t.w })
-                })
-                .collect(),
+        let linear = Mat3::from_mat4(*m);
+        let flip = linear.determinant() < 0.0;
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
         }
+        for n in &mut self.normals {
+            *n = (nm * *n).normalize_or_zero();
+        }
+        if flip {
+            for t in &mut self.triangles {
+                t.swap(1, 2);
+            }
+        }
+        // A tangent is a direction in the surface: transformed by `m` itself; a mirror flips
+        // the bitangent.
+        for t in &mut self.tangents {
+            let d = (linear * t.truncate()).normalize_or_zero();
+            *t = d.extend(if flip { -t.w } else { t.w });
+        }
+        self
     }
 
     /// Flat normals: every triangle gets its own three vertices carrying its facet normal.
@@ -450,6 +478,33 @@ fn append_attribute<T: Clone>(mine: &mut Vec<T>, theirs: &[T], n_mine: usize, n_
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The vectorised checks find what a plain search finds: the first point with a NaN or an
+    /// infinity in any coordinate (none in a finite mesh, the largest finite values included),
+    /// and the first triangle with an index at or past the count.
+    #[test]
+    fn checks_find_the_first_bad_element() {
+        let points: Vec<Vec3> = (0..100).map(|i| Vec3::new(i as f32, -(i as f32), f32::MAX)).collect();
+        assert_eq!(first_not_finite(&points), None);
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for (at, lane) in [(0, 0), (37, 1), (99, 2)] {
+                let mut p = points.clone();
+                p[at][lane] = bad;
+                p[at + (99 - at) / 2][2 - lane] = bad;
+                let want = p.iter().position(|q| !q.is_finite());
+                assert_eq!(
+                    first_not_finite(&p).map(|q| q as *const Vec3),
+                    want.map(|i| &p[i] as *const Vec3)
+                );
+            }
+        }
+        let tris: Vec<[u32; 3]> = (0..50u32).map(|i| [i, i + 1, i + 2]).collect();
+        assert_eq!(first_out_of_range(&tris, 52), None);
+        assert_eq!(first_out_of_range(&tris, 51), Some(&[49, 50, 51]));
+        assert_eq!(first_out_of_range(&tris, 10), Some(&[8, 9, 10]));
+        assert_eq!(first_out_of_range(&[], 0), None);
+        assert_eq!(first_out_of_range(&[[0, 0, 0]], 0), Some(&[0, 0, 0]));
+    }
 
     /// A unit square in z = 0 as two triangles, plus a third triangle folded up by 90° along x = 1.
     fn folded() -> Mesh {

@@ -117,9 +117,25 @@ pub struct ModelOptions {
 /// decided goes to `notes` (`-v`).
 pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
     let model = ModelFile::read(path)?;
-    let mut loaded = scene_of_model(path, &model, options)?;
-    loaded.warnings.splice(0..0, model.warnings);
-    loaded.sources = model.sources;
+    let (json, notes) = framed(path, &model, options);
+    let ModelFile {
+        parts,
+        warnings,
+        sources,
+        ..
+    } = model;
+    // Read for this scene alone: its parts move into the scene's object, not copied (the
+    // model-alone scene names the model once).
+    let parts = std::cell::RefCell::new(Some(parts));
+    let lookup = |_: &str| {
+        parts
+            .borrow_mut()
+            .take()
+            .ok_or_else(|| "the model is named twice in its own scene".to_string())
+    };
+    let mut loaded = scene_from(path, &json, &lookup, notes)?;
+    loaded.warnings.splice(0..0, warnings);
+    loaded.sources = sources;
     Ok(loaded)
 }
 
@@ -127,14 +143,29 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
 /// from `path` (a model read once and viewed many times: `phong batch`, the Python module).
 /// `sources` is left empty and `warnings` holds the scene reader's only.
 pub fn scene_of_model(path: &Path, model: &ModelFile, options: &ModelOptions) -> Result<Loaded, Error> {
+    let (json, notes) = framed(path, model, options);
+    let parts = &model.parts;
+    scene_from(path, &json, &|_: &str| Ok(parts.clone()), notes)
+}
+
+/// The model-alone scene of `model` (read from `path`) as JSON, and its notes.
+fn framed(path: &Path, model: &ModelFile, options: &ModelOptions) -> (serde_json::Value, Vec<String>) {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (json, notes) = crate::timing::timed(|t| &mut t.framing, || model_scene(&name, model, options));
-    let parts = &model.parts;
-    let lookup = |_: &str| Ok(parts.clone());
-    let mut loaded = crate::parse_scene_json(&json, &lookup).map_err(|e| Error::Parse {
+    crate::timing::timed(|t| &mut t.framing, || model_scene(&name, model, options))
+}
+
+/// The scene of `json` (a model-alone scene of the model at `path`), its model's parts from
+/// `lookup`, with `notes`.
+fn scene_from(
+    path: &Path,
+    json: &serde_json::Value,
+    lookup: &crate::toml_scene::MeshLookup,
+    notes: Vec<String>,
+) -> Result<Loaded, Error> {
+    let mut loaded = crate::parse_scene_json(json, lookup).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: 1,
         col: 1,

@@ -189,7 +189,7 @@ fn shape_object(
     let mesh = tangents_for(mesh, &maps);
     Ok(vec![Object {
         name: kind.to_string(),
-        mesh: mesh.transformed(&world_from_object),
+        mesh: mesh.into_transformed(&world_from_object),
         material,
         shading,
         maps,
@@ -318,7 +318,7 @@ fn mesh_objects(
         let mesh = tangents_for(mesh, &maps);
         out.push(Object {
             name: p.name,
-            mesh: mesh.transformed(&world_from_file),
+            mesh: mesh.into_transformed(&world_from_file),
             material,
             shading,
             maps,

@@ -284,7 +284,7 @@ pub(super) fn load_obj_text(
     let materials = materials_of(path, &tobj_materials, warnings);
     let maps = material_maps(&tobj_materials, map_requests.into_inner(), read_texture, warnings);
     let mut parts = Vec::new();
-    for model in &models {
+    for model in models {
         if let Some(part) = part_of(path, src, model, (&materials, &maps), prepared.origin, warnings)? {
             parts.push(part);
         }
@@ -328,7 +328,7 @@ fn material_maps(
 fn part_of(
     path: &Path,
     src: &str,
-    model: &tobj::Model,
+    mut model: tobj::Model,
     (materials, maps): (&[Material], &[Maps]),
     origin: glam::DVec3,
     warnings: &mut Vec<String>,
@@ -337,16 +337,19 @@ fn part_of(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let m = &model.mesh;
-    if m.indices.is_empty() {
+    if model.mesh.indices.is_empty() {
         return Ok(None);
     }
-    let positions: Vec<Vec3> = m
-        .positions
-        .chunks_exact(3)
-        .map(|p| Vec3::new(p[0], p[1], p[2]))
-        .collect();
-    let has_normals = m.normals.len() == m.positions.len();
+    // The flat coordinates taken as points, and the indices as triangles where every face is
+    // one, in place where the vectors' sizes allow (the reader sizes them so), else copied.
+    let positions: Vec<Vec3> = bytemuck::allocation::try_cast_vec(std::mem::take(&mut model.mesh.positions))
+        .unwrap_or_else(|(_, flat)| flat.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect());
+    let triangles: Option<Vec<[u32; 3]>> = model.mesh.face_arities.is_empty().then(|| {
+        bytemuck::allocation::try_cast_vec(std::mem::take(&mut model.mesh.indices))
+            .unwrap_or_else(|(_, flat)| flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
+    });
+    let m = &model.mesh;
+    let has_normals = m.normals.len() == 3 * positions.len();
     let normals = if has_normals {
         m.normals
             .chunks_exact(3)
@@ -355,7 +358,10 @@ fn part_of(
     } else {
         vec![Vec3::ZERO; positions.len()]
     };
-    let tris = polygons_to_triangles(&positions, &m.indices, &m.face_arities);
+    let tris = match triangles {
+        Some(t) => t,
+        None => polygons_to_triangles(&positions, &m.indices, &m.face_arities),
+    };
     let n = positions.len();
     // One texture coordinate per vertex where the file gives them (tobj's single index).
     let uvs: Vec<Vec2> = if m.texcoords.len() == 2 * n {

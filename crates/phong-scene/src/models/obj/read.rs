@@ -10,7 +10,7 @@
 //! and materials (`usemtl`) split the faces into models as tobj splits them.
 
 use super::text::{
-    Checker, NO_MATERIAL, lines, plain_decimal, plain_decimal_bytes, plain_index, slashed, strtod, vertex_kind, words,
+    Checker, NO_MATERIAL, lines, plain_decimal, plain_decimal_at, plain_index, slashed, strtod, vertex_kind, words,
 };
 use crate::Error;
 use glam::DVec3;
@@ -283,13 +283,24 @@ impl<'a> Reader<'a> {
         let mut xs = [0.0f64; 3];
         let mut own = [0.0f32; 3];
         let mut n = 0;
-        for word in rest.split(|&c| c == b' ').filter(|w| !w.is_empty()) {
+        // Words apart by spaces, each read where it starts (one pass over the line).
+        let mut i = 0;
+        loop {
+            while i < rest.len() && rest[i] == b' ' {
+                i += 1;
+            }
+            if i == rest.len() {
+                break;
+            }
             if n == 3 {
                 return false;
             }
-            match plain_decimal_bytes(word) {
-                Some((x, f)) => (xs[n], own[n]) = (x, f),
-                None => return false,
+            match plain_decimal_at(rest, i) {
+                Some((x, f, end)) if end == rest.len() || rest[end] == b' ' => {
+                    (xs[n], own[n]) = (x, f);
+                    i = end;
+                }
+                _ => return false,
             }
             n += 1;
         }
@@ -310,12 +321,28 @@ impl<'a> Reader<'a> {
         let count = self.base[0] + self.xyz.len() as i64;
         let mut corners = [0u32; 8];
         let mut n = 0;
-        for word in rest.split(|&c| c == b' ').filter(|w| !w.is_empty()) {
-            if n == corners.len() || word.len() > 18 || !word.iter().all(u8::is_ascii_digit) {
+        let mut i = 0;
+        loop {
+            while i < rest.len() && rest[i] == b' ' {
+                i += 1;
+            }
+            if i == rest.len() {
+                break;
+            }
+            if n == corners.len() {
                 return false;
             }
-            let v = word.iter().fold(0i64, |v, &c| v * 10 + i64::from(c - b'0'));
-            if v < 1 || v > count {
+            // A word of at most 18 digits, ended by a space or the line.
+            let start = i;
+            let mut v = 0i64;
+            while i < rest.len() && rest[i].is_ascii_digit() {
+                if i - start == 18 {
+                    return false;
+                }
+                v = v * 10 + i64::from(rest[i] - b'0');
+                i += 1;
+            }
+            if i == start || (i < rest.len() && rest[i] != b' ') || v < 1 || v > count {
                 return false;
             }
             corners[n] = (v - 1) as u32;
@@ -409,22 +436,20 @@ impl<'a> Reader<'a> {
         // the f64 value moved to the origin, then rounded.
         let origin = crate::models::far_origin(self.xyz.iter().copied());
         let keep_colours = self.seven && !self.xyz.is_empty();
-        let positions: Vec<f32> = self
-            .xyz
-            .iter()
-            .zip(&self.direct)
-            .flat_map(|(x, own)| {
-                (0..3).map(move |k| {
-                    if origin[k] == 0.0 && !own[k].is_nan() {
-                        own[k]
-                    } else {
-                        (x[k] - origin[k]) as f32
-                    }
-                })
-            })
-            .collect();
+        // (A loop into a sized vector: a flattening iterator's `collect` grew it element by
+        // element.)
+        let mut positions: Vec<f32> = Vec::with_capacity(3 * self.xyz.len());
+        for (x, own) in self.xyz.iter().zip(&self.direct) {
+            for k in 0..3 {
+                positions.push(if origin[k] == 0.0 && !own[k].is_nan() {
+                    own[k]
+                } else {
+                    (x[k] - origin[k]) as f32
+                });
+            }
+        }
         let colours: Vec<f32> = if keep_colours {
-            self.colours.iter().flatten().copied().collect()
+            self.colours.as_flattened().to_vec()
         } else {
             Vec::new()
         };
@@ -471,6 +496,8 @@ impl Groups {
     /// A pass's faces and events, in file order, after those of the passes before it.
     fn replay(&mut self, r: &mut Reader, load_mtl: &mut dyn FnMut(&Path) -> tobj::MTLLoadResult) {
         let (mut c0, mut a0) = (0, 0);
+        self.current.corners.reserve(r.corners.len());
+        self.current.arities.reserve(r.arities.len());
         for (c, a, e) in std::mem::take(&mut r.events) {
             self.current.corners.extend_from_slice(&r.corners[c0..c]);
             self.current.arities.extend_from_slice(&r.arities[a0..a]);
@@ -656,18 +683,22 @@ fn vertex_counts(run: &str) -> [i64; 3] {
 /// One pass over the lines `src[run.0..run.1]`, with `base` vertex statements before them:
 /// the pass, and the error it stopped at.
 fn pass<'a>(path: &'a Path, src: &'a str, run: (usize, usize), base: [i64; 3]) -> (Reader<'a>, Option<Error>) {
+    // Room for as many vertices and faces as the run has lines, three corners a face: no
+    // growth (each a copy of what was read) for the common files; memory not written to is
+    // only reserved.
+    let lines = newlines(&src.as_bytes()[run.0..run.1]) + 1;
     let mut r = Reader {
         path,
         src,
         base,
-        xyz: Vec::new(),
-        direct: Vec::new(),
+        xyz: Vec::with_capacity(lines),
+        direct: Vec::with_capacity(lines),
         colours: Vec::new(),
         seven: true,
         texcoords: Vec::new(),
         normals: Vec::new(),
-        corners: Vec::new(),
-        arities: Vec::new(),
+        corners: Vec::with_capacity(3 * lines),
+        arities: Vec::with_capacity(lines),
         events: Vec::new(),
         lenient: None,
         short_faces: 0,
@@ -680,6 +711,15 @@ fn pass<'a>(path: &'a Path, src: &'a str, run: (usize, usize), base: [i64; 3]) -
     };
     let error = statements(&mut r, run).err();
     (r, error)
+}
+
+/// The `\n` bytes of `bytes`, counted in 8-bit lanes (blocks of 255 bytes, so that no lane
+/// wraps): a few instructions a 32 bytes, where a count in `usize` costs a few a byte.
+fn newlines(bytes: &[u8]) -> usize {
+    bytes
+        .chunks(255)
+        .map(|block| usize::from(block.iter().fold(0u8, |n, &b| n.wrapping_add(u8::from(b == b'\n')))))
+        .sum()
 }
 
 /// The statements of a pass's lines, until the first error.
@@ -741,6 +781,9 @@ fn export(g: Group, positions: &[f32], colours: &[f32], texcoords: &[f32], norma
     let mut by_key: FxHashMap<[u32; 3], u32> = FxHashMap::default();
     let n = g.corners.len();
     mesh.indices.reserve(n);
+    // At most one vertex a corner, and (positions alone) one a position.
+    let most = if plain { n.min(positions.len() / 3) } else { n };
+    mesh.positions.reserve(3 * most);
     for c in &g.corners {
         let slot = if plain {
             &mut by_v[c[0] as usize]
@@ -777,6 +820,23 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
     use std::io::BufReader;
+
+    /// The newline count in 8-bit lanes is the plain count, over blocks that end on a
+    /// newline, runs of more than 255 newlines, and none.
+    #[test]
+    fn newlines_are_counted() {
+        for text in [
+            "",
+            "v",
+            "\n",
+            "f 1 2 3\n",
+            &"\n".repeat(1000),
+            &"ab\ncd\n\n".repeat(300),
+        ] {
+            let want = text.bytes().filter(|&b| b == b'\n').count();
+            assert_eq!(newlines(text.as_bytes()), want, "{:?}", &text[..text.len().min(20)]);
+        }
+    }
 
     /// The models, materials, notes and origin a reader gives.
     type Outcome = (Vec<tobj::Model>, Vec<tobj::Material>, Vec<String>, DVec3);

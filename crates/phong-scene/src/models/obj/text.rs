@@ -177,43 +177,42 @@ pub(super) fn words<'a>(line: &'a str, out: &mut Vec<(usize, &'a str)>) {
 /// 10^22 for f64, 2^24 and 10^10 for f32), so one division rounds correctly (Clinger's fast
 /// path); the f32 is parsed apart where its fast path does not hold.
 pub(super) fn plain_decimal(word: &str) -> Option<(f64, f32)> {
-    plain_decimal_bytes(word.as_bytes())
+    plain_decimal_at(word.as_bytes(), 0).and_then(|(x, f, end)| (end == word.len()).then_some((x, f)))
 }
 
-/// [`plain_decimal`] of a word's bytes.
-pub(super) fn plain_decimal_bytes(b: &[u8]) -> Option<(f64, f32)> {
+/// [`plain_decimal`] of the number that starts at `b[start]` (a sign, digits, a point,
+/// digits), read up to the first byte that is none of these: its value and that byte's
+/// index, read in the same pass as the line (no word split first).
+pub(super) fn plain_decimal_at(b: &[u8], start: usize) -> Option<(f64, f32, usize)> {
     const POW10: [f64; 23] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
         1e20, 1e21, 1e22,
     ];
     const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
-    let negative = b.first() == Some(&b'-');
-    let body = &b[usize::from(negative || b.first() == Some(&b'+'))..];
-    if body.is_empty() || body.len() > 20 {
-        return None;
-    }
+    let negative = b.get(start) == Some(&b'-');
+    let body = start + usize::from(negative || b.get(start) == Some(&b'+'));
     // The digits before the point, then those after it, into one mantissa (at most 20
     // digits: wrapping where 20 overflow, and refused below).
     let digit = |c: u8| c.wrapping_sub(b'0');
     let mut m = 0u64;
-    let mut i = 0;
-    while i < body.len() && digit(body[i]) < 10 {
-        m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+    let mut i = body;
+    while i < b.len() && digit(b[i]) < 10 {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(digit(b[i])));
         i += 1;
     }
-    let whole = i;
+    let whole = i - body;
     let mut fraction = 0;
-    if i < body.len() && body[i] == b'.' {
+    if i < b.len() && b[i] == b'.' {
         i += 1;
-        let start = i;
-        while i < body.len() && digit(body[i]) < 10 {
-            m = m.wrapping_mul(10).wrapping_add(u64::from(digit(body[i])));
+        let first = i;
+        while i < b.len() && digit(b[i]) < 10 {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(digit(b[i])));
             i += 1;
         }
-        fraction = i - start;
+        fraction = i - first;
     }
     let digits = whole + fraction;
-    if i < body.len() || digits == 0 || digits > 19 || m > 1 << 53 || fraction >= POW10.len() {
+    if i - body > 20 || digits == 0 || digits > 19 || m > 1 << 53 || fraction >= POW10.len() {
         return None;
     }
     let sign = if negative { -1.0 } else { 1.0 };
@@ -227,9 +226,9 @@ pub(super) fn plain_decimal_bytes(b: &[u8]) -> Option<(f64, f32)> {
         x as f32
     } else {
         // (ASCII: a sign, digits and a point.)
-        std::str::from_utf8(b).ok()?.parse::<f32>().ok()?
+        std::str::from_utf8(&b[start..i]).ok()?.parse::<f32>().ok()?
     };
-    Some((x, f))
+    Some((x, f, i))
 }
 
 /// A corner's fields between its slashes (`r.split('/')`, without a generic searcher).
