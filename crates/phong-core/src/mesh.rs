@@ -7,7 +7,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rustc_hash::FxHashMap;
 
 mod crease;
-pub use crease::weld_positions;
+pub use crease::{weld_ids, weld_positions};
 
 /// An indexed triangle mesh with one normal per vertex and, optionally, texture coordinates
 /// per vertex. Triangles are counter-clockwise seen from the side their normals point to.

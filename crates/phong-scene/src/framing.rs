@@ -681,6 +681,30 @@ impl Closed {
     }
 }
 
+/// Each face of `parts` with three distinct welded ids (`ids`, all parts' vertices in turn;
+/// `identity`: each id is the vertex's index), given to `f` with its positions. Generic, so
+/// that each pass is one loop (as a `dyn` callback it was a call per face).
+#[inline(always)]
+fn each_face(parts: &[ModelPart], ids: &[u32], identity: bool, mut f: impl FnMut([u32; 3], [Vec3; 3])) {
+    let mut first = 0;
+    for p in parts {
+        let pos = p.mesh.positions();
+        let id = &ids[first..first + pos.len()];
+        let base = first as u32;
+        first += pos.len();
+        for t in p.mesh.triangles() {
+            let [a, b, c] = if identity {
+                t.map(|i| base + i)
+            } else {
+                t.map(|i| id[i as usize])
+            };
+            if a != b && b != c && c != a {
+                f([a, b, c], t.map(|i| pos[i as usize]));
+            }
+        }
+    }
+}
+
 /// Models with more triangles than this are not checked for closedness (and drawn two-sided):
 /// the edge lists take about 36 bytes a triangle.
 const MAX_CLOSED_CHECK: usize = 4_000_000;
@@ -692,9 +716,9 @@ fn closedness(parts: &[ModelPart]) -> Closed {
         return Closed::Unchecked;
     }
     // Positions welded (one id where parts or vertices share a position), all parts at once.
-    let (welded, ids) = match parts {
-        [p] => phong_core::mesh::weld_positions(p.mesh.positions()),
-        _ => phong_core::mesh::weld_positions(
+    let (distinct, ids) = match parts {
+        [p] => phong_core::mesh::weld_ids(p.mesh.positions()),
+        _ => phong_core::mesh::weld_ids(
             &parts
                 .iter()
                 .flat_map(|p| p.mesh.positions())
@@ -702,29 +726,15 @@ fn closedness(parts: &[ModelPart]) -> Closed {
                 .collect::<Vec<_>>(),
         ),
     };
-    let distinct = welded.len();
+    // Every position distinct (most files): a vertex's id is its index.
+    let identity = distinct == ids.len();
     // Each face's edges (x, y) as (higher id, +1 or -1), kept under the lower id; a closed,
     // consistent model has two faces on every edge, wound opposite ways. Lists under each id
     // (counted in a first pass over the faces, filled in a second), not a hash map of edges:
     // linear, and a few times faster.
-    // Each face with three distinct ids: its ids and its positions.
-    let faces = |f: &mut dyn FnMut([u32; 3], [Vec3; 3])| {
-        let mut first = 0;
-        for p in parts {
-            let pos = p.mesh.positions();
-            let id = &ids[first..first + pos.len()];
-            first += pos.len();
-            for t in p.mesh.triangles() {
-                let [a, b, c] = t.map(|i| id[i as usize]);
-                if a != b && b != c && c != a {
-                    f([a, b, c], t.map(|i| pos[i as usize]));
-                }
-            }
-        }
-    };
     let mut start = vec![0u32; distinct + 1];
     let mut volume = 0.0f64;
-    faces(&mut |[a, b, c], [pa, pb, pc]| {
+    each_face(parts, &ids, identity, |[a, b, c], [pa, pb, pc]| {
         volume += pa.as_dvec3().dot(pb.as_dvec3().cross(pc.as_dvec3()));
         for (x, y) in [(a, b), (b, c), (c, a)] {
             start[x.min(y) as usize + 1] += 1;
@@ -735,7 +745,7 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     }
     let mut under = vec![(0u32, 0i32); start[distinct] as usize];
     let mut fill = start.clone();
-    faces(&mut |[a, b, c], _| {
+    each_face(parts, &ids, identity, |[a, b, c], _| {
         for (x, y) in [(a, b), (b, c), (c, a)] {
             let (lo, hi, sign) = if x < y { (x, y, 1) } else { (y, x, -1) };
             under[fill[lo as usize] as usize] = (hi, sign);
@@ -788,6 +798,40 @@ mod tests {
             has_normals: false,
             origin: DVec3::ZERO,
         }
+    }
+
+    /// Parts whose positions are all distinct (each id its index, counted on from part to
+    /// part): two welded cubes apart are closed, a cube and a plane apart are open at the
+    /// plane's 8 border edges, and the same parts with each position repeated (ids by table)
+    /// are judged alike.
+    #[test]
+    fn closedness_of_distinct_parts() {
+        let cube = primitives::cube().welded();
+        assert_eq!(cube.positions().len(), 8, "a welded cube has its 8 corners");
+        let moved = |m: &Mesh, dx: f32| m.transformed(&glam::Mat4::from_translation(Vec3::new(dx, 0.0, 0.0)));
+        let two = [part(cube.clone()), part(moved(&cube, 5.0))];
+        assert_eq!(closedness(&two), Closed::Outward);
+        let plane = primitives::plane(2).welded();
+        let open = [part(cube.clone()), part(moved(&plane, 5.0))];
+        let want = Closed::Open {
+            open_edges: 8,
+            inconsistent: 0,
+        };
+        assert_eq!(closedness(&open), want);
+        // Each part's positions twice over (the second copy unused): ids from the table.
+        let doubled = |m: &Mesh| {
+            let mut p = m.positions().to_vec();
+            p.extend_from_slice(m.positions());
+            Mesh::from_triangles(p, m.triangles().to_vec()).unwrap()
+        };
+        assert_eq!(
+            closedness(&[part(doubled(&cube)), part(moved(&doubled(&cube), 5.0))]),
+            Closed::Outward
+        );
+        assert_eq!(
+            closedness(&[part(doubled(&cube)), part(moved(&doubled(&plane), 5.0))]),
+            want
+        );
     }
 
     /// The cube (its faces' vertices apart, joined by position) is closed; a plane is open;

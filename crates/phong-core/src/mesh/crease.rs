@@ -6,14 +6,24 @@ use super::Mesh;
 use crate::Color;
 use glam::{Vec2, Vec3};
 use rustc_hash::FxHashMap;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 impl Mesh {
     /// [`Mesh::with_crease_normals`], and the work it did (facet comparisons), for the test
     /// that it is linear.
     pub(super) fn crease_normals(&self, crease_deg: f32) -> (Mesh, u64) {
-        let (positions, remap) = weld_positions(&self.positions);
-        let tris: Vec<[u32; 3]> = self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect();
+        // Where no two positions are equal (most files), the mesh's own arrays stand for the
+        // welded ones: no copies.
+        let (distinct, remap) = weld_ids(&self.positions);
+        let (positions, tris): (Cow<[Vec3]>, Cow<[[u32; 3]]>) = if distinct == self.positions.len() {
+            (Cow::Borrowed(&self.positions), Cow::Borrowed(&self.triangles))
+        } else {
+            (
+                Cow::Owned(merged(&self.positions, &remap, distinct)),
+                Cow::Owned(self.triangles.iter().map(|t| t.map(|i| remap[i as usize])).collect()),
+            )
+        };
         let cos_crease = crease_deg.to_radians().cos();
         let (facet, unit) = facets_of(&positions, &tris);
         // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
@@ -160,15 +170,34 @@ impl Others<'_> {
 }
 
 /// Positions merged where they are equal (0 and −0 alike), in the order first met, and per
-/// position its merged index. An open-addressing table of indices sized for the positions
-/// (at most half full): about half the instructions of a hash map's entry per position (the
-/// bunny's 35k positions: 5.8M → 3.1M).
+/// position its merged index.
 pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
+    let (distinct, ids) = weld_ids(points);
+    (merged(points, &ids, distinct), ids)
+}
+
+/// The `distinct` positions of `points` in the order first met, from their ids
+/// ([`weld_ids`]).
+fn merged(points: &[Vec3], ids: &[u32], distinct: usize) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(distinct);
+    for (p, &id) in points.iter().zip(ids) {
+        if id as usize == out.len() {
+            out.push(*p);
+        }
+    }
+    out
+}
+
+/// How many distinct positions `points` has (equal positions, 0 and −0 alike, are one), and
+/// per point the index of its position in the order first met: point `i`'s is `i` for every
+/// `i` exactly where the count is `points.len()`. An open-addressing table of indices sized
+/// for the positions (at most half full): about half the instructions of a hash map's entry
+/// per position (the bunny's 35k positions: 5.8M → 3.1M).
+pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
     let size = (points.len() * 2).next_power_of_two().max(16);
     let shift = 64 - size.trailing_zeros();
     let mut table = vec![u32::MAX; size];
     let mut keys: Vec<[u32; 3]> = Vec::with_capacity(points.len());
-    let mut merged = Vec::with_capacity(points.len());
     let mut remap = Vec::with_capacity(points.len());
     for p in points {
         let k = p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
@@ -181,7 +210,6 @@ pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
                 let e = keys.len() as u32;
                 table[i] = e;
                 keys.push(k);
-                merged.push(*p);
                 break e;
             }
             if keys[e as usize] == k {
@@ -191,7 +219,7 @@ pub fn weld_positions(points: &[Vec3]) -> (Vec<Vec3>, Vec<u32>) {
         };
         remap.push(index);
     }
-    (merged, remap)
+    (keys.len(), remap)
 }
 
 /// Faces at a vertex up to which the mean direction may stand for all of them
@@ -502,6 +530,27 @@ fn edge_groups(
 #[cfg(test)]
 mod crease_tests {
     use super::*;
+
+    /// Welded ids: equal positions (0 and −0 alike) share an id and only they do, ids are
+    /// numbered as first met, the count is the number of distinct positions, and all-distinct
+    /// points get their own indices; `weld_positions` lists each distinct position once.
+    #[test]
+    fn welded_ids_number_positions_as_first_met() {
+        let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        let points = [
+            p(1.0, 2.0, 3.0),
+            p(0.0, 1.0, 0.0),
+            p(1.0, 2.0, 3.0),
+            p(-0.0, 1.0, -0.0),
+            p(4.0, 5.0, 6.0),
+        ];
+        let (count, ids) = weld_ids(&points);
+        assert_eq!((count, ids.clone()), (3, vec![0, 1, 0, 1, 2]));
+        let (merged, same) = weld_positions(&points);
+        assert_eq!((merged, same), (vec![points[0], points[1], points[4]], ids));
+        let distinct: Vec<Vec3> = (0..1000).map(|i| p(i as f32 * 0.5, (i % 7) as f32, 1.0)).collect();
+        assert_eq!(weld_ids(&distinct), (1000, (0..1000).collect()));
+    }
 
     impl Mesh {
         /// The crease normals from their definition alone, for meshes whose vertices have at
