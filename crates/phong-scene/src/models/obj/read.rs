@@ -282,29 +282,12 @@ impl<'a> Reader<'a> {
     fn plain_vertex(&mut self, rest: &[u8]) -> bool {
         let mut xs = [0.0f64; 3];
         let mut own = [0.0f32; 3];
-        let mut n = 0;
-        // Words apart by spaces, each read where it starts (one pass over the line).
-        let mut i = 0;
-        loop {
-            while i < rest.len() && rest[i] == b' ' {
-                i += 1;
-            }
-            if i == rest.len() {
-                break;
-            }
-            if n == 3 {
-                return false;
-            }
-            match plain_decimal_at(rest, i) {
-                Some((x, f, end)) if end == rest.len() || rest[end] == b' ' => {
-                    (xs[n], own[n]) = (x, f);
-                    i = end;
-                }
-                _ => return false,
-            }
-            n += 1;
-        }
-        if n < 3 {
+        let words = each_word(rest, 3, |n, i| {
+            let (x, f, end) = plain_decimal_at(rest, i)?;
+            (xs[n], own[n]) = (x, f);
+            Some(end)
+        });
+        if words != Some(3) {
             return false;
         }
         self.seven = false;
@@ -320,37 +303,25 @@ impl<'a> Reader<'a> {
     fn plain_face(&mut self, rest: &[u8]) -> bool {
         let count = self.base[0] + self.xyz.len() as i64;
         let mut corners = [0u32; 8];
-        let mut n = 0;
-        let mut i = 0;
-        loop {
-            while i < rest.len() && rest[i] == b' ' {
-                i += 1;
-            }
-            if i == rest.len() {
-                break;
-            }
-            if n == corners.len() {
-                return false;
-            }
-            // A word of at most 18 digits, ended by a space or the line.
-            let start = i;
-            let mut v = 0i64;
+        // Each a word of at most 18 digits.
+        let words = each_word(rest, corners.len(), |n, start| {
+            let (mut i, mut v) = (start, 0i64);
             while i < rest.len() && rest[i].is_ascii_digit() {
                 if i - start == 18 {
-                    return false;
+                    return None;
                 }
                 v = v * 10 + i64::from(rest[i] - b'0');
                 i += 1;
             }
-            if i == start || (i < rest.len() && rest[i] != b' ') || v < 1 || v > count {
-                return false;
+            if i == start || v < 1 || v > count {
+                return None;
             }
             corners[n] = (v - 1) as u32;
-            n += 1;
-        }
-        if n < 3 {
+            Some(i)
+        });
+        let Some(n) = words.filter(|&n| n >= 3) else {
             return false;
-        }
+        };
         self.corners.extend(corners[..n].iter().map(|&v| [v, MISSING, MISSING]));
         self.arities.push(n as u32);
         true
@@ -711,6 +682,31 @@ fn pass<'a>(path: &'a Path, src: &'a str, run: (usize, usize), base: [i64; 3]) -
     };
     let error = statements(&mut r, run).err();
     (r, error)
+}
+
+/// The words of `rest` (apart by spaces), each read where it starts, in one pass over the
+/// line: `read(n, i)` reads word `n` at `rest[i]` and returns where it ended, which must be a
+/// space or the line's end. The number of words, or `None` where a word is refused or there
+/// are more than `most`.
+#[inline(always)]
+fn each_word(rest: &[u8], most: usize, mut read: impl FnMut(usize, usize) -> Option<usize>) -> Option<usize> {
+    let (mut n, mut i) = (0, 0);
+    loop {
+        while i < rest.len() && rest[i] == b' ' {
+            i += 1;
+        }
+        if i == rest.len() {
+            return Some(n);
+        }
+        if n == most {
+            return None;
+        }
+        let end = read(n, i)?;
+        if end < rest.len() && rest[end] != b' ' {
+            return None;
+        }
+        (i, n) = (end, n + 1);
+    }
 }
 
 /// The `\n` bytes of `bytes`, counted in 8-bit lanes (blocks of 255 bytes, so that no lane
