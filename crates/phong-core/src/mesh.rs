@@ -26,10 +26,15 @@ pub struct Mesh {
     tangents: Vec<Vec4>,
 }
 
-/// The first point with a coordinate that is not finite. The common case, none, is decided by
-/// one pass the compiler vectorises (the exponent bits of every coordinate or'd together);
-/// only a mesh that fails is searched.
+/// The first point with a coordinate that is not finite ([`not_finite_at`]).
 pub fn first_not_finite(points: &[Vec3]) -> Option<&Vec3> {
+    not_finite_at(points).map(|i| &points[i])
+}
+
+/// The index of the first point with a coordinate that is not finite. The common case,
+/// none, is decided by one pass the compiler vectorises (the exponent bits of every
+/// coordinate or'd together); only points that fail are searched.
+pub fn not_finite_at(points: &[Vec3]) -> Option<usize> {
     const EXPONENT: u32 = 0x7f80_0000;
     let all = bytemuck::cast_slice::<Vec3, f32>(points)
         .iter()
@@ -37,18 +42,23 @@ pub fn first_not_finite(points: &[Vec3]) -> Option<&Vec3> {
     if all == 0 {
         None
     } else {
-        points.iter().find(|p| !p.is_finite())
+        points.iter().position(|p| !p.is_finite())
     }
 }
 
-/// The first triangle with an index at or past `n`: the largest index found by one vectorised
-/// pass, the triangle searched only when it is out of range.
+/// The first triangle with an index at or past `n` ([`index_at_least`] over its corners).
 pub fn first_out_of_range(triangles: &[[u32; 3]], n: usize) -> Option<&[u32; 3]> {
-    let max = triangles.as_flattened().iter().fold(0u32, |m, &i| m.max(i));
-    if triangles.is_empty() || (max as usize) < n {
+    index_at_least(triangles.as_flattened(), n).map(|k| &triangles[k / 3])
+}
+
+/// Where the first index at or past `n` is in `indices`: the largest found by one vectorised
+/// pass, the position searched only when it is out of range.
+pub fn index_at_least(indices: &[u32], n: usize) -> Option<usize> {
+    let max = indices.iter().fold(0u32, |m, &i| m.max(i));
+    if indices.is_empty() || (max as usize) < n {
         None
     } else {
-        triangles.iter().find(|t| t.iter().any(|&i| i as usize >= n))
+        indices.iter().position(|&i| i as usize >= n)
     }
 }
 

@@ -379,12 +379,8 @@ fn geometry(
     let positions = packed_positions(prim, buffers)
         .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
         .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
-    if phong_core::mesh::first_not_finite(bytemuck::cast_slice(&positions)).is_some()
-        && let Some((i, p)) = positions
-            .iter()
-            .enumerate()
-            .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
-    {
+    if let Some(i) = phong_core::mesh::not_finite_at(bytemuck::cast_slice(&positions)) {
+        let p = positions[i];
         return Err(fail(format!("{what}: position {i} is not finite: {p:?}")));
     }
     let n = positions.len();
@@ -408,9 +404,8 @@ fn geometry(
         (None, Some(i)) => i.into_u32().collect(),
         (None, None) => (0..n as u32).collect(),
     };
-    if indices.iter().fold(0u32, |m, &i| m.max(i)) as usize >= n
-        && let Some(bad) = indices.iter().find(|&&i| i as usize >= n)
-    {
+    if let Some(k) = phong_core::mesh::index_at_least(&indices, n) {
+        let bad = indices[k];
         return Err(fail(format!("{what}: index {bad} is out of range ({n} vertices)")));
     }
     let mut tris: Vec<[u32; 3]> = match prim.mode() {
