@@ -310,6 +310,7 @@ impl SceneCore {
             maps: Default::default(),
             has_normals,
             origin: glam::DVec3::ZERO,
+            drawn: None,
         };
         let model = ModelFile::from_parts(vec![part]);
         py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options, None)))

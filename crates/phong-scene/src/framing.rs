@@ -6,8 +6,10 @@
 //! framed by the same arithmetic. The view is built in the model's frame: its up axis (given,
 //! or detected), its front, and the camera placed so that every vertex is inside the frame.
 
+use crate::toml_scene::object::{DEFAULT_CREASE, default_normals, drawn_mesh};
 use crate::{Error, Loaded, ModelFile, ModelFormat, ModelPart};
 use glam::{DVec3, Vec3};
+use phong_core::Mesh;
 use std::path::Path;
 
 /// An axis, signed: the model's up (`--up`).
@@ -116,8 +118,32 @@ pub struct ModelOptions {
 /// its mesh (so that `phong render MODEL` and `phong serve MODEL` draw the same). What the view
 /// decided goes to `notes` (`-v`).
 pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loaded, Error> {
-    let model = ModelFile::read(path)?;
-    let (json, notes) = framed(path, &model, options);
+    let mut model = ModelFile::read(path)?;
+    // The framing (its closedness check) and the parts as drawn (their normals) do not depend
+    // on each other and take milliseconds each for a large model: side by side. What the scene
+    // reader would compute for the model-alone scene's object, by its own function.
+    let fit = fit_of(&model.parts);
+    let draw = |parts: &[ModelPart]| -> Vec<Option<Mesh>> {
+        parts
+            .iter()
+            .map(|p| drawn_mesh(p.mesh.clone(), fit, default_normals(p), DEFAULT_CREASE).ok())
+            .collect()
+    };
+    let (json, notes) = if beside_worth_it(&model) {
+        let (framing, drawn) = std::thread::scope(|scope| {
+            let parts = &model.parts;
+            let other = scope.spawn(move || (draw(parts), crate::timing::take_times()));
+            let framing = framed(path, &model, options);
+            (framing, other.join().expect("the normals' thread panicked"))
+        });
+        crate::timing::add_times(drawn.1);
+        for (p, d) in model.parts.iter_mut().zip(drawn.0) {
+            p.drawn = d;
+        }
+        framing
+    } else {
+        framed(path, &model, options)
+    };
     let ModelFile {
         parts,
         warnings,
@@ -137,6 +163,19 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     loaded.warnings.splice(0..0, warnings);
     loaded.sources = sources;
     Ok(loaded)
+}
+
+/// Whether the framing and the normals of `parts` are worth a second thread: where both
+/// are computed (a model without normals of its own, not a glTF, whose closedness the framing
+/// checks) and large enough that a thread's start (tens of µs) is small beside them.
+fn beside_worth_it(model: &ModelFile) -> bool {
+    const MIN_TRIANGLES: usize = 20_000;
+    let parts = &model.parts;
+    let triangles: usize = parts.iter().map(|p| p.mesh.triangles().len()).sum();
+    model.format != ModelFormat::Gltf
+        && (MIN_TRIANGLES..=MAX_CLOSED_CHECK).contains(&triangles)
+        && parts.iter().any(|p| default_normals(p) == "angle")
+        && std::thread::available_parallelism().is_ok_and(|n| n.get() > 1)
 }
 
 /// The scene of a model alone (as `phong render MODEL` frames it) for a model already read
@@ -797,6 +836,7 @@ mod tests {
             maps: Default::default(),
             has_normals: false,
             origin: DVec3::ZERO,
+            drawn: None,
         }
     }
 

@@ -26,6 +26,18 @@ pub fn take_times() -> LoadTimes {
     TIMES.with(|t| t.replace(LoadTimes::default()))
 }
 
+/// Adds `t` (another thread's stage times, taken where it ends) to this thread's.
+pub(crate) fn add_times(t: LoadTimes) {
+    TIMES.with(|c| {
+        let mut times = c.get();
+        times.read += t.read;
+        times.parse += t.parse;
+        times.normals += t.normals;
+        times.framing += t.framing;
+        c.set(times);
+    });
+}
+
 /// Runs `f`, adding its time to the stage `add` picks; time spent reading files inside it is
 /// counted as reading only.
 pub(crate) fn timed<T>(add: fn(&mut LoadTimes) -> &mut Duration, f: impl FnOnce() -> T) -> T {

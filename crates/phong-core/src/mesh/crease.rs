@@ -37,7 +37,7 @@ impl Mesh {
         let n = positions.len();
         // Most vertices take `Rule::Same`, found in two passes over the faces; the faces
         // around each vertex and the other rules only for the rest.
-        let (same, count) = same_normals(n, &tris, &facet, &unit, cos_half);
+        let (mut same, count) = same_normals(n, &tris, &facet, &unit, cos_half);
         let mut work = 6 * tris.len() as u64;
         // Per vertex of the rest, its rule's index (u32::MAX: none).
         let mut slot = vec![u32::MAX; n];
@@ -54,6 +54,10 @@ impl Mesh {
             let cosines = (cos_crease, cos_half);
             for v in (0..n).filter(|&v| slot[v] != u32::MAX) {
                 let r = vertex_rule(around.of(slot[v]), v as u32, &tris, &facet, &unit, cosines, &mut work);
+                // One normal for all its corners: the corner loop's shortcut.
+                if let Rule::Same(m) = r {
+                    same[v] = m;
+                }
                 rules.push(r);
             }
         }
@@ -340,15 +344,24 @@ fn vertex_rule(
 ) -> Rule {
     const MANY_GROUPS: usize = 64;
     if fs.len() <= MANY {
+        *work += fs.len() as u64;
+        let sum = fs.iter().fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize]);
+        let mean = sum.normalize_or_zero();
         if let Some(cos_half) = cos_half {
-            *work += 2 * fs.len() as u64;
-            let sum = fs.iter().fold(Vec3::ZERO, |acc, &g| acc + facet[g as usize]);
-            let mean = sum.normalize_or_zero();
+            *work += fs.len() as u64;
             if mean != Vec3::ZERO && fs.iter().all(|&g| unit[g as usize].dot(mean) >= cos_half) {
                 return Rule::Same(mean);
             }
         }
-        return Rule::Plain;
+        // Every pair of faces within the crease (each face with itself too: at a crease of
+        // 0° a unit vector's square may fall short of 1): each corner's loop would keep every
+        // face, in face order, so its sum is `sum` (dot products are symmetric in f32).
+        *work += (fs.len() * (fs.len() + 1) / 2) as u64;
+        let all = fs.iter().enumerate().all(|(i, &f)| {
+            let u = unit[f as usize];
+            fs[i..].iter().all(|&g| unit[g as usize].dot(u) >= cos_crease)
+        });
+        return if all { Rule::Same(mean) } else { Rule::Plain };
     }
     let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
     let mut g: Vec<(Vec3, Vec3)> = Vec::new();

@@ -24,6 +24,11 @@ pub struct ModelPart {
     /// the origin for its size is re-centred in f64 before its positions become f32 (so that
     /// it keeps its detail); zero otherwise. Every part of a model has the same.
     pub origin: DVec3,
+    /// The mesh as the model-alone scene draws it (fitted to the model's bounding sphere, its
+    /// normals by the default rule), where `phong render MODEL` computed it beside the framing;
+    /// `None` from the readers. The scene reader uses it for an object with `fit` and no
+    /// `normals` or `crease` of its own, and computes the same otherwise.
+    pub drawn: Option<Mesh>,
 }
 
 /// The name of a model's one part: its file name.

@@ -639,6 +639,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         maps: phong_core::Maps::default(),
         has_normals,
         origin,
+        drawn: None,
     }])
 }
 

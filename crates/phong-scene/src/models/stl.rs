@@ -64,6 +64,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
             maps: phong_core::Maps::default(),
             has_normals: false,
             origin,
+            drawn: None,
         });
     }
     if parts.is_empty() {

@@ -10,7 +10,7 @@ mod ctx;
 mod image;
 mod light;
 mod material;
-mod object;
+pub(crate) mod object;
 mod raw;
 mod shading;
 

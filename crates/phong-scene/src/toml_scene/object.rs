@@ -5,7 +5,7 @@ use super::ctx::{Ctx, S};
 use super::material::{Mat, lookup_material, material};
 use super::raw::{MaterialRef, RawMaterial, RawObject, Scale};
 use crate::Error;
-use crate::ModelFile;
+use crate::{ModelFile, ModelPart};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use phong_core::limits::MAX_SEGMENTS;
 use phong_core::{Maps, Mesh, Object, ShadingSettings, primitives};
@@ -41,11 +41,14 @@ pub(super) fn object(
     }
 }
 
-/// The object's `crease` (degrees, for `normals = "angle"`; 60 by default).
+/// The crease angle of `normals = "angle"` where the object gives none, in degrees.
+pub(crate) const DEFAULT_CREASE: f32 = 60.0;
+
+/// The object's `crease` (degrees, for `normals = "angle"`; [`DEFAULT_CREASE`] by default).
 fn crease(ctx: &mut Ctx, o: &RawObject) -> Result<f32, Error> {
     match &o.crease {
         Some(c) => ctx.num(c, "crease", |x| (0.0..=180.0).contains(&x), "in [0, 180] degrees"),
-        None => Ok(60.0),
+        None => Ok(DEFAULT_CREASE),
     }
 }
 
@@ -196,6 +199,47 @@ fn shape_object(
     }])
 }
 
+/// The normals a part is drawn with where the scene does not ask: the file's where every
+/// vertex has a usable one, else by angle.
+pub(crate) fn default_normals(p: &ModelPart) -> &'static str {
+    if p.has_normals && !p.mesh.normals().contains(&Vec3::ZERO) {
+        "file"
+    } else {
+        "angle"
+    }
+}
+
+/// A part's mesh as its object draws it: fitted to `fit_frame` (centre and radius, where the
+/// object has `fit`) and given the normals of `choice` (`crease` degrees for `"angle"`).
+pub(crate) fn drawn_mesh(
+    mut mesh: Mesh,
+    fit_frame: Option<(glam::DVec3, f64)>,
+    choice: &str,
+    crease: f32,
+) -> Result<Mesh, phong_core::Error> {
+    if let Some((centre, radius)) = fit_frame {
+        // In f64 (coordinates near f32's largest, a radius whose inverse is below its
+        // smallest normal number). A uniform scale and a move: the file's normals keep
+        // their directions. Fitted before the normals are computed (at 1e30, f32 cross
+        // products overflow).
+        let positions = mesh
+            .positions()
+            .iter()
+            .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
+            .collect();
+        mesh = mesh.with_positions(positions)?;
+    }
+    Ok(crate::timing::timed(
+        |t| &mut t.normals,
+        || match choice {
+            "flat" => mesh.with_flat_normals(),
+            "smooth" => mesh.with_smooth_normals(),
+            "angle" => mesh.with_crease_normals(crease),
+            _ => mesh,
+        },
+    ))
+}
+
 /// A `mesh` object: one object a part of the model file, placed in the file's coordinates (or
 /// fitted), its normals as asked (the file's where usable), the scene's material or the file's.
 fn mesh_objects(
@@ -251,23 +295,6 @@ fn mesh_objects(
     };
     let mut out = Vec::new();
     for mut p in parts {
-        if let Some((centre, radius)) = fit_frame {
-            // In f64 (coordinates near f32's largest, a radius whose inverse is below its
-            // smallest normal number). A uniform scale and a move: the file's normals keep
-            // their directions.
-            let positions = p
-                .mesh
-                .positions()
-                .iter()
-                .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
-                .collect();
-            p.mesh = std::mem::take(&mut p.mesh)
-                .with_positions(positions)
-                .map_err(|e| Error::Model {
-                    path: ctx.path.to_path_buf(),
-                    message: format!("{}: {e}", p.name),
-                })?;
-        }
         // File normals where every vertex has a usable one; else, or where `"file"`
         // is asked of a model without them, normals by angle, with a warning.
         let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
@@ -290,17 +317,17 @@ fn mesh_objects(
         let choice = match asked {
             Some("file") | None if !usable => "angle",
             Some(a) => a,
-            None => "file",
+            None => default_normals(&p),
         };
-        let mesh = crate::timing::timed(
-            |t| &mut t.normals,
-            || match choice {
-                "flat" => p.mesh.with_flat_normals(),
-                "smooth" => p.mesh.with_smooth_normals(),
-                "angle" => p.mesh.with_crease_normals(crease),
-                _ => p.mesh,
-            },
-        );
+        let mesh = match p.drawn.take() {
+            // Computed beside the model-alone scene's framing by this same function, for the
+            // choice and crease it would be given here.
+            Some(drawn) if fit && asked.is_none() && o.crease.is_none() => drawn,
+            _ => drawn_mesh(std::mem::take(&mut p.mesh), fit_frame, choice, crease).map_err(|e| Error::Model {
+                path: ctx.path.to_path_buf(),
+                message: format!("{}: {e}", p.name),
+            })?,
+        };
         // The scene's material replaces the file's, maps and all.
         let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
         let maps = if !maps.is_empty() && !mesh.has_uvs() {

@@ -624,6 +624,7 @@ fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<V
                 maps: p.maps,
                 has_normals: p.has_normals,
                 origin,
+                drawn: None,
             })
         })
         .collect()

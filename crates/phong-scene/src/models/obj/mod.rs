@@ -414,6 +414,7 @@ fn part_of(
                 .unwrap_or_default(),
             has_normals,
             origin,
+            drawn: None,
         },
         m.material_id,
     )))
