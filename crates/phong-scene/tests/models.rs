@@ -1310,3 +1310,102 @@ fn every_face_the_camera_sees_is_lit() {
         );
     }
 }
+
+/// `phong render MODEL` computes a large model's normals beside its framing, on a second
+/// thread (the model's `drawn` meshes); `scene_of_model` (batch, Python) computes them in the
+/// scene reader. Both give the same scene, bit for bit: camera, sides, and each object's
+/// positions, normals and triangles. Models of 20k triangles and more without normals: a
+/// smooth torus and a teapot with rims and a spout (creases, split vertices), as OBJ and as
+/// binary STL.
+#[test]
+fn normals_beside_the_framing_are_the_scene_readers() {
+    let d = dir("beside");
+    let obj = |m: &phong_core::Mesh| {
+        let mut s = String::new();
+        for p in m.positions() {
+            s += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+        for t in m.triangles() {
+            s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s.into_bytes()
+    };
+    let stl = |m: &phong_core::Mesh| {
+        let mut b = vec![0u8; 80];
+        b.extend((m.triangles().len() as u32).to_le_bytes());
+        for t in m.triangles() {
+            b.extend([0u8; 12]);
+            for &i in t {
+                for c in m.positions()[i as usize].to_array() {
+                    b.extend(c.to_le_bytes());
+                }
+            }
+            b.extend([0u8; 2]);
+        }
+        b
+    };
+    let torus = phong_core::primitives::torus(160, 1.0, 0.35);
+    let teapot = phong_core::primitives::teapot(20);
+    let mut files = Vec::new();
+    for (name, mesh) in [("torus", &torus), ("teapot", &teapot)] {
+        assert!(mesh.triangles().len() >= 20_000, "{name}: {}", mesh.triangles().len());
+        files.push(write(&d, &format!("{name}.obj"), &obj(mesh)));
+        files.push(write(&d, &format!("{name}.stl"), &stl(mesh)));
+    }
+    let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+    for path in &files {
+        let options = ModelOptions::default();
+        let beside = load_with(path, &options).unwrap();
+        let model = ModelFile::read(path).unwrap();
+        let reader = phong_scene::scene_of_model(path, &model, &options).unwrap();
+        let (a, b) = (&beside.scene, &reader.scene);
+        assert_eq!(
+            format!("{:?}", a.camera),
+            format!("{:?}", b.camera),
+            "{}",
+            path.display()
+        );
+        assert_eq!(
+            format!("{:?}", a.lighting),
+            format!("{:?}", b.lighting),
+            "{}",
+            path.display()
+        );
+        assert_eq!(a.objects.len(), b.objects.len());
+        for (x, y) in a.objects.iter().zip(&b.objects) {
+            // (Not `assert_eq!`: a difference would print every vertex.)
+            assert!(
+                bits(x.mesh.positions()) == bits(y.mesh.positions()),
+                "{}: positions",
+                path.display()
+            );
+            assert!(
+                bits(x.mesh.normals()) == bits(y.mesh.normals()),
+                "{}: normals",
+                path.display()
+            );
+            assert!(
+                x.mesh.triangles() == y.mesh.triangles(),
+                "{}: triangles",
+                path.display()
+            );
+            assert_eq!(
+                format!("{:?}", x.shading),
+                format!("{:?}", y.shading),
+                "{}",
+                path.display()
+            );
+            let unit = x
+                .mesh
+                .normals()
+                .iter()
+                .filter(|n| (n.length() - 1.0).abs() < 1e-4)
+                .count();
+            assert!(
+                unit * 100 >= x.mesh.normals().len() * 99,
+                "{}: normals computed",
+                path.display()
+            );
+        }
+    }
+}

@@ -25,7 +25,6 @@ impl Mesh {
             )
         };
         let cos_crease = crease_deg.to_radians().cos();
-        let (facet, unit) = facets_of(&positions, &tris);
         // The shortcut's half angle, less 0.02° against f32's rounding of the dot products
         // (whose error in angle is under 0.001° for creases in [1°, 179°]), so that it gives
         // what the loop would.
@@ -37,7 +36,13 @@ impl Mesh {
         let n = positions.len();
         // Most vertices take `Rule::Same`, found in two passes over the faces; the faces
         // around each vertex and the other rules only for the rest.
-        let (mut same, count) = same_normals(n, &tris, &facet, &unit, cos_half);
+        let Facets {
+            facet,
+            unit,
+            sum,
+            count,
+        } = facets_of(&positions, &tris, cos_half.is_some());
+        let mut same = same_normals(sum, &count, &tris, &unit, cos_half);
         let mut work = 6 * tris.len() as u64;
         // Per vertex of the rest, its rule's index (u32::MAX: none).
         let mut slot = vec![u32::MAX; n];
@@ -230,46 +235,68 @@ pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
 /// ([`vertex_rule`]).
 const MANY: usize = 32;
 
-/// Per vertex of the welded mesh `w`, the normal of `Rule::Same` where [`vertex_rule`] would
-/// give it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
-/// `cos_half`), else zero; and its number of corners. The facets are summed per vertex in
-/// face order, as [`vertex_rule`] sums them: the same bits, without the faces-around lists.
 /// Each face's facet normal `(b − a) × (c − a)` (its length twice its area) and that
-/// normal's unit vector (zero for a degenerate face).
-fn facets_of(positions: &[Vec3], tris: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
-    let facet: Vec<Vec3> = tris
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            (b - a).cross(c - a)
-        })
-        .collect();
-    let unit: Vec<Vec3> = facet.iter().map(|f| f.normalize_or_zero()).collect();
-    (facet, unit)
+/// normal's unit vector (zero for a degenerate face); per vertex, its number of corners and
+/// (where asked) its faces' facets summed in face order.
+struct Facets {
+    facet: Vec<Vec3>,
+    unit: Vec<Vec3>,
+    /// Empty where not asked.
+    sum: Vec<Vec3>,
+    count: Vec<u32>,
 }
 
-fn same_normals(
-    n: usize,
-    tris: &[[u32; 3]],
-    facet: &[Vec3],
-    unit: &[Vec3],
-    cos_half: Option<f32>,
-) -> (Vec<Vec3>, Vec<u32>) {
-    let mut mean = vec![Vec3::ZERO; n];
+/// [`Facets`] of a welded mesh, in one pass over its faces.
+fn facets_of(positions: &[Vec3], tris: &[[u32; 3]], sums: bool) -> Facets {
+    if sums {
+        facets_summed::<true>(positions, tris)
+    } else {
+        facets_summed::<false>(positions, tris)
+    }
+}
+
+#[inline(always)]
+fn facets_summed<const SUMS: bool>(positions: &[Vec3], tris: &[[u32; 3]]) -> Facets {
+    let n = positions.len();
+    let mut facet = Vec::with_capacity(tris.len());
+    let mut unit = Vec::with_capacity(tris.len());
+    let mut sum = vec![Vec3::ZERO; if SUMS { n } else { 0 }];
     let mut count = vec![0u32; n];
-    let Some(cos_half) = cos_half else {
-        for &v in tris.iter().flatten() {
-            count[v as usize] += 1;
-        }
-        return (mean, count);
-    };
-    for (t, f) in tris.iter().zip(facet) {
+    for t in tris {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+        let f = (b - a).cross(c - a);
+        facet.push(f);
+        unit.push(f.normalize_or_zero());
         for &v in t {
-            mean[v as usize] += *f;
             count[v as usize] += 1;
+            if SUMS {
+                sum[v as usize] += f;
+            }
         }
     }
-    for (m, &c) in mean.iter_mut().zip(&count) {
+    Facets {
+        facet,
+        unit,
+        sum,
+        count,
+    }
+}
+
+/// Per vertex of the welded mesh, the normal of `Rule::Same` where [`vertex_rule`] would give
+/// it (at most [`MANY`] faces, all within half the crease angle of their mean direction,
+/// `cos_half`), else zero, from its facets' sum in face order (`sum`, as [`vertex_rule`] sums
+/// them: the same bits, without the faces-around lists) and its number of corners.
+fn same_normals(
+    mut mean: Vec<Vec3>,
+    count: &[u32],
+    tris: &[[u32; 3]],
+    unit: &[Vec3],
+    cos_half: Option<f32>,
+) -> Vec<Vec3> {
+    let Some(cos_half) = cos_half else {
+        return vec![Vec3::ZERO; count.len()];
+    };
+    for (m, &c) in mean.iter_mut().zip(count) {
         *m = if c as usize > MANY {
             Vec3::ZERO
         } else {
@@ -286,7 +313,7 @@ fn same_normals(
             }
         }
     }
-    (mean, count)
+    mean
 }
 
 /// The faces around some of the vertices, in face order: those of the vertex of slot `k`
