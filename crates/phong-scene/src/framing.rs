@@ -681,9 +681,11 @@ fn facets(parts: &[ModelPart]) -> Facets {
             let [a, b, c] = t.map(|i| pos[i as usize].as_dvec3());
             let n = (b - a).cross(c - a);
             let half = n * 0.5;
-            sums.area += half;
-            sums.area_total += half.length();
             let area2 = n.length();
+            sums.area += half;
+            // `half.length()`, one root fewer: halving is exact in f64 for products of f32
+            // coordinates (no underflow or overflow), and so is the root's.
+            sums.area_total += area2 * 0.5;
             if area2.is_nan() || area2 <= 0.0 {
                 continue;
             }
@@ -721,10 +723,16 @@ impl Closed {
 }
 
 /// Each face of `parts` with three distinct welded ids (`ids`, all parts' vertices in turn;
-/// `identity`: each id is the vertex's index), given to `f` with its positions. Generic, so
-/// that each pass is one loop (as a `dyn` callback it was a call per face).
+/// `identity`: each id is the vertex's index), given to `f` with its positions (zeros without
+/// `POSITIONS`: a pass that reads none does not fetch them). Generic, so that each pass is one
+/// loop (as a `dyn` callback it was a call per face).
 #[inline(always)]
-fn each_face(parts: &[ModelPart], ids: &[u32], identity: bool, mut f: impl FnMut([u32; 3], [Vec3; 3])) {
+fn each_face<const POSITIONS: bool>(
+    parts: &[ModelPart],
+    ids: &[u32],
+    identity: bool,
+    mut f: impl FnMut([u32; 3], [Vec3; 3]),
+) {
     let mut first = 0;
     for p in parts {
         let pos = p.mesh.positions();
@@ -738,7 +746,14 @@ fn each_face(parts: &[ModelPart], ids: &[u32], identity: bool, mut f: impl FnMut
                 t.map(|i| id[i as usize])
             };
             if a != b && b != c && c != a {
-                f([a, b, c], t.map(|i| pos[i as usize]));
+                f(
+                    [a, b, c],
+                    if POSITIONS {
+                        t.map(|i| pos[i as usize])
+                    } else {
+                        [Vec3::ZERO; 3]
+                    },
+                );
             }
         }
     }
@@ -773,7 +788,7 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     // linear, and a few times faster.
     let mut start = vec![0u32; distinct + 1];
     let mut volume = 0.0f64;
-    each_face(parts, &ids, identity, |[a, b, c], [pa, pb, pc]| {
+    each_face::<true>(parts, &ids, identity, |[a, b, c], [pa, pb, pc]| {
         volume += pa.as_dvec3().dot(pb.as_dvec3().cross(pc.as_dvec3()));
         for (x, y) in [(a, b), (b, c), (c, a)] {
             start[x.min(y) as usize + 1] += 1;
@@ -784,7 +799,7 @@ fn closedness(parts: &[ModelPart]) -> Closed {
     }
     let mut under = vec![(0u32, 0i32); start[distinct] as usize];
     let mut fill = start.clone();
-    each_face(parts, &ids, identity, |[a, b, c], _| {
+    each_face::<false>(parts, &ids, identity, |[a, b, c], _| {
         for (x, y) in [(a, b), (b, c), (c, a)] {
             let (lo, hi, sign) = if x < y { (x, y, 1) } else { (y, x, -1) };
             under[fill[lo as usize] as usize] = (hi, sign);
