@@ -220,7 +220,7 @@ impl RunArgs {
             }
             let l = &loaded.times;
             eprintln!(
-                "phong: load stages: read={:.1}ms parse={:.1}ms normals={:.1}ms framing={:.1}ms (the rest of load= builds the scene)",
+                "phong: load stages: read={:.1}ms parse={:.1}ms normals={:.1}ms framing={:.1}ms (a large model's normals and framing side by side; the rest of load= builds the scene)",
                 l.read.as_secs_f64() * 1e3,
                 l.parse.as_secs_f64() * 1e3,
                 l.normals.as_secs_f64() * 1e3,
