@@ -26,16 +26,27 @@ pub fn take_times() -> LoadTimes {
     TIMES.with(|t| t.replace(LoadTimes::default()))
 }
 
+/// Stage by stage.
+impl std::ops::Add for LoadTimes {
+    type Output = LoadTimes;
+    fn add(mut self, t: LoadTimes) -> LoadTimes {
+        let LoadTimes {
+            read,
+            parse,
+            normals,
+            framing,
+        } = t;
+        self.read += read;
+        self.parse += parse;
+        self.normals += normals;
+        self.framing += framing;
+        self
+    }
+}
+
 /// Adds `t` (another thread's stage times, taken where it ends) to this thread's.
 pub(crate) fn add_times(t: LoadTimes) {
-    TIMES.with(|c| {
-        let mut times = c.get();
-        times.read += t.read;
-        times.parse += t.parse;
-        times.normals += t.normals;
-        times.framing += t.framing;
-        c.set(times);
-    });
+    TIMES.with(|c| c.set(c.get() + t));
 }
 
 /// Runs `f`, adding its time to the stage `add` picks; time spent reading files inside it is

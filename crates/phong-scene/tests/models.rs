@@ -1359,41 +1359,18 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         let model = ModelFile::read(path).unwrap();
         let reader = phong_scene::scene_of_model(path, &model, &options).unwrap();
         let (a, b) = (&beside.scene, &reader.scene);
-        assert_eq!(
-            format!("{:?}", a.camera),
-            format!("{:?}", b.camera),
-            "{}",
-            path.display()
-        );
-        assert_eq!(
-            format!("{:?}", a.lighting),
-            format!("{:?}", b.lighting),
-            "{}",
-            path.display()
-        );
-        assert_eq!(a.objects.len(), b.objects.len());
+        // (Compared as `==`, not by `assert_eq!`: a difference would print every vertex.)
+        let same = |equal: bool, what: &str| assert!(equal, "{}: {what} differ", path.display());
+        same(format!("{:?}", a.camera) == format!("{:?}", b.camera), "cameras");
+        same(format!("{:?}", a.lighting) == format!("{:?}", b.lighting), "lights");
+        same(a.objects.len() == b.objects.len(), "object counts");
         for (x, y) in a.objects.iter().zip(&b.objects) {
-            // (Not `assert_eq!`: a difference would print every vertex.)
-            assert!(
-                bits(x.mesh.positions()) == bits(y.mesh.positions()),
-                "{}: positions",
-                path.display()
-            );
-            assert!(
-                bits(x.mesh.normals()) == bits(y.mesh.normals()),
-                "{}: normals",
-                path.display()
-            );
-            assert!(
-                x.mesh.triangles() == y.mesh.triangles(),
-                "{}: triangles",
-                path.display()
-            );
-            assert_eq!(
-                format!("{:?}", x.shading),
-                format!("{:?}", y.shading),
-                "{}",
-                path.display()
+            same(bits(x.mesh.positions()) == bits(y.mesh.positions()), "positions");
+            same(bits(x.mesh.normals()) == bits(y.mesh.normals()), "normals");
+            same(x.mesh.triangles() == y.mesh.triangles(), "triangles");
+            same(
+                format!("{:?}", x.shading) == format!("{:?}", y.shading),
+                "shading settings",
             );
             let unit = x
                 .mesh

@@ -114,15 +114,7 @@ fn shape_object(
             Some(n) => ctx.name(n, "normals", allowed)?,
             None => default,
         };
-        Ok(crate::timing::timed(
-            |t| &mut t.normals,
-            || match choice {
-                "flat" => mesh.with_flat_normals(),
-                "smooth" => mesh.with_smooth_normals(),
-                "angle" => mesh.with_crease_normals(crease),
-                _ => mesh,
-            },
-        ))
+        Ok(with_normals(mesh, choice, crease))
     };
     let kind = ctx.name(shape, "shape", SHAPES)?;
     let default_segments = match kind {
@@ -229,7 +221,13 @@ pub(crate) fn drawn_mesh(
             .collect();
         mesh = mesh.with_positions(positions)?;
     }
-    Ok(crate::timing::timed(
+    Ok(with_normals(mesh, choice, crease))
+}
+
+/// `mesh` with the normals of `choice` (`"flat"`, `"smooth"`, `"angle"` at `crease` degrees;
+/// anything else keeps its own), timed as the load's `normals` stage.
+fn with_normals(mesh: Mesh, choice: &str, crease: f32) -> Mesh {
+    crate::timing::timed(
         |t| &mut t.normals,
         || match choice {
             "flat" => mesh.with_flat_normals(),
@@ -237,7 +235,7 @@ pub(crate) fn drawn_mesh(
             "angle" => mesh.with_crease_normals(crease),
             _ => mesh,
         },
-    ))
+    )
 }
 
 /// A `mesh` object: one object a part of the model file, placed in the file's coordinates (or
