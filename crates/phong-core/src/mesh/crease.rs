@@ -358,8 +358,9 @@ impl Around {
 /// once, in face order), so the work is faces + groups² there, not faces² (80 000 copies
 /// of one triangle are one group); past MANY_GROUPS directions, the edge rule. Vertices with
 /// few faces keep the plain loop, whose summation order the images were made with, or, where
-/// every face lies within half the crease angle of their mean direction (so every pair is
-/// within the crease), that loop's result once for all the vertex's corners.
+/// every pair of faces is within the crease (found at once where every face lies within half
+/// the crease angle of their mean direction, else pair by pair), that loop's result once for
+/// all the vertex's corners.
 fn vertex_rule(
     fs: &[u32],
     v: u32,
