@@ -296,7 +296,7 @@ fn mesh_objects(
         // File normals where every vertex has a usable one; else, or where `"file"`
         // is asked of a model without them, normals by angle, with a warning.
         let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
-        let usable = p.has_normals && bad == 0;
+        let usable = default_normals(&p) == "file";
         let asked = normals_choice
             .map(|n| ctx.name(n, "normals", &["file", "flat", "smooth", "angle"]))
             .transpose()?;
@@ -313,7 +313,7 @@ fn mesh_objects(
             ));
         }
         let choice = match asked {
-            Some("file") | None if !usable => "angle",
+            Some("file") if !usable => "angle",
             Some(a) => a,
             None => default_normals(&p),
         };
