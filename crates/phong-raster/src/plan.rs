@@ -262,6 +262,9 @@ pub(crate) struct FramePlan<'a> {
     /// per pixel, untextured ([`Mode::Phong`]): one-sample tiles of 8-bit frames are then
     /// shaded and encoded straight into the frame (`Tiles::tile_single8`).
     pub phong_only: bool,
+    /// Every object opaque (no alpha test, no blending): a multi-sample tile's triangles then
+    /// all go through one visibility kernel call (`Tiles::tile_multi`).
+    pub opaque_only: bool,
     /// Per object, in the scene's order.
     pub objects: Vec<ObjectPlan<'a>>,
 }
@@ -295,6 +298,7 @@ impl<'a> FramePlan<'a> {
                 && objects
                     .iter()
                     .all(|o| matches!(o.mode, Mode::Phong(..)) && o.visibility == Visibility::Opaque),
+            opaque_only: objects.iter().all(|o| o.visibility == Visibility::Opaque),
             objects,
         }
     }

@@ -32,7 +32,7 @@ pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
 pub use tile::{GouraudTri, TilePixel, gouraud_tile};
-pub(crate) use visible::{SampleBuffers, multi_visible, single_visible};
+pub(crate) use visible::{SampleBuffers, multi_visible, multi_visible_run, single_visible};
 
 /// Whether the CPU has AVX2 and FMA (checked once, cached by std).
 pub fn avx2_available() -> bool {

@@ -534,6 +534,11 @@ impl Tiles<'_> {
         let out = rows.iter_mut().flat_map(|r| r.iter_mut());
         for (pixel, o) in out.enumerate() {
             let mine = &jobs[starts[pixel]..starts[pixel + 1]];
+            if mine.is_empty() {
+                // Every sample is background (each visible id has a job).
+                *o = self.plan.background;
+                continue;
+            }
             let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
                 if id == u32::MAX {
                     self.plan.bg

@@ -12,7 +12,9 @@ use super::{Multi, Tile};
 use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
-use crate::simd::{Isa, Planes, SampleBuffers, TilePixel, covered_span, multi_visible, prefetch, single_visible};
+use crate::simd::{
+    Isa, Planes, SampleBuffers, TilePixel, covered_span, multi_visible, multi_visible_run, prefetch, single_visible,
+};
 use crate::stats::Marks;
 use crate::target::{Store, resolve};
 use phong_core::limits::SUBPIXEL_BITS;
@@ -246,6 +248,24 @@ impl Tiles<'_> {
         depth.resize(tw * tile.height() * ns, f32::INFINITY);
         ids.clear();
         ids.resize(tw * tile.height() * ns, u32::MAX);
+        if self.plan.opaque_only {
+            let bin = tile.bin;
+            let mut buf = SampleBuffers {
+                rect: (x0, y0, x1, y1),
+                depth,
+                ids,
+            };
+            let tri = |k: usize| {
+                if let Some(&ahead) = bin.get(k + PREFETCH_AHEAD) {
+                    prefetch(self.binned.tri(ahead));
+                }
+                (self.binned.tri(bin[k]), bin[k])
+            };
+            if multi_visible_run(self.plan.isa, bin.len(), tri, &self.plan.pattern, &mut buf) {
+                marks.shading();
+                return self.shade_multi(tile, work, rows, &[], marks);
+            }
+        }
         let mut offsets = [[0i64; 3]; 16];
         // Blended triangles come last in a bin (`Scene::draw_order`), after the opaque samples.
         let mut blended = tile.bin.len();
