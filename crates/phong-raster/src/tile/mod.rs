@@ -106,6 +106,8 @@ pub(crate) struct Multi {
     pub colors: Vec<[f32; 4]>,
     /// Each sample's colour, where blended triangles are laid over them.
     pub samples: Vec<[f32; 4]>,
+    /// Per sample, the index in `jobs` of its triangle's job (`u32::MAX`: background).
+    pub which: Vec<u32>,
 }
 
 /// Draws every tile of `plan` from `binned` into `pixels` (the frame, row-major), in

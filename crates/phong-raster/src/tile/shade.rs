@@ -468,6 +468,7 @@ impl Tiles<'_> {
             jobs,
             starts,
             colors,
+            which,
             ..
         } = work;
         let (x0, y0) = (tile.x0, tile.y0);
@@ -477,16 +478,25 @@ impl Tiles<'_> {
         // pixel's jobs are contiguous.
         jobs.clear();
         starts.clear();
+        which.clear();
+        which.resize(ids.len(), u32::MAX);
         for row in 0..th {
             for col in 0..tw {
                 let pixel = row * tw + col;
                 let packed = (row as u32) << 16 | col as u32;
                 starts.push(jobs.len());
                 let first = jobs.len();
-                for &id in &ids[pixel * ns..(pixel + 1) * ns] {
-                    if id != u32::MAX && !jobs[first..].iter().any(|j| j.1 == id) {
-                        jobs.push((packed, id));
+                let samples = pixel * ns..(pixel + 1) * ns;
+                for (job, &id) in which[samples.clone()].iter_mut().zip(&ids[samples]) {
+                    if id == u32::MAX {
+                        continue;
                     }
+                    *job = if let Some(j) = jobs[first..].iter().position(|j| j.1 == id) {
+                        (first + j) as u32
+                    } else {
+                        jobs.push((packed, id));
+                        (jobs.len() - 1) as u32
+                    };
                 }
             }
         }
@@ -497,18 +507,25 @@ impl Tiles<'_> {
         let mut batches: Vec<Vec<u32>> = vec![Vec::new(); self.scene.objects.len()];
         // Per textured object, its jobs `(pixel, triangle)` and where each is in `jobs`.
         let mut textured: Vec<TexturedJobs> = vec![Default::default(); self.scene.objects.len()];
-        for (k, &(pixel, ti)) in jobs.iter().enumerate() {
-            match self.plan.objects[self.binned.object(ti)].mode {
-                Mode::Scalar => {
-                    let (px, py) = at(pixel);
-                    colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.plan.bg);
+        if let [only] = &self.plan.objects[..]
+            && only.mode.batch().is_some()
+        {
+            // One object, shaded by the vector kernels: every job is its.
+            batches[0].extend(0..jobs.len() as u32);
+        } else {
+            for (k, &(pixel, ti)) in jobs.iter().enumerate() {
+                match self.plan.objects[self.binned.object(ti)].mode {
+                    Mode::Scalar => {
+                        let (px, py) = at(pixel);
+                        colors[k] = self.shade_pixel(ti, px, py).unwrap_or(self.plan.bg);
+                    }
+                    Mode::Textured { .. } => {
+                        let (items, at) = &mut textured[self.binned.object(ti)];
+                        items.push((pixel, ti));
+                        at.push(k as u32);
+                    }
+                    _ => batches[self.binned.object(ti)].push(k as u32),
                 }
-                Mode::Textured { .. } => {
-                    let (items, at) = &mut textured[self.binned.object(ti)];
-                    items.push((pixel, ti));
-                    at.push(k as u32);
-                }
-                _ => batches[self.binned.object(ti)].push(k as u32),
             }
         }
         self.shade_gathered(
@@ -533,17 +550,16 @@ impl Tiles<'_> {
         marks.resolving();
         let out = rows.iter_mut().flat_map(|r| r.iter_mut());
         for (pixel, o) in out.enumerate() {
-            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
-            if mine.is_empty() {
+            if starts[pixel] == starts[pixel + 1] {
                 // Every sample is background (each visible id has a job).
                 *o = self.plan.background;
                 continue;
             }
-            let samples = ids[pixel * ns..(pixel + 1) * ns].iter().map(|&id| {
-                if id == u32::MAX {
+            let samples = which[pixel * ns..(pixel + 1) * ns].iter().map(|&j| {
+                if j == u32::MAX {
                     self.plan.bg
                 } else {
-                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
+                    colors[j as usize]
                 }
             });
             *o = resolve(samples, ns, self.plan.bg);
@@ -567,24 +583,21 @@ impl Tiles<'_> {
     ) -> u64 {
         let Multi {
             depth,
-            ids,
             jobs,
-            starts,
             colors,
             samples,
+            which,
+            ..
         } = work;
         let ns = self.plan.pattern.len();
         samples.clear();
-        for (pixel, ids) in ids.chunks_exact(ns).enumerate() {
-            let mine = &jobs[starts[pixel]..starts[pixel + 1]];
-            samples.extend(ids.iter().map(|&id| {
-                if id == u32::MAX {
-                    self.plan.bg
-                } else {
-                    colors[starts[pixel] + mine.iter().position(|j| j.1 == id).unwrap_or(0)]
-                }
-            }));
-        }
+        samples.extend(which.iter().map(|&j| {
+            if j == u32::MAX {
+                self.plan.bg
+            } else {
+                colors[j as usize]
+            }
+        }));
         let mut shaded = jobs.len() as u64;
         for &ti in blended {
             self.covered_multi(self.binned.tri(ti), tile, |px, py, base, zs, covered| {
