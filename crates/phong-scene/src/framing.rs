@@ -230,6 +230,34 @@ pub(crate) fn fit_of(parts: &[ModelPart]) -> Option<(DVec3, f64)> {
     Some(((lo + hi) * 0.5, radius))
 }
 
+/// A model's fit (the centre and radius of its bounding box's sphere; the origin and 1 without
+/// vertices) and its vertices in the fitted frame (centred, radius 1), in its parts' order.
+#[derive(Clone, Debug)]
+pub(crate) struct Fitted {
+    centre: DVec3,
+    radius: f64,
+    points: Vec<Vec3>,
+}
+
+impl Fitted {
+    fn of(parts: &[ModelPart]) -> Fitted {
+        let (centre, radius) = fit_of(parts).unwrap_or((DVec3::ZERO, 1.0));
+        let points = parts
+            .iter()
+            .flat_map(|p| p.mesh.positions())
+            .map(|&p| fitted_point(p, centre, radius))
+            .collect();
+        Fitted { centre, radius, points }
+    }
+}
+
+/// `p` in the fitted frame of `centre` and `radius`. In f64: a model's coordinates may be near
+/// f32's largest, its radius's inverse below f32's smallest normal number.
+#[inline]
+fn fitted_point(p: Vec3, centre: DVec3, radius: f64) -> Vec3 {
+    ((p.as_dvec3() - centre) / radius).as_vec3()
+}
+
 /// The bounding box of a model's parts together (`None`: no vertices).
 fn bounds_of(parts: &[ModelPart]) -> Option<(Vec3, Vec3)> {
     parts
@@ -287,11 +315,12 @@ pub fn model_scene(name: &str, model: &ModelFile, options: &ModelOptions) -> (se
     let parts = &model.parts[..];
     let gltf = model.format == ModelFormat::Gltf;
     let mut notes = Vec::new();
-    let (centre, radius) = fit_of(parts).unwrap_or((DVec3::ZERO, 1.0));
-    // Vertices in the fitted frame (centred, radius 1).
-    // In f64: a model's coordinates may be near f32's largest, its radius's inverse below f32's
-    // smallest normal number.
-    let fitted = |p: Vec3| ((p.as_dvec3() - centre) / radius).as_vec3();
+    let Fitted {
+        centre,
+        radius,
+        ref points,
+    } = *model.fitted.get_or_init(|| Fitted::of(parts));
+    let fitted = |p: Vec3| fitted_point(p, centre, radius);
     let origin = parts.first().map_or(DVec3::ZERO, |p| p.origin);
     if origin != DVec3::ZERO {
         notes.push(format!(
@@ -348,11 +377,11 @@ pub fn model_scene(name: &str, model: &ModelFile, options: &ModelOptions) -> (se
         }
         None => {
             let (dir, cu) = view_direction(options.view, (r, u, f));
-            let dist = framing_distance(parts, &fitted, dir, cu, aspect);
+            let dist = framing_distance(points, dir, cu, aspect);
             (dir * dist, Vec3::ZERO, cu)
         }
     };
-    let (near, far) = depth_range(parts, &fitted, position, target);
+    let (near, far) = depth_range(points, position, target);
     let lights = match file_lights(model, &|x| fitted(to_parts(x))) {
         Some(l) => {
             notes.push(format!("the file's {} lights", model.lights.len()));
@@ -536,14 +565,13 @@ fn round6(v: Vec3) -> [f64; 3] {
 
 /// The camera distance along `dir` (from the origin of the fitted frame) at which every vertex
 /// is inside [`FILL`] of a frame of aspect `aspect`, the camera's up `up`.
-fn framing_distance(parts: &[ModelPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec3, up: Vec3, aspect: f32) -> f32 {
+fn framing_distance(points: &[Vec3], dir: Vec3, up: Vec3, aspect: f32) -> f32 {
     let right = up.cross(dir).normalize();
     let up = dir.cross(right);
     let ty = (FOV.to_radians() * 0.5).tan() * FILL;
     let tx = ty * aspect;
     let mut dist = 0.0f32;
-    for p in parts.iter().flat_map(|p| p.mesh.positions()) {
-        let q = fitted(*p);
+    for &q in points {
         let z = q.dot(dir);
         dist = dist.max(z + q.dot(right).abs() / tx).max(z + q.dot(up).abs() / ty);
     }
@@ -553,11 +581,11 @@ fn framing_distance(parts: &[ModelPart], fitted: &dyn Fn(Vec3) -> Vec3, dir: Vec
 
 /// Near and far planes for a camera at `eye` looking at `target`: just outside the vertices'
 /// depths (a camera inside the model gets a near plane of 1/1000 of the model's radius).
-fn depth_range(parts: &[ModelPart], fitted: &dyn Fn(Vec3) -> Vec3, eye: Vec3, target: Vec3) -> (f32, f32) {
+fn depth_range(points: &[Vec3], eye: Vec3, target: Vec3) -> (f32, f32) {
     let d = (target - eye).normalize_or(Vec3::NEG_Z);
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for p in parts.iter().flat_map(|p| p.mesh.positions()) {
-        let z = (fitted(*p) - eye).dot(d);
+    for &q in points {
+        let z = (q - eye).dot(d);
         lo = lo.min(z);
         hi = hi.max(z);
     }

@@ -109,6 +109,9 @@ pub struct ModelFile {
     pub(crate) closed: std::sync::OnceLock<crate::framing::Closed>,
     /// The sums over its facets that its framing reads, found when it is first framed.
     pub(crate) facets: std::sync::OnceLock<crate::framing::Facets>,
+    /// Its vertices in the fitted frame, which every view's framing reads, found when it is
+    /// first framed.
+    pub(crate) fitted: std::sync::OnceLock<crate::framing::Fitted>,
 }
 
 impl ModelFile {
@@ -200,6 +203,7 @@ impl ModelFile {
             sources: Vec::new(),
             closed: Default::default(),
             facets: Default::default(),
+            fitted: Default::default(),
         }
     }
 }
