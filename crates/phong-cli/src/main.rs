@@ -3,7 +3,8 @@
 
 /// mimalloc keeps freed memory for the next allocation instead of returning it to the
 /// system: a model's load and its first frame allocate and free large arrays in turn, and
-/// every fresh page costs a fault (BENCHMARKS.md, C12). Measured on x86-64 only.
+/// every fresh page costs a fault (BENCHMARKS.md, C12). Version 2 (the crate's `v2` feature):
+/// version 3 returned more of it and took fresh pages again. Measured on x86-64 only.
 #[cfg(target_arch = "x86_64")]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
