@@ -283,6 +283,34 @@ pub(crate) mod testkit {
         }
     }
 
+    /// Values to check an 8-bit encoding with: every 1/4096 step of [−0.5, 1.5], the values
+    /// just around each rounding threshold `(k + 0.5) / 255`, random bit patterns, and NaN,
+    /// the infinities and the extremes.
+    pub fn encoding_values() -> Vec<f32> {
+        let mut values: Vec<f32> = (-2048..=6144).map(|i| i as f32 / 4096.0).collect();
+        for k in 0..256 {
+            let t = (k as f32 + 0.5) / 255.0;
+            values.extend([t, f32::from_bits(t.to_bits() - 1), f32::from_bits(t.to_bits() + 1)]);
+        }
+        let mut next = xorshift(7);
+        values.extend((0..10_000).map(|_| f32::from_bits(next() as u32)));
+        values.extend([
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            -1e-30,
+            -1.0,
+            2.0,
+        ]);
+        values
+    }
+
     /// The AVX2 build, or `None` (the test skips, saying so) on a CPU without it; with
     /// `PHONG_REQUIRE_AVX2=1` a CPU without it fails the test instead.
     pub fn avx2() -> Option<Isa> {

@@ -670,28 +670,12 @@ pub(crate) fn prefetch<T>(x: &T) {
 
 #[cfg(test)]
 mod tests {
-    /// The vector encoding is `Encoding::Linear`'s, bit for bit: every 1/4096 step of
-    /// [−0.5, 1.5], the values just around each rounding threshold `(k + 0.5) / 255`, random
-    /// values, and NaN and the infinities.
+    /// The vector encoding is `Encoding::Linear`'s, bit for bit, on
+    /// [`encoding_values`](crate::testkit::encoding_values).
     #[test]
     fn encode_linear_is_the_scalar_encoding() {
         use phong_core::Encoding;
-        let mut values: Vec<f32> = (-2048..=6144).map(|i| i as f32 / 4096.0).collect();
-        for k in 0..256 {
-            let t = (k as f32 + 0.5) / 255.0;
-            values.extend([t, f32::from_bits(t.to_bits() - 1), f32::from_bits(t.to_bits() + 1)]);
-        }
-        let mut next = crate::testkit::xorshift(7);
-        values.extend((0..10_000).map(|_| f32::from_bits(next() as u32)));
-        values.extend([
-            f32::NAN,
-            -f32::NAN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            -0.0,
-            f32::MAX,
-            f32::MIN_POSITIVE,
-        ]);
+        let values = crate::testkit::encoding_values();
         let src: Vec<[f32; 4]> = values
             .chunks(4)
             .filter(|c| c.len() == 4)
@@ -701,6 +685,46 @@ mod tests {
         super::encode_linear(&mut dst, &src);
         for (d, s) in dst.iter().zip(&src) {
             assert_eq!(*d, s.map(|c| Encoding::Linear.encode(c)), "{s:?}");
+        }
+    }
+
+    /// The kernels' in-register encodings (the lean kernel's `encode_rgba8`, 8 and 16 lanes,
+    /// whose lower clamp is the saturating packs') are `Encoding::Linear`'s, bit for bit, on
+    /// [`encoding_values`](crate::testkit::encoding_values).
+    #[test]
+    fn vector_encode_rgba8_is_the_scalar_encoding() {
+        use super::vector::{Portable, Vf32};
+        use phong_core::Encoding;
+        fn check<V: Vf32>(values: &[f32]) {
+            for chunk in values.chunks_exact(V::N) {
+                let mut a = V::A::default();
+                a.as_mut().copy_from_slice(chunk);
+                let v = V::from_array(a);
+                // Each channel a rotation of the lanes, so that every value meets every channel.
+                let mut b = V::A::default();
+                for (i, l) in b.as_mut().iter_mut().enumerate() {
+                    *l = chunk[(i + 1) % V::N];
+                }
+                let w = V::from_array(b);
+                let px = V::encode_rgba8([v, w, v]);
+                for (i, p) in px.as_ref().iter().enumerate() {
+                    let (x, y) = (chunk[i], chunk[(i + 1) % V::N]);
+                    let e = |c: f32| Encoding::Linear.encode(c);
+                    assert_eq!(*p, [e(x), e(y), e(x), 255], "{x:e}, {y:e}");
+                }
+            }
+        }
+        let values = crate::testkit::encoding_values();
+        check::<Portable>(&values);
+        #[cfg(target_arch = "x86_64")]
+        if crate::testkit::avx2().is_some() {
+            #[target_feature(enable = "avx2,fma")]
+            fn avx2(values: &[f32]) {
+                check::<super::vector::Avx2>(values);
+                check::<super::vector::Avx2x2>(values);
+            }
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            unsafe { avx2(&values) };
         }
     }
 

@@ -138,7 +138,7 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
     let mut covered = 0u64;
     let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
     let lanes_epi = _mm_setr_epi32(0, 1, 2, 3);
-    let (one, half) = (_mm_set1_ps(1.0), _mm_set1_ps(0.5));
+    let (half, four) = (_mm_set1_ps(0.5), _mm_set1_ps(4.0));
     for k in 0..n {
         let t = tri(k);
         let ((c0, c1), (r0, r1)) = (t.cols, t.rows);
@@ -177,35 +177,65 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
                 });
                 let line = r as usize * stride;
                 let row = &mut *rows[r as usize];
-                while col < end {
-                    let outside = _mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(e[0], e[1]), e[2])) as u32;
-                    // Lanes past the tile's right edge (a frame's last column of tiles).
-                    let valid = 15u32 >> (col + 4 - row.len() as i64).max(0);
-                    let inside = !outside & valid;
-                    if inside != 0 {
-                        let zz = window_depths(e, bias, inv, z);
-                        let pass = depth_window(depth, line + col as usize, zz, inside, &mut covered);
-                        if pass != 0 {
-                            let c = col as usize;
-                            let px =
-                                _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32((x0 as usize + c) as i32), lanes_epi));
-                            let dx = _mm_sub_ps(_mm_add_ps(px, half), ox);
-                            let q: [__m128; 4] = std::array::from_fn(|ch| {
-                                _mm_add_ps(_mm_add_ps(cc[ch], _mm_mul_ps(gx[ch], dx)), gyy[ch])
-                            });
-                            let w = _mm_div_ps(one, q[3]);
-                            let (cr, cg, cb) = (_mm_mul_ps(q[0], w), _mm_mul_ps(q[1], w), _mm_mul_ps(q[2], w));
-                            if P::EIGHT {
-                                store_rgba8(bytemuck::cast_slice_mut(row), c, pass, [cr, cg, cb]);
-                            } else {
-                                store_rgba32(bytemuck::cast_slice_mut(row), c, pass, [cr, cg, cb]);
+                // The row's windows, whole inside the tile's depths and pixels (every row but
+                // those of a frame's last column of tiles, when its width is not a multiple
+                // of 4): taken as 4-element arrays, without a bounds check or a lane past the
+                // edge per window.
+                let (first, span) = (col as usize, ((end - col + 3) & !3) as usize);
+                if let (Some(dw), Some(pw)) = (
+                    depth.get_mut(line + first..line + first + span),
+                    row.get_mut(first..first + span),
+                ) {
+                    // The pixels' columns, exact integers in `f32`, 4 more each window.
+                    let mut xs =
+                        _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32((x0 as usize + first) as i32), lanes_epi));
+                    for (d4, p4) in dw.as_chunks_mut::<4>().0.iter_mut().zip(pw.as_chunks_mut::<4>().0) {
+                        let inside = !_mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(e[0], e[1]), e[2])) as u32 & 15;
+                        if inside != 0 {
+                            let zz = window_depths(e, bias, inv, z);
+                            let (pass, mask) = depth_window4(d4, zz, inside, &mut covered);
+                            if pass != 0 {
+                                let dx = _mm_sub_ps(_mm_add_ps(xs, half), ox);
+                                let rgb = window_colour(cc, gx, gyy, dx);
+                                if P::EIGHT {
+                                    store_rgba8_window(bytemuck::cast_mut(p4), mask, rgb);
+                                } else {
+                                    store_rgba32(bytemuck::cast_slice_mut(p4), 0, pass, rgb);
+                                }
                             }
                         }
+                        for i in 0..3 {
+                            e[i] = _mm256_add_pd(e[i], step4[i]);
+                        }
+                        xs = _mm_add_ps(xs, four);
                     }
-                    for i in 0..3 {
-                        e[i] = _mm256_add_pd(e[i], step4[i]);
+                } else {
+                    while col < end {
+                        let outside = _mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(e[0], e[1]), e[2])) as u32;
+                        // Lanes past the tile's right edge (a frame's last column of tiles).
+                        let valid = 15u32 >> (col + 4 - row.len() as i64).max(0);
+                        let inside = !outside & valid;
+                        if inside != 0 {
+                            let zz = window_depths(e, bias, inv, z);
+                            let pass = depth_window(depth, line + col as usize, zz, inside, &mut covered);
+                            if pass != 0 {
+                                let c = col as usize;
+                                let px =
+                                    _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32((x0 as usize + c) as i32), lanes_epi));
+                                let dx = _mm_sub_ps(_mm_add_ps(px, half), ox);
+                                let rgb = window_colour(cc, gx, gyy, dx);
+                                if P::EIGHT {
+                                    store_rgba8(bytemuck::cast_slice_mut(row), c, pass, rgb);
+                                } else {
+                                    store_rgba32(bytemuck::cast_slice_mut(row), c, pass, rgb);
+                                }
+                            }
+                        }
+                        for i in 0..3 {
+                            e[i] = _mm256_add_pd(e[i], step4[i]);
+                        }
+                        col += 4;
                     }
-                    col += 4;
                 }
             }
             for (e, s) in row_e.iter_mut().zip(t.step_y) {
@@ -234,6 +264,51 @@ pub(super) fn window_depths(
         _mm_add_ps(_mm_mul_ps(l[0], z[0]), _mm_mul_ps(l[1], z[1])),
         _mm_mul_ps(l[2], z[2]),
     )
+}
+
+/// A window's colours from the planes `q = c + g_x·dx + g_y·dy` per channel (`gyy` is
+/// `g_y·dy`) in the scalar loop's order (no fused multiply-adds), `[r, g, b]` over `w` by an
+/// exact division.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn window_colour(
+    cc: [core::arch::x86_64::__m128; 4],
+    gx: [core::arch::x86_64::__m128; 4],
+    gyy: [core::arch::x86_64::__m128; 4],
+    dx: core::arch::x86_64::__m128,
+) -> [core::arch::x86_64::__m128; 3] {
+    use core::arch::x86_64::*;
+    let q: [__m128; 4] = std::array::from_fn(|ch| _mm_add_ps(_mm_add_ps(cc[ch], _mm_mul_ps(gx[ch], dx)), gyy[ch]));
+    let w = _mm_div_ps(_mm_set1_ps(1.0), q[3]);
+    [_mm_mul_ps(q[0], w), _mm_mul_ps(q[1], w), _mm_mul_ps(q[2], w)]
+}
+
+/// How many bits of a window's 4 are set.
+const POP4: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
+
+/// [`depth_window`] for a whole window `d4`: returns the lanes that passed, as bits and as a
+/// blend mask.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn depth_window4(
+    d4: &mut [f32; 4],
+    zz: core::arch::x86_64::__m128,
+    inside: u32,
+    covered: &mut u64,
+) -> (u32, core::arch::x86_64::__m128) {
+    use core::arch::x86_64::*;
+    // By `lddqu`, as in `depth_window` (K1).
+    // SAFETY: `d4` is 4 readable f32.
+    let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
+    let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
+    let fresh = pass & _mm_movemask_ps(_mm_cmpeq_ps(d, _mm_set1_ps(f32::INFINITY))) as u32;
+    *covered += u64::from(POP4[fresh as usize & 15]);
+    let mask = lane_mask(pass);
+    // SAFETY: `d4` is 4 writable f32.
+    unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, mask)) };
+    (pass, mask)
 }
 
 /// The depth test of the window of 4 pixels at `depth[at..]`: each `inside` lane whose depth
@@ -284,6 +359,43 @@ fn lane_mask(bits: u32) -> core::arch::x86_64::__m128 {
     ))
 }
 
+/// A window's colours `rgb` (channel planes of 4 pixels) as four 8-bit RGBA pixels, as
+/// `encode_linear` computes them: `(clamp(v, 0, 1)·255 + 0.5)` truncated, NaN as 0, alpha 255.
+/// Only the upper clamp is taken in `f32` (`min(1, v)`, which keeps a NaN): the conversion of
+/// a value below 0 truncates to 0 or to a negative integer, and of NaN or `−∞` to `i32::MIN`,
+/// and the saturating packs take all of those to 0, as the lower clamp would.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn encode_window(rgb: [core::arch::x86_64::__m128; 3]) -> core::arch::x86_64::__m128 {
+    use core::arch::x86_64::*;
+    let (one, half, c255) = (_mm_set1_ps(1.0), _mm_set1_ps(0.5), _mm_set1_ps(255.0));
+    let enc = |v: __m128| _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(_mm_min_ps(one, v), c255), half));
+    // [r0..r3 g0..g3 b0..b3 a a a a] bytes, then pixel by pixel.
+    let planar = _mm_packus_epi16(
+        _mm_packs_epi32(enc(rgb[0]), enc(rgb[1])),
+        _mm_packs_epi32(enc(rgb[2]), _mm_set1_epi32(255)),
+    );
+    let interleave = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+    _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave))
+}
+
+/// [`store_rgba8`] for a whole window `win`, its passing lanes given as a blend `mask`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn store_rgba8_window(win: &mut [[u8; 4]; 4], mask: core::arch::x86_64::__m128, rgb: [core::arch::x86_64::__m128; 3]) {
+    use core::arch::x86_64::*;
+    let packed = encode_window(rgb);
+    let ptr = win.as_mut_ptr().cast::<f32>();
+    // SAFETY: `win` is 16 readable and writable bytes from `ptr`. By `lddqu`, as the depth
+    // in `depth_window`.
+    unsafe {
+        let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
+        _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, mask));
+    }
+}
+
 /// The colours `rgb` (channel planes of 4 pixels) of a window's `pass` lanes written as 8-bit
 /// pixels to `row[c..]`, as `encode_linear` computes them: `(clamp(v, 0, 1)·255 + 0.5)`
 /// truncated, NaN as 0, alpha 255.
@@ -292,15 +404,7 @@ fn lane_mask(bits: u32) -> core::arch::x86_64::__m128 {
 #[inline]
 fn store_rgba8(row: &mut [[u8; 4]], c: usize, pass: u32, rgb: [core::arch::x86_64::__m128; 3]) {
     use core::arch::x86_64::*;
-    let (zero, one, half, c255) = (_mm_setzero_ps(), _mm_set1_ps(1.0), _mm_set1_ps(0.5), _mm_set1_ps(255.0));
-    let enc = |v: __m128| _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(_mm_min_ps(_mm_max_ps(v, zero), one), c255), half));
-    // [r0..r3 g0..g3 b0..b3 a a a a] bytes, then pixel by pixel.
-    let planar = _mm_packus_epi16(
-        _mm_packs_epi32(enc(rgb[0]), enc(rgb[1])),
-        _mm_packs_epi32(enc(rgb[2]), _mm_set1_epi32(255)),
-    );
-    let interleave = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
-    let packed = _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave));
+    let packed = encode_window(rgb);
     if let Some(win) = row.get_mut(c..c + 4) {
         let ptr = win.as_mut_ptr().cast::<f32>();
         // SAFETY: `win` is 4 pixels, 16 readable and writable bytes from `ptr`. By `lddqu`, as
@@ -363,5 +467,38 @@ fn store_rgba32(row: &mut [[f32; 4]], c: usize, pass: u32, [cr, cg, cb]: [core::
             unsafe { _mm_storeu_ps(row[c + j].as_mut_ptr(), pixels[j]) };
             m &= m - 1;
         }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use phong_core::Encoding;
+
+    /// The Gouraud kernel's window encoding (its lower clamp the saturating packs') is
+    /// `Encoding::Linear`'s, bit for bit, on
+    /// [`encoding_values`](crate::testkit::encoding_values).
+    #[test]
+    fn encode_window_is_the_scalar_encoding() {
+        if crate::testkit::avx2().is_none() {
+            return;
+        }
+        #[target_feature(enable = "avx2,fma")]
+        fn check(values: &[f32]) {
+            use core::arch::x86_64::*;
+            for c in values.chunks_exact(4) {
+                let load = |v: [f32; 4]| _mm_setr_ps(v[0], v[1], v[2], v[3]);
+                let rot = [c[1], c[2], c[3], c[0]];
+                let packed = super::encode_window([load([c[0], c[1], c[2], c[3]]), load(rot), load(rot)]);
+                let mut px = [[0u8; 4]; 4];
+                // SAFETY: `px` is 16 writable bytes.
+                unsafe { _mm_storeu_ps(px.as_mut_ptr().cast(), packed) };
+                let e = |x: f32| Encoding::Linear.encode(x);
+                for i in 0..4 {
+                    assert_eq!(px[i], [e(c[i]), e(rot[i]), e(rot[i]), 255], "{:e}, {:e}", c[i], rot[i]);
+                }
+            }
+        }
+        // SAFETY: the CPU has AVX2 and FMA (checked above).
+        unsafe { check(&crate::testkit::encoding_values()) };
     }
 }

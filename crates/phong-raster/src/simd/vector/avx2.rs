@@ -34,15 +34,17 @@ fn texel_index(w: usize, h: usize, x: __m256, y: __m256) -> __m256i {
     }
 }
 
-/// `Encoding::Linear`'s 8-bit value of each lane, as a 32-bit integer: `min(max(c, 0), 1)`
-/// (`maxps` with 0 second maps NaN to 0), times 255, plus 0.5, truncated, each step
-/// rounded as the scalar code rounds it (no fused multiply-add). Needs AVX (callers are
-/// inside `avx2,fma` functions).
+/// `Encoding::Linear`'s 8-bit value of each lane once packed with signed, then unsigned
+/// saturation (as [`Avx2::encode_rgba8`] packs it), as a 32-bit integer: `min(1, c)` (`minps`
+/// with `c` second keeps a NaN), times 255, plus 0.5, truncated, each step rounded as the
+/// scalar code rounds it (no fused multiply-add). The lower clamp is the packs': a value below
+/// 0 truncates to 0 or a negative integer, NaN and `−∞` to `i32::MIN`, all packed to 0, as
+/// `max(c, 0)` first would give. Needs AVX (callers are inside `avx2,fma` functions).
 #[inline(always)]
 fn encode_channel(c: __m256) -> __m256i {
     // SAFETY: AVX is present (the callers' contract); register arithmetic only.
     unsafe {
-        let v = _mm256_min_ps(_mm256_max_ps(c, _mm256_setzero_ps()), _mm256_set1_ps(1.0));
+        let v = _mm256_min_ps(_mm256_set1_ps(1.0), c);
         _mm256_cvttps_epi32(_mm256_add_ps(
             _mm256_mul_ps(v, _mm256_set1_ps(255.0)),
             _mm256_set1_ps(0.5),
