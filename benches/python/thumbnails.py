@@ -10,6 +10,9 @@ read from the kernel (ru_maxrss):
     python benches/python/thumbnails.py [--renders 1000] [--rounds 3] [--phong target/release/phong]
 
 Prints images a second and peak memory per method and round, then the medians and ratios.
+pyrender's environment needs SciPy (trimesh's smooth normals; without it a slow fallback makes
+pyrender about four times slower) and networkx 3 (pyrender's pinned 2.2 does not import on
+Python 3.11); see BENCHMARKS.md, "Thumbnails".
 """
 
 import argparse
