@@ -287,8 +287,9 @@ fn window_colour(
 /// How many bits of a window's 4 are set.
 const POP4: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 
-/// [`depth_window`] for a whole window `d4`: returns the lanes that passed, as bits and as a
-/// blend mask.
+/// The depth test of a window of 4 pixels `d4`: each `inside` lane whose depth `zz` is below
+/// the stored one stores it. Returns the lanes that passed, as bits and as a blend mask,
+/// adding to `covered` those that were `+∞`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline]
@@ -299,7 +300,9 @@ fn depth_window4(
     covered: &mut u64,
 ) -> (u32, core::arch::x86_64::__m128) {
     use core::arch::x86_64::*;
-    // By `lddqu`, as in `depth_window` (K1).
+    // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend and a store of the
+    // same address are otherwise turned into a masked store (`vmaskmovps`), slow on AMD and
+    // not forwarded to later loads (BENCHMARKS.md, K1).
     // SAFETY: `d4` is 4 readable f32.
     let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
     let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
@@ -311,26 +314,18 @@ fn depth_window4(
     (pass, mask)
 }
 
-/// The depth test of the window of 4 pixels at `depth[at..]`: each `inside` lane whose depth
-/// `zz` is below the stored one stores it. Returns the lanes that passed, adding to `covered`
-/// those that were `+∞`.
+/// [`depth_window4`] for the window at `depth[at..]`, which may run past `depth`'s end (its
+/// lanes there are not `inside`). Returns the lanes that passed.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn depth_window(depth: &mut [f32], at: usize, zz: core::arch::x86_64::__m128, inside: u32, covered: &mut u64) -> u32 {
     use core::arch::x86_64::*;
-    if let Some(d4) = depth.get_mut(at..at + 4) {
-        // Loaded by `lddqu`, which LLVM does not see as a load: a load, a blend and a store of
-        // the same address are otherwise turned into a masked store (`vmaskmovps`), slow on
-        // AMD and not forwarded to later loads (BENCHMARKS.md, K1).
-        // SAFETY: `d4` is 4 readable f32.
-        let d = _mm_castsi128_ps(unsafe { _mm_lddqu_si128(d4.as_ptr().cast()) });
-        let pass = _mm_movemask_ps(_mm_cmplt_ps(zz, d)) as u32 & inside;
-        *covered +=
-            u64::from((pass & _mm_movemask_ps(_mm_cmpeq_ps(d, _mm_set1_ps(f32::INFINITY))) as u32).count_ones());
-        // SAFETY: `d4` is 4 writable f32.
-        unsafe { _mm_storeu_ps(d4.as_mut_ptr(), _mm_blendv_ps(d, zz, lane_mask(pass))) };
-        return pass;
+    if let Some(d4) = depth
+        .get_mut(at..at + 4)
+        .and_then(|d| <&mut [f32; 4]>::try_from(d).ok())
+    {
+        return depth_window4(d4, zz, inside, covered).0;
     }
     // A caller's depth without room for whole windows: one at a time.
     let mut zs = [0f32; 4];
@@ -380,7 +375,8 @@ fn encode_window(rgb: [core::arch::x86_64::__m128; 3]) -> core::arch::x86_64::__
     _mm_castsi128_ps(_mm_shuffle_epi8(planar, interleave))
 }
 
-/// [`store_rgba8`] for a whole window `win`, its passing lanes given as a blend `mask`.
+/// The colours `rgb` (channel planes of 4 pixels) written as 8-bit pixels ([`encode_window`])
+/// into the lanes of `win` that `mask` selects.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline]
@@ -389,40 +385,35 @@ fn store_rgba8_window(win: &mut [[u8; 4]; 4], mask: core::arch::x86_64::__m128, 
     let packed = encode_window(rgb);
     let ptr = win.as_mut_ptr().cast::<f32>();
     // SAFETY: `win` is 16 readable and writable bytes from `ptr`. By `lddqu`, as the depth
-    // in `depth_window`.
+    // in `depth_window4` (K1).
     unsafe {
         let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
         _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, mask));
     }
 }
 
-/// The colours `rgb` (channel planes of 4 pixels) of a window's `pass` lanes written as 8-bit
-/// pixels to `row[c..]`, as `encode_linear` computes them: `(clamp(v, 0, 1)·255 + 0.5)`
-/// truncated, NaN as 0, alpha 255.
+/// [`store_rgba8_window`] for the window at `row[c..]`, which may run past the row's end (its
+/// lanes there are not in `pass`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn store_rgba8(row: &mut [[u8; 4]], c: usize, pass: u32, rgb: [core::arch::x86_64::__m128; 3]) {
     use core::arch::x86_64::*;
-    let packed = encode_window(rgb);
-    if let Some(win) = row.get_mut(c..c + 4) {
-        let ptr = win.as_mut_ptr().cast::<f32>();
-        // SAFETY: `win` is 4 pixels, 16 readable and writable bytes from `ptr`. By `lddqu`, as
-        // the depth in `depth_window`.
-        unsafe {
-            let old = _mm_castsi128_ps(_mm_lddqu_si128(ptr.cast()));
-            _mm_storeu_ps(ptr, _mm_blendv_ps(old, packed, lane_mask(pass)));
-        }
-    } else {
-        let mut bytes = [[0u8; 4]; 4];
-        // SAFETY: `bytes` is 16 writable bytes.
-        unsafe { _mm_storeu_ps(bytes.as_mut_ptr().cast(), packed) };
-        let mut m = pass;
-        while m != 0 {
-            let j = m.trailing_zeros() as usize;
-            row[c + j] = bytes[j];
-            m &= m - 1;
-        }
+    if let Some(win) = row
+        .get_mut(c..c + 4)
+        .and_then(|w| <&mut [[u8; 4]; 4]>::try_from(w).ok())
+    {
+        return store_rgba8_window(win, lane_mask(pass), rgb);
+    }
+    // A row without room for the whole window: pixel by pixel.
+    let mut bytes = [[0u8; 4]; 4];
+    // SAFETY: `bytes` is 16 writable bytes.
+    unsafe { _mm_storeu_ps(bytes.as_mut_ptr().cast(), encode_window(rgb)) };
+    let mut m = pass;
+    while m != 0 {
+        let j = m.trailing_zeros() as usize;
+        row[c + j] = bytes[j];
+        m &= m - 1;
     }
 }
 
