@@ -93,6 +93,13 @@ fn sort_by_triangle(
     (starts, order)
 }
 
+/// A sample's colour from its job index `j` in a multi-sample tile's `colors` (`Multi::which`;
+/// `u32::MAX`: the background `bg`).
+#[inline(always)]
+fn sample_colour(colors: &[[f32; 4]], j: u32, bg: [f32; 4]) -> [f32; 4] {
+    if j == u32::MAX { bg } else { colors[j as usize] }
+}
+
 /// A textured object's jobs of a multi-sample tile: `(pixel, triangle)`, and each one's index
 /// in the tile's jobs.
 type TexturedJobs = (Vec<(u32, u32)>, Vec<u32>);
@@ -555,13 +562,9 @@ impl Tiles<'_> {
                 *o = self.plan.background;
                 continue;
             }
-            let samples = which[pixel * ns..(pixel + 1) * ns].iter().map(|&j| {
-                if j == u32::MAX {
-                    self.plan.bg
-                } else {
-                    colors[j as usize]
-                }
-            });
+            let samples = which[pixel * ns..(pixel + 1) * ns]
+                .iter()
+                .map(|&j| sample_colour(colors, j, self.plan.bg));
             *o = resolve(samples, ns, self.plan.bg);
         }
         tile.clock.add(marks);
@@ -591,13 +594,7 @@ impl Tiles<'_> {
         } = work;
         let ns = self.plan.pattern.len();
         samples.clear();
-        samples.extend(which.iter().map(|&j| {
-            if j == u32::MAX {
-                self.plan.bg
-            } else {
-                colors[j as usize]
-            }
-        }));
+        samples.extend(which.iter().map(|&j| sample_colour(colors, j, self.plan.bg)));
         let mut shaded = jobs.len() as u64;
         for &ti in blended {
             self.covered_multi(self.binned.tri(ti), tile, |px, py, base, zs, covered| {
