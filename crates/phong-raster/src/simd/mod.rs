@@ -662,7 +662,12 @@ pub(crate) fn prefetch<T>(x: &T) {
     // SAFETY: a prefetch reads nothing the program sees and cannot fault; `x` is a reference.
     unsafe {
         use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast());
+        let first = (x as *const T).cast::<i8>();
+        _mm_prefetch::<_MM_HINT_T0>(first);
+        // A record that crosses into the next line (80- and 96-byte records mostly do).
+        if size_of::<T>() > 1 {
+            _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(size_of::<T>() - 1));
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = x;

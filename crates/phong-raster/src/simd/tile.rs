@@ -15,9 +15,10 @@
 //! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
 //! sign bit is exactly `E − bias < 0`.
 //!
-//! Why the caller chooses it per tile (`Tiles::plan_tile`, BENCHMARKS.md C4): its cost per
-//! triangle loses on tiny triangles. Measurements and dead ends: BENCHMARKS.md ("Dead ends",
-//! K1–K8).
+//! A triangle whose columns lie in one or two aligned windows (most triangles of a fine mesh)
+//! steps its windows down from row to row instead of setting each row up, so the kernel draws
+//! every tile of an AVX2 frame, tiny triangles included (BENCHMARKS.md, C4). Measurements and
+//! dead ends: BENCHMARKS.md ("Dead ends", K1–K8).
 
 // Elsewhere than x86-64 only the scalar fallback of this module is compiled.
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code, unused_imports))]
@@ -139,10 +140,24 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
     let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
     let lanes_epi = _mm_setr_epi32(0, 1, 2, 3);
     let (half, four) = (_mm_set1_ps(0.5), _mm_set1_ps(4.0));
+    // The tile's width (its rows' length).
+    let tw = rows.first().map_or(0, |r| r.len());
     for k in 0..n {
         let t = tri(k);
         let ((c0, c1), (r0, r1)) = (t.cols, t.rows);
         if c1 <= c0 || r1 <= r0 {
+            continue;
+        }
+        // A triangle whose columns lie in one or two aligned windows inside the tile (most
+        // triangles of a fine mesh): its rows' windows are stepped down, not set up per row.
+        let base = c0 & !3;
+        let windows = (c1.next_multiple_of(4) - base) / 4;
+        if windows <= 2 && (base + 4 * windows) as usize <= tw.min(stride) {
+            if windows == 1 {
+                narrow_triangle::<P, 1>(&t, (x0, y0), stride, base, depth, rows, &mut covered);
+            } else {
+                narrow_triangle::<P, 2>(&t, (x0, y0), stride, base, depth, rows, &mut covered);
+            }
             continue;
         }
         let width = i64::from(c1 - c0);
@@ -244,6 +259,81 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
         }
     }
     covered
+}
+
+/// [`gouraud_tile_avx2`]'s drawing of triangle `t`, whose columns lie in the `NW` windows of 4
+/// from tile column `base` (all inside the tile's rows and depths): each row's windows from
+/// the row above's by one exact step of the edge functions, without the row's span, bounds or
+/// start found again. The same arithmetic per window as the general loop.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn narrow_triangle<P: TilePixel, const NW: usize>(
+    t: &GouraudTri,
+    (x0, y0): (u32, u32),
+    stride: usize,
+    base: u32,
+    depth: &mut [f32],
+    rows: &mut [&mut [P]],
+    covered: &mut u64,
+) {
+    use core::arch::x86_64::*;
+    let ((c0, _), (r0, r1)) = (t.cols, t.rows);
+    let p = t.planes;
+    let inv = _mm256_set1_pd(t.inv_area);
+    let z = t.z.map(|v| _mm_set1_ps(v));
+    let bias = t.bias.map(|b| _mm256_set1_pd(b as f64));
+    let step4 = t.step_x.map(|s| _mm256_set1_pd((4 * s) as f64));
+    let step_y = t.step_y.map(|s| _mm256_set1_pd(s as f64));
+    // `E − bias` at the 4 pixels of the first window of row `r0`: exact integers (the edge
+    // functions' values near the triangle's box), so every step below is exact.
+    let lanes_pd = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+    let back = i64::from(base) - i64::from(c0);
+    let mut e: [__m256d; 3] = std::array::from_fn(|i| {
+        _mm256_fmadd_pd(
+            lanes_pd,
+            _mm256_set1_pd(t.step_x[i] as f64),
+            _mm256_set1_pd((t.start[i] + t.step_x[i] * back) as f64),
+        )
+    });
+    let plane = |ch: usize| if ch < 3 { p.attr[ch] } else { p.inv_w };
+    let cc: [__m128; 4] = std::array::from_fn(|ch| _mm_set1_ps(plane(ch)[0]));
+    let gx: [__m128; 4] = std::array::from_fn(|ch| _mm_set1_ps(plane(ch)[1]));
+    // Each window's `dx` from the planes' origin, the same in every row.
+    let dx: [__m128; NW] = std::array::from_fn(|w| {
+        let first = _mm_set1_epi32((x0 + base) as i32 + 4 * w as i32);
+        let px = _mm_cvtepi32_ps(_mm_add_epi32(first, _mm_setr_epi32(0, 1, 2, 3)));
+        _mm_sub_ps(_mm_add_ps(px, _mm_set1_ps(0.5)), _mm_set1_ps(p.origin[0]))
+    });
+    for r in r0..r1 {
+        let mut ew = e;
+        for (w, &dxw) in dx.iter().enumerate() {
+            let inside = !_mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(ew[0], ew[1]), ew[2])) as u32 & 15;
+            let col = base as usize + 4 * w;
+            if inside != 0
+                && let Some(d4) = depth[r as usize * stride + col..].first_chunk_mut::<4>()
+            {
+                let zz = window_depths(ew, bias, inv, z);
+                let (pass, mask) = depth_window4(d4, zz, inside, covered);
+                if pass != 0
+                    && let Some(p4) = rows[r as usize][col..].first_chunk_mut::<4>()
+                {
+                    let dy = _mm_set1_ps((y0 + r) as f32 + 0.5 - p.origin[1]);
+                    let gyy: [__m128; 4] = std::array::from_fn(|ch| _mm_mul_ps(_mm_set1_ps(plane(ch)[2]), dy));
+                    let rgb = window_colour(cc, gx, gyy, dxw);
+                    if P::EIGHT {
+                        store_rgba8_window(bytemuck::cast_mut(p4), mask, rgb);
+                    } else {
+                        store_rgba32(bytemuck::cast_slice_mut(p4), 0, pass, rgb);
+                    }
+                }
+            }
+            if w + 1 < NW {
+                ew = std::array::from_fn(|i| _mm256_add_pd(ew[i], step4[i]));
+            }
+        }
+        e = std::array::from_fn(|i| _mm256_add_pd(e[i], step_y[i]));
+    }
 }
 
 /// The depths of a window's 4 samples from their edge functions `e` (bias subtracted, exact

@@ -175,6 +175,33 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
     let n = i64::from(bx1 - bx0);
     // The tile column of the box's first pixel.
     let c0 = i64::from(bx0 - x0);
+    // A triangle whose columns lie in one or two aligned windows inside the tile (most
+    // triangles of a fine mesh): each row's windows stepped down from the row above's.
+    let base = c0 & !3;
+    let windows = ((c0 + n + 3) & !3) - base;
+    if windows <= 8 && base + windows <= tw {
+        let first = bb[1].max(y0);
+        let (cx, cy) = (
+            (i64::from(x0) + base) << SUBPIXEL_BITS,
+            i64::from(first) << SUBPIXEL_BITS,
+        );
+        let e: [__m256d; 3] = std::array::from_fn(|i| {
+            _mm256_add_pd(
+                _mm256_set1_pd((t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]) as f64),
+                lane_step[i],
+            )
+        });
+        let step_y: [__m256d; 3] = std::array::from_fn(|i| _mm256_set1_pd((t.b(i) << SUBPIXEL_BITS) as f64));
+        let at = (first - y0) as usize * tw as usize + base as usize;
+        let rows = (first..bb[3].min(y1)).len();
+        let (wz, line) = ((bias, inv, z, idv), (at, tw as usize, rows));
+        if windows == 4 {
+            narrow_rows::<1>(buf, e, step_y, step4, wz, line);
+        } else {
+            narrow_rows::<2>(buf, e, step_y, step4, wz, line);
+        }
+        return;
+    }
     for py in bb[1].max(y0)..bb[3].min(y1) {
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
         // e − bias at the row's first pixel, and the exact span of covered pixels.
@@ -203,6 +230,43 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
             }
             col += 4;
         }
+    }
+}
+
+/// [`single_visible_avx2`]'s rows of a triangle whose columns lie in `NW` aligned windows
+/// inside the tile: `e` holds `E − bias` at the 4 pixels of the first row's first window,
+/// `line` is `(index of that window in buf, the tile's width, rows)`; each window is the one
+/// to its left plus `step4`, each row the one above plus `step_y` (exact integer steps).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn narrow_rows<const NW: usize>(
+    buf: &mut SampleBuffers,
+    mut e: [core::arch::x86_64::__m256d; 3],
+    step_y: [core::arch::x86_64::__m256d; 3],
+    step4: [core::arch::x86_64::__m256d; 3],
+    (bias, inv, z, idv): (
+        [core::arch::x86_64::__m256d; 3],
+        core::arch::x86_64::__m256d,
+        [core::arch::x86_64::__m128; 3],
+        core::arch::x86_64::__m128,
+    ),
+    (mut at, tw, rows): (usize, usize, usize),
+) {
+    use core::arch::x86_64::*;
+    for _ in 0..rows {
+        let mut ew = e;
+        for w in 0..NW {
+            let outside = _mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(ew[0], ew[1]), ew[2])) as u32;
+            if outside != 15 {
+                window(buf, at + 4 * w, window_depths(ew, bias, inv, z), !outside & 15, idv);
+            }
+            if w + 1 < NW {
+                ew = std::array::from_fn(|i| _mm256_add_pd(ew[i], step4[i]));
+            }
+        }
+        e = std::array::from_fn(|i| _mm256_add_pd(e[i], step_y[i]));
+        at += tw;
     }
 }
 

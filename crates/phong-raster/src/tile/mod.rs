@@ -160,10 +160,11 @@ impl Tiles<'_> {
         {
             TilePlan::Covered
         } else if self.plan.gouraud_only {
-            // The AVX2 kernel costs more per triangle and less per pixel than the scalar loop:
-            // where the tile has 8 pixels per triangle or more (BENCHMARKS.md, C4).
-            let kernel = self.plan.isa.is_avx2() && tile.width() * tile.height() >= 8 * n;
-            TilePlan::Gouraud { kernel }
+            // The AVX2 kernel wherever the CPU has it, tiny triangles included (BENCHMARKS.md,
+            // C4); the scalar loop elsewhere.
+            TilePlan::Gouraud {
+                kernel: self.plan.isa.is_avx2(),
+            }
         } else {
             TilePlan::Single
         }

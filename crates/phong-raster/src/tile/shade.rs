@@ -16,7 +16,7 @@ use crate::plan::{Mode, lit_term};
 use crate::setup::{Corners, Tri};
 use crate::simd::kernel::pixel_centre;
 use crate::simd::{
-    Planes, group_lanes, shade_batch, shade_batch_lit, shade_batch_textured, shade_batch8, shade_group,
+    Planes, group_lanes, prefetch, shade_batch, shade_batch_lit, shade_batch_textured, shade_batch8, shade_group,
     shade_group_textured, shade_group8,
 };
 use crate::stats::Marks;
@@ -100,6 +100,10 @@ fn sample_colour(colors: &[[f32; 4]], j: u32, bg: [f32; 4]) -> [f32; 4] {
     if j == u32::MAX { bg } else { colors[j as usize] }
 }
 
+/// How many pixels ahead a gathered batch asks for its triangles' planes: two vectors of 8
+/// (a fine mesh's planes are scattered through memory, one triangle every pixel or two).
+const GATHER_AHEAD: usize = 16;
+
 /// A textured object's jobs of a multi-sample tile: `(pixel, triangle)`, and each one's index
 /// in the tile's jobs.
 type TexturedJobs = (Vec<(u32, u32)>, Vec<u32>);
@@ -122,7 +126,12 @@ impl Tiles<'_> {
                 self.plan.isa,
                 kind,
                 batch.len(),
-                |i| lane(batch[i]),
+                |i| {
+                    if let Some(&ahead) = batch.get(i + GATHER_AHEAD) {
+                        prefetch(lane(ahead).2);
+                    }
+                    lane(batch[i])
+                },
                 |i, rgb| out(batch[i], rgb),
             );
         }
@@ -299,6 +308,9 @@ impl Tiles<'_> {
                 kind,
                 batch.len(),
                 |i| {
+                    if let Some(&(_, ahead)) = batch.get(i + GATHER_AHEAD) {
+                        prefetch(self.binned.planes(ahead));
+                    }
                     let (p, id) = batch[i];
                     let (x, y) = pixel_centre((x0, y0), p);
                     (x, y, self.binned.planes(id))

@@ -21,7 +21,7 @@ use phong_core::limits::SUBPIXEL_BITS;
 
 /// How many triangles of a bin ahead the tiles ask for their records: a bin's triangles are a
 /// sparse subset of the frame's, in an order the hardware does not predict.
-const PREFETCH_AHEAD: usize = 8;
+pub(super) const PREFETCH_AHEAD: usize = 8;
 
 /// The id of a pixel coloured during visibility (see [`Forward`]); bin indices stay below it.
 pub(super) const FORWARD: u32 = u32::MAX - 1;
@@ -127,8 +127,8 @@ impl Tiles<'_> {
 
     /// A one-sample tile's `depth` (all `+∞`) and `ids` (all `u32::MAX`), and the build of the
     /// visibility kernels for it: the AVX2 kernel costs more per triangle and less per pixel
-    /// than the scalar loop, so it draws tiles of 8 pixels per triangle or more (as Gouraud's,
-    /// BENCHMARKS.md, C4).
+    /// than the scalar loop, so it draws tiles of 8 pixels per triangle or more (BENCHMARKS.md,
+    /// C4: every tile by it was no faster on the 1M Phong sphere, whose time is its shading).
     fn single_buffers(&self, tile: &Tile, depth: &mut Vec<f32>, ids: &mut Vec<u32>) -> Isa {
         let n = tile.width() * tile.height();
         depth.clear();
