@@ -16,7 +16,7 @@
 //! relative, both builds) and the fast path's images against the reference path's (within
 //! 1/255 on every pixel).
 
-pub(super) use super::planes::{Broadcast, centres, coefficients, interpolate, same_planes};
+pub(super) use super::planes::{Broadcast, centres, coefficients, interpolate};
 pub use super::planes::{Planes, pixel_centre};
 use super::vector::Vf32;
 use glam::Vec3;
@@ -787,19 +787,16 @@ pub(super) fn lanes<'p, V: Vf32>(
     let m = (n - start).min(V::N);
     let mut xs = V::A::default();
     let mut ys = V::A::default();
-    let first = lane(start).2;
-    let mut planes: [&Planes; MAX_LANES] = [first; MAX_LANES];
-    let mut same = true;
+    let mut planes: [&Planes; MAX_LANES] = [lane(start).2; MAX_LANES];
     for (i, plane) in planes.iter_mut().enumerate().take(V::N) {
         let (x, y, p) = lane(start + i.min(m - 1));
         xs.as_mut()[i] = x;
         ys.as_mut()[i] = y;
-        same &= same_planes(p, first);
         *plane = p;
     }
     (
         m,
-        interpolate::<V>(&planes[..V::N], same, attrs, V::from_array(xs), V::from_array(ys)).0,
+        interpolate::<V>(&planes[..V::N], attrs, V::from_array(xs), V::from_array(ys)).0,
     )
 }
 

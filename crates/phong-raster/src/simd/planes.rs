@@ -91,15 +91,12 @@ impl<V: Vf32> Broadcast<V> {
 }
 
 /// The first `rows` rows of 8 of the lanes' planes' 24 floats as vectors (the rest 0):
-/// broadcast where `same` says one triangle has every lane (the usual case in large
-/// triangles), else gathered by transposing each lane's rows. The callers find `same` as they
-/// fill `planes` ([`same_planes`]): compared after, the pointers stored one by one were read
-/// back as one wide vector, which waits for the stores (a quarter of a 1M-triangle Phong
-/// sphere's shading time).
+/// broadcast when one triangle has every lane (the usual case in large triangles), else
+/// gathered by transposing each lane's rows.
 #[inline(always)]
-pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], same: bool, rows: usize) -> [V; 24] {
+pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], rows: usize) -> [V; 24] {
     let mut k = [V::splat(0.0); 24];
-    if same {
+    if planes.iter().all(|p| std::ptr::eq(*p, planes[0])) {
         let f = bytemuck::cast_ref::<_, [f32; 24]>(planes[0]);
         for (v, &c) in k.iter_mut().zip(f).take(rows * 8) {
             *v = V::splat(c);
@@ -116,18 +113,12 @@ pub(super) fn coefficients<V: Vf32>(planes: &[&Planes], same: bool, rows: usize)
     k
 }
 
-/// Whether lane plane `p` is the first lane's `first` (the same triangle).
-#[inline(always)]
-pub(super) fn same_planes(p: &Planes, first: &Planes) -> bool {
-    std::ptr::eq(p, first)
-}
-
 /// Evaluates the first `attrs` attribute planes at `(x, y)` per lane and divides by `1/w`;
 /// with where it evaluated them, `(x − ox, y − oy, w)` (the texture coordinates' planes share
 /// the origin and `1/w`).
 #[inline(always)]
-pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], same: bool, attrs: usize, x: V, y: V) -> ([V; 6], (V, V, V)) {
-    let k = coefficients::<V>(planes, same, if attrs > 3 { 3 } else { 2 });
+pub(super) fn interpolate<V: Vf32>(planes: &[&Planes], attrs: usize, x: V, y: V) -> ([V; 6], (V, V, V)) {
+    let k = coefficients::<V>(planes, if attrs > 3 { 3 } else { 2 });
     let (dx, dy) = (x.sub(k[0]), y.sub(k[1]));
     // `c + gx·dx + gy·dy` from floats `i..i + 3`.
     let plane = |i: usize| k[i + 2].mul_add(dy, k[i + 1].mul_add(dx, k[i]));

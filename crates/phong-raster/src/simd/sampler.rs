@@ -16,7 +16,7 @@
 use super::filter::{VectorMap, bilinear_lanes, mapped, texels_per_lane};
 use super::kernel::{
     Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal,
-    same_planes, shade_shininess,
+    shade_shininess,
 };
 use super::vector::{Portable, Vf32};
 use phong_core::{Channel, Maps, MetalRough, NormalMap, TextureMap, UvTransform};
@@ -752,19 +752,16 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_
         let (_, _, p0, uv0) = lane(start);
         let mut planes: [&Planes; MAX_LANES] = [p0; MAX_LANES];
         let mut uv: [&Planes; MAX_LANES] = [uv0; MAX_LANES];
-        let (mut same, mut same_uv) = (true, true);
         for i in 0..V::N {
             let (x, y, p, q) = lane(start + i.min(m - 1));
             xs.as_mut()[i] = x;
             ys.as_mut()[i] = y;
-            same &= same_planes(p, p0);
-            same_uv &= same_planes(q, uv0);
             planes[i] = p;
             uv[i] = q;
         }
         let (xs, ys) = (V::from_array(xs), V::from_array(ys));
-        let (q, at) = interpolate::<V>(&planes[..V::N], same, 6, xs, ys);
-        let k = folded(maps, coefficients::<V>(&uv[..V::N], same_uv, maps.rows()));
+        let (q, at) = interpolate::<V>(&planes[..V::N], 6, xs, ys);
+        let k = folded(maps, coefficients::<V>(&uv[..V::N], maps.rows()));
         let r = V::textured::<FULL, PER_VERTEX>(prep, maps, q, at, &k);
         emit::<V, usize>(r, m, |i| start + i, &mut out, unsampled);
         start += m;
@@ -790,7 +787,7 @@ pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool, const PER_VERT
         return 0;
     }
     let planes = Broadcast::<V>::new(planes, 6);
-    let k = folded(maps, coefficients::<V>(&[uv], true, maps.rows()));
+    let k = folded(maps, coefficients::<V>(&[uv], maps.rows()));
     for chunk in pixels[..full].chunks_exact(V::N) {
         let (x, y) = centres::<V>(origin, chunk);
         let (q, at) = planes.at(x, y, 6);

@@ -178,8 +178,8 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
     // A triangle whose columns lie in one or two aligned windows inside the tile (most
     // triangles of a fine mesh): each row's windows stepped down from the row above's.
     let base = c0 & !3;
-    let windows = ((c0 + n + 3) & !3) - base;
-    if windows <= 8 && base + windows <= tw {
+    let columns = ((c0 + n + 3) & !3) - base;
+    if columns <= 8 && base + columns <= tw {
         let first = bb[1].max(y0);
         let (cx, cy) = (
             (i64::from(x0) + base) << SUBPIXEL_BITS,
@@ -195,7 +195,7 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
         let at = (first - y0) as usize * tw as usize + base as usize;
         let rows = (first..bb[3].min(y1)).len();
         let (wz, line) = ((bias, inv, z, idv), (at, tw as usize, rows));
-        if windows == 4 {
+        if columns == 4 {
             narrow_rows::<1>(buf, e, step_y, step4, wz, line);
         } else {
             narrow_rows::<2>(buf, e, step_y, step4, wz, line);
