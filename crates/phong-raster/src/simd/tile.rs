@@ -15,8 +15,8 @@
 //! and a lane's first value is a converted integer plus `0·step`, `+0.0 + −0.0 = +0.0`), so the
 //! sign bit is exactly `E − bias < 0`.
 //!
-//! A triangle whose columns lie in one or two aligned windows (most triangles of a fine mesh)
-//! steps its windows down from row to row instead of setting each row up, so the kernel draws
+//! A triangle whose columns lie in at most four aligned windows (most triangles of a fine
+//! mesh) steps its windows down from row to row instead of setting each row up, so the kernel draws
 //! every tile of an AVX2 frame, tiny triangles included (BENCHMARKS.md, C4). Measurements and
 //! dead ends: BENCHMARKS.md ("Dead ends", K1–K8).
 
@@ -25,6 +25,11 @@
 
 use super::Isa;
 use super::kernel::Planes;
+
+/// The most windows of 4 a triangle's columns may span in a tile to be drawn by
+/// `narrow_triangle` (every row's windows stepped down and tested) rather than row by row
+/// (each row's covered span found, its first window set up).
+const NARROW_WINDOWS: u32 = 4;
 
 /// The pixels a triangle's row covers, as a range of `k` over `0..n` (pixels from the row's
 /// first column), given per edge `row[i]` = `E_i − bias_i` at the first pixel and its step per
@@ -148,15 +153,17 @@ fn gouraud_tile_avx2<'p, P: TilePixel>(
         if c1 <= c0 || r1 <= r0 {
             continue;
         }
-        // A triangle whose columns lie in one or two aligned windows inside the tile (most
+        // A triangle whose columns lie in at most four aligned windows inside the tile (most
         // triangles of a fine mesh): its rows' windows are stepped down, not set up per row.
         let base = c0 & !3;
         let windows = (c1.next_multiple_of(4) - base) / 4;
-        if windows <= 2 && (base + 4 * windows) as usize <= tw.min(stride) {
-            if windows == 1 {
-                narrow_triangle::<P, 1>(&t, (x0, y0), stride, base, depth, rows, &mut covered);
-            } else {
-                narrow_triangle::<P, 2>(&t, (x0, y0), stride, base, depth, rows, &mut covered);
+        if windows <= NARROW_WINDOWS && (base + 4 * windows) as usize <= tw.min(stride) {
+            let at = (x0, y0);
+            match windows {
+                1 => narrow_triangle::<P, 1>(&t, at, stride, base, depth, rows, &mut covered),
+                2 => narrow_triangle::<P, 2>(&t, at, stride, base, depth, rows, &mut covered),
+                3 => narrow_triangle::<P, 3>(&t, at, stride, base, depth, rows, &mut covered),
+                _ => narrow_triangle::<P, 4>(&t, at, stride, base, depth, rows, &mut covered),
             }
             continue;
         }
@@ -305,31 +312,41 @@ fn narrow_triangle<P: TilePixel, const NW: usize>(
         let px = _mm_cvtepi32_ps(_mm_add_epi32(first, _mm_setr_epi32(0, 1, 2, 3)));
         _mm_sub_ps(_mm_add_ps(px, _mm_set1_ps(0.5)), _mm_set1_ps(p.origin[0]))
     });
+    let gy: [__m128; 4] = std::array::from_fn(|ch| _mm_set1_ps(plane(ch)[2]));
     for r in r0..r1 {
         let mut ew = e;
-        for (w, &dxw) in dx.iter().enumerate() {
-            let inside = !_mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(ew[0], ew[1]), ew[2])) as u32 & 15;
-            let col = base as usize + 4 * w;
-            if inside != 0
-                && let Some(d4) = depth[r as usize * stride + col..].first_chunk_mut::<4>()
-            {
-                let zz = window_depths(ew, bias, inv, z);
-                let (pass, mask) = depth_window4(d4, zz, inside, covered);
-                if pass != 0
-                    && let Some(p4) = rows[r as usize][col..].first_chunk_mut::<4>()
-                {
-                    let dy = _mm_set1_ps((y0 + r) as f32 + 0.5 - p.origin[1]);
-                    let gyy: [__m128; 4] = std::array::from_fn(|ch| _mm_mul_ps(_mm_set1_ps(plane(ch)[2]), dy));
-                    let rgb = window_colour(cc, gx, gyy, dxw);
-                    if P::EIGHT {
-                        store_rgba8_window(bytemuck::cast_mut(p4), mask, rgb);
-                    } else {
-                        store_rgba32(bytemuck::cast_slice_mut(p4), 0, pass, rgb);
+        // The row's `g_y·dy`, made once for its windows (one window: where it passes).
+        let row_gyy = || {
+            let dy = _mm_set1_ps((y0 + r) as f32 + 0.5 - p.origin[1]);
+            gy.map(|g| _mm_mul_ps(g, dy))
+        };
+        let shared = (NW > 1).then(row_gyy);
+        // The row's windows, inside the tile's depths and pixels (the caller's test): no
+        // bounds check per window.
+        let (line, first) = (r as usize * stride + base as usize, base as usize);
+        if let (Some(dw), Some(pw)) = (
+            depth.get_mut(line..line + 4 * NW),
+            rows[r as usize].get_mut(first..first + 4 * NW),
+        ) {
+            let windows = dw.as_chunks_mut::<4>().0.iter_mut().zip(pw.as_chunks_mut::<4>().0);
+            for (w, ((d4, p4), &dxw)) in windows.zip(&dx).enumerate() {
+                let inside = !_mm256_movemask_pd(_mm256_or_pd(_mm256_or_pd(ew[0], ew[1]), ew[2])) as u32 & 15;
+                if inside != 0 {
+                    let zz = window_depths(ew, bias, inv, z);
+                    let (pass, mask) = depth_window4(d4, zz, inside, covered);
+                    if pass != 0 {
+                        let gyy = shared.unwrap_or_else(row_gyy);
+                        let rgb = window_colour(cc, gx, gyy, dxw);
+                        if P::EIGHT {
+                            store_rgba8_window(bytemuck::cast_mut(p4), mask, rgb);
+                        } else {
+                            store_rgba32(bytemuck::cast_slice_mut(p4), 0, pass, rgb);
+                        }
                     }
                 }
-            }
-            if w + 1 < NW {
-                ew = std::array::from_fn(|i| _mm256_add_pd(ew[i], step4[i]));
+                if w + 1 < NW {
+                    ew = std::array::from_fn(|i| _mm256_add_pd(ew[i], step4[i]));
+                }
             }
         }
         e = std::array::from_fn(|i| _mm256_add_pd(e[i], step_y[i]));
