@@ -368,36 +368,34 @@ impl Mesh {
 
     /// Flat normals: every triangle gets its own three vertices carrying its facet normal.
     pub fn with_flat_normals(&self) -> Mesh {
-        let mut positions = Vec::with_capacity(self.triangles.len() * 3);
-        let mut normals = Vec::with_capacity(self.triangles.len() * 3);
-        let mut triangles = Vec::with_capacity(self.triangles.len());
-        let mut uvs = Vec::new();
-        let mut uvs1 = Vec::new();
-        let mut colors = Vec::new();
-        for (t, corners) in self.triangles.iter().enumerate() {
-            let [a, b, c] = self.corners(t);
-            let n = facet_normal(a, b, c);
-            let i = positions.len() as u32;
-            positions.extend([a, b, c]);
-            normals.extend([n; 3]);
-            triangles.push([i, i + 1, i + 2]);
-            if !self.uvs.is_empty() {
-                uvs.extend(corners.map(|k| self.uvs[k as usize]));
+        // Each array sized once and written triangle by triangle, no growth check per
+        // vertex (a large glTF without normals takes this path).
+        fn per_corner<T: Copy + Default>(from: &[T], triangles: &[[u32; 3]]) -> Vec<T> {
+            if from.is_empty() {
+                return Vec::new();
             }
-            if !self.uvs1.is_empty() {
-                uvs1.extend(corners.map(|k| self.uvs1[k as usize]));
+            let mut out = vec![T::default(); 3 * triangles.len()];
+            for (o, t) in out.chunks_exact_mut(3).zip(triangles) {
+                o[0] = from[t[0] as usize];
+                o[1] = from[t[1] as usize];
+                o[2] = from[t[2] as usize];
             }
-            if !self.colors.is_empty() {
-                colors.extend(corners.map(|k| self.colors[k as usize]));
-            }
+            out
+        }
+        let positions = per_corner(&self.positions, &self.triangles);
+        let mut normals = vec![Vec3::ZERO; positions.len()];
+        for (n, c) in normals.chunks_exact_mut(3).zip(positions.chunks_exact(3)) {
+            n.fill(facet_normal(c[0], c[1], c[2]));
         }
         Mesh {
             positions,
             normals,
-            triangles,
-            uvs,
-            uvs1,
-            colors,
+            triangles: (0..self.triangles.len() as u32)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            uvs: per_corner(&self.uvs, &self.triangles),
+            uvs1: per_corner(&self.uvs1, &self.triangles),
+            colors: per_corner(&self.colors, &self.triangles),
             tangents: Vec::new(),
         }
     }
@@ -571,6 +569,20 @@ mod tests {
         assert_eq!(m.positions().len(), 9);
         assert_eq!(m.normals()[0], Vec3::Z);
         assert_eq!(m.normals()[6], Vec3::X);
+        // Each corner its vertex's position and texture coordinates, triangle t on vertices
+        // 3t, 3t + 1, 3t + 2.
+        let base = folded();
+        let uvs: Vec<Vec2> = (0..base.positions().len()).map(|i| Vec2::new(i as f32, 0.5)).collect();
+        let m = base.clone().with_uvs(uvs.clone()).unwrap().with_flat_normals();
+        for (t, tri) in base.triangles().iter().enumerate() {
+            let t3 = 3 * t as u32;
+            assert_eq!(m.triangles()[t], [t3, t3 + 1, t3 + 2]);
+            for k in 0..3 {
+                assert_eq!(m.positions()[3 * t + k], base.positions()[tri[k] as usize]);
+                assert_eq!(m.uvs()[3 * t + k], uvs[tri[k] as usize]);
+            }
+        }
+        assert!(m.colors().is_empty() && m.tangents().is_empty());
     }
 
     #[test]

@@ -309,6 +309,7 @@ impl SceneCore {
             material: None,
             maps: Default::default(),
             has_normals,
+            flat_without_normals: false,
             origin: glam::DVec3::ZERO,
             drawn: None,
         };

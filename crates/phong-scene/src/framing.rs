@@ -878,6 +878,7 @@ mod tests {
             material: None,
             maps: Default::default(),
             has_normals: false,
+            flat_without_normals: false,
             origin: DVec3::ZERO,
             drawn: None,
         }

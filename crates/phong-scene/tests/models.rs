@@ -987,6 +987,83 @@ fn gltf_tangents_are_read() {
     }
 }
 
+/// A glTF primitive without normals gets flat normals, as the specification requires ("client
+/// implementations MUST calculate flat normals"): a strip of two triangles folded 35° along
+/// their shared edge, well inside the 60° crease that would smooth it, has on each triangle's
+/// corners that triangle's facet normal (the cross product of its edges, by hand below), in a
+/// scene and as a model alone; `normals = "angle"` asks for the smooth ones, and `"file"` says
+/// the file has none and gives flat ones.
+#[test]
+fn gltf_without_normals_is_flat() {
+    let d = dir("gltf_flat");
+    let mut bin = Vec::new();
+    for x in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.5] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 1, 3, 2] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let gltf = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0.5]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+    );
+    let model = write(&d, "fold.gltf", gltf.as_bytes());
+    // (1,0,0) × (0,1,0) and (0,1,0.5) × (−1,1,0), normalised.
+    let facets = [Vec3::Z, Vec3::new(-0.5, -0.5, 1.0) / 1.5f32.sqrt()];
+    // Each corner's normal against its triangle's facet normal, the triangles told apart by
+    // the direction of the facet of their drawn positions (the model alone may be turned).
+    let corners_are_flat = |mesh: &phong_core::Mesh, turned: bool| {
+        let (pos, nor) = (mesh.positions(), mesh.normals());
+        assert_eq!(mesh.triangles().len(), 2);
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|i| pos[i as usize]);
+            let facet = (b - a).cross(c - a).normalize();
+            if !turned {
+                assert!(facets.iter().any(|f| (facet - *f).length() < 1e-6), "{facet}");
+            }
+            for &i in t {
+                let n = nor[i as usize];
+                assert!((n - facet).length() < 1e-6, "corner normal {n} on a facet {facet}");
+            }
+        }
+    };
+    for (normals, flat) in [
+        ("", true),
+        ("normals = \"file\"\n", true),
+        ("normals = \"angle\"\n", false),
+    ] {
+        let toml = format!("[[object]]\nmesh = \"fold.gltf\"\nfit = false\n{normals}");
+        let scene = write(&d, "s.toml", toml.as_bytes());
+        let loaded = load_with(&scene, &ModelOptions::default()).unwrap();
+        let mesh = &loaded.scene.objects[0].mesh;
+        if flat {
+            corners_are_flat(mesh, false);
+        } else {
+            // Smooth across the fold: the shared corners' normals lie between the facets'.
+            let shared = mesh
+                .normals()
+                .iter()
+                .filter(|n| n.dot(facets[0]) < 0.999 && n.dot(facets[1]) < 0.999)
+                .count();
+            assert!(shared >= 2, "{normals}: {:?}", mesh.normals());
+        }
+        let said = loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("no normals for it: normals computed flat"));
+        assert_eq!(said, normals.contains("file"), "{normals}: {:?}", loaded.warnings);
+    }
+    let alone = load_with(&model, &ModelOptions::default()).unwrap();
+    corners_are_flat(&alone.scene.objects[0].mesh, true);
+}
+
 /// glTF's second texture coordinate set: each texture reads the set its `texCoord` (or its
 /// KHR_texture_transform's `texCoord`) names, both sets read with v flipped to OpenGL's; the
 /// normal texture's set is the mesh's first (its tangents are made from it); a texture on a

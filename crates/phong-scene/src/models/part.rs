@@ -20,6 +20,9 @@ pub struct ModelPart {
     pub maps: Maps,
     /// True when the file gave normals for every vertex of this part.
     pub has_normals: bool,
+    /// Without normals of its own, the part's format asks for flat normals (glTF: "client
+    /// implementations MUST calculate flat normals"); else they are computed by angle.
+    pub flat_without_normals: bool,
     /// The point the positions are relative to, in the file's coordinates: a model far from
     /// the origin for its size is re-centred in f64 before its positions become f32 (so that
     /// it keeps its detail); zero otherwise. Every part of a model has the same.

@@ -638,6 +638,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         material,
         maps: phong_core::Maps::default(),
         has_normals,
+        flat_without_normals: false,
         origin,
         drawn: None,
     }])

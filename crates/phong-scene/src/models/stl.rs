@@ -63,6 +63,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
             material: None,
             maps: phong_core::Maps::default(),
             has_normals: false,
+            flat_without_normals: false,
             origin,
             drawn: None,
         });

@@ -192,10 +192,20 @@ fn shape_object(
 }
 
 /// The normals a part is drawn with where the scene does not ask: the file's where every
-/// vertex has a usable one, else by angle.
+/// vertex has a usable one, else [`computed_normals`].
 pub(crate) fn default_normals(p: &ModelPart) -> &'static str {
     if p.has_normals && !p.mesh.normals().contains(&Vec3::ZERO) {
         "file"
+    } else {
+        computed_normals(p)
+    }
+}
+
+/// The normals computed for a part whose file normals are missing or unusable: flat where its
+/// format asks for them when it has none (glTF), else by angle.
+fn computed_normals(p: &ModelPart) -> &'static str {
+    if !p.has_normals && p.flat_without_normals {
+        "flat"
     } else {
         "angle"
     }
@@ -294,7 +304,8 @@ fn mesh_objects(
     let mut out = Vec::new();
     for mut p in parts {
         // File normals where every vertex has a usable one; else, or where `"file"`
-        // is asked of a model without them, normals by angle, with a warning.
+        // is asked of a model without them, computed normals (`computed_normals`), with a
+        // warning.
         let bad = p.mesh.normals().iter().filter(|n| **n == Vec3::ZERO).count();
         let usable = default_normals(&p) == "file";
         let asked = normals_choice
@@ -308,12 +319,17 @@ fn mesh_objects(
             ));
         } else if !p.has_normals && asked == Some("file") {
             warnings.push(format!(
-                "{}: `normals = \"file\"` but the file has no normals for it: normals computed by angle",
-                p.name
+                "{}: `normals = \"file\"` but the file has no normals for it: normals computed {}",
+                p.name,
+                if computed_normals(&p) == "flat" {
+                    "flat"
+                } else {
+                    "by angle"
+                }
             ));
         }
         let choice = match asked {
-            Some("file") if !usable => "angle",
+            Some("file") if !usable => computed_normals(&p),
             Some(a) => a,
             None => default_normals(&p),
         };

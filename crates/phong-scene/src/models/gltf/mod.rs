@@ -623,6 +623,7 @@ fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<V
                 material: p.material,
                 maps: p.maps,
                 has_normals: p.has_normals,
+                flat_without_normals: true,
                 origin,
                 drawn: None,
             })

@@ -413,6 +413,7 @@ fn part_of(
                 })
                 .unwrap_or_default(),
             has_normals,
+            flat_without_normals: false,
             origin,
             drawn: None,
         },
