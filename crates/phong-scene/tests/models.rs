@@ -1017,8 +1017,8 @@ fn gltf_without_normals_is_flat() {
     let model = write(&d, "fold.gltf", gltf.as_bytes());
     // (1,0,0) × (0,1,0) and (0,1,0.5) × (−1,1,0), normalised.
     let facets = [Vec3::Z, Vec3::new(-0.5, -0.5, 1.0) / 1.5f32.sqrt()];
-    // Each corner's normal against its triangle's facet normal, the triangles told apart by
-    // the direction of the facet of their drawn positions (the model alone may be turned).
+    // Each corner's normal against the facet normal of its triangle's drawn positions, and
+    // that facet one of the two above (not checked for the model alone, which may be turned).
     let corners_are_flat = |mesh: &phong_core::Mesh, turned: bool| {
         let (pos, nor) = (mesh.positions(), mesh.normals());
         assert_eq!(mesh.triangles().len(), 2);

@@ -16,9 +16,9 @@
 //! sign bit is exactly `E − bias < 0`.
 //!
 //! A triangle whose columns lie in at most four aligned windows (most triangles of a fine
-//! mesh) steps its windows down from row to row instead of setting each row up, so the kernel draws
-//! every tile of an AVX2 frame, tiny triangles included (BENCHMARKS.md, C4). Measurements and
-//! dead ends: BENCHMARKS.md ("Dead ends", K1–K8).
+//! mesh) steps its windows down from row to row instead of setting each row up, so the kernel
+//! draws every tile of an AVX2 frame, tiny triangles included (BENCHMARKS.md, C4). Measurements
+//! and dead ends: BENCHMARKS.md ("Dead ends", K1–K10).
 
 // Elsewhere than x86-64 only the scalar fallback of this module is compiled.
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code, unused_imports))]
