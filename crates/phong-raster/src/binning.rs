@@ -2,7 +2,7 @@
 //! trivially reject, in the input's order.
 
 use crate::setup::{Chunk, Corners, ID_INDEX_BITS, Scratch, Tri};
-use crate::simd::Planes;
+use crate::simd::{ColourPlanes, Planes};
 use phong_core::limits::{SUBPIXEL_BITS, TILE_SIZE};
 use rayon::prelude::*;
 
@@ -100,6 +100,13 @@ impl Binned {
     #[inline]
     pub fn planes(&self, id: u32) -> &Planes {
         &self.tris[(id >> ID_INDEX_BITS) as usize].planes[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
+    }
+
+    /// The colour planes of triangle `id` in a frame that keeps them
+    /// ([`FramePlan::colour_planes`](crate::plan::FramePlan::colour_planes)).
+    #[inline]
+    pub fn colour(&self, id: u32) -> &ColourPlanes {
+        &self.tris[(id >> ID_INDEX_BITS) as usize].colour[(id & ((1 << ID_INDEX_BITS) - 1)) as usize]
     }
 
     /// The planes of a textured triangle's texture coordinates (`Mode::Textured`).

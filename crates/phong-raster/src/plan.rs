@@ -258,6 +258,11 @@ pub(crate) struct FramePlan<'a> {
     pub tiles_x: u32,
     /// The fast path with every object Gouraud-shaded (see `tile::gouraud`).
     pub gouraud_only: bool,
+    /// `gouraud_only` with one sample: the set-up keeps each triangle's
+    /// [`ColourPlanes`](crate::simd::ColourPlanes) (`Chunk::colour`), not its whole
+    /// [`Planes`](crate::simd::Planes), for the tiles that read only those
+    /// (`tile::gouraud`, and a covered tile's 8-bit shading).
+    pub colour_planes: bool,
     /// The fast path with one sample and every object opaque and shaded by the vector kernels
     /// per pixel, untextured ([`Mode::Phong`]): one-sample tiles of 8-bit frames are then
     /// shaded and encoded straight into the frame (`Tiles::tile_single8`).
@@ -281,6 +286,7 @@ impl<'a> FramePlan<'a> {
         let pattern = pattern(scene.image.samples);
         let bg = scene.image.background;
         let ns = pattern.len();
+        let gouraud_only = path == Path::Fast && objects.iter().all(|o| matches!(o.mode, Mode::Gouraud));
         FramePlan {
             path,
             isa,
@@ -292,7 +298,8 @@ impl<'a> FramePlan<'a> {
             bg,
             background: resolve(std::iter::repeat_n(bg, ns), ns, bg),
             tiles_x: w.div_ceil(TILE_SIZE),
-            gouraud_only: path == Path::Fast && objects.iter().all(|o| matches!(o.mode, Mode::Gouraud)),
+            gouraud_only,
+            colour_planes: gouraud_only && ns == 1,
             phong_only: path == Path::Fast
                 && ns == 1
                 && objects

@@ -12,7 +12,7 @@ use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, 
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
 use crate::plan::{Mode, lit_term};
-use crate::simd::Planes;
+use crate::simd::{ColourPlanes, Planes};
 use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -75,7 +75,12 @@ impl Stage<'_> {
         };
         let setup_chunk = |chunk: &[[u32; 3]]| {
             let mut out = Chunk::reuse(spare, oi, chunk.len());
-            out.planes.reserve(chunk.len());
+            // Room for every triangle, so that a recycled chunk never grows (fresh pages).
+            if self.plan.colour_planes {
+                out.colour.reserve(chunk.len());
+            } else {
+                out.planes.reserve(chunk.len());
+            }
             for &tri in chunk {
                 let v = [
                     vertices[tri[0] as usize],
@@ -165,7 +170,13 @@ impl Stage<'_> {
             // Lit straight into the colour arrays, which keep last frame's values: only the
             // used vertices' colours are read.
             lighting.light_used(positions, normals, used, &mut scratch.colors);
-            gouraud_planes(&mut chunks, vertices, &scratch.colors, textured);
+            gouraud_planes(
+                &mut chunks,
+                vertices,
+                &scratch.colors,
+                textured,
+                self.plan.colour_planes,
+            );
         }
         chunks
     }
@@ -175,11 +186,19 @@ impl Stage<'_> {
 /// ([`Pending`]), made from `colors` (front, back and, textured, their
 /// specular colours) once the used vertices are lit; each chunk's clipped triangles' planes,
 /// made at setup, are taken in slot order.
-fn gouraud_planes(chunks: &mut [Chunk], vertices: &[FastVertex], colors: &[Vec<Vec3>; 4], textured: bool) {
+/// `colour`: kept as [`ColourPlanes`] (`FramePlan::colour_planes`).
+fn gouraud_planes(
+    chunks: &mut [Chunk],
+    vertices: &[FastVertex],
+    colors: &[Vec<Vec3>; 4],
+    textured: bool,
+    colour: bool,
+) {
     chunks.par_iter_mut().for_each(|chunk| {
         let Chunk {
             tris,
             planes,
+            colour: colour_planes,
             pending,
             clipped,
             ..
@@ -187,7 +206,7 @@ fn gouraud_planes(chunks: &mut [Chunk], vertices: &[FastVertex], colors: &[Vec<V
         // In slot order: the pending triangles' planes made here, the clipped ones'
         // taken (no default planes written first: 96 bytes a triangle).
         let (mut pending, mut clipped) = (pending.iter().peekable(), clipped.iter().peekable());
-        planes.extend((0..tris.len() as u32).map(|slot| {
+        let each = (0..tris.len() as u32).map(|slot| {
             if let Some(p) = pending.next_if(|p| p.slot == slot) {
                 let t = &tris[slot as usize];
                 let v = each3(|k| vertices[p.idx[k] as usize].p);
@@ -215,7 +234,12 @@ fn gouraud_planes(chunks: &mut [Chunk], vertices: &[FastVertex], colors: &[Vec<V
                 debug_assert_eq!(c.map(|c| c.0), Some(slot), "every slot is pending or clipped");
                 c.map(|c| c.1).unwrap_or_default()
             }
-        }));
+        });
+        if colour {
+            colour_planes.extend(each.map(|p| ColourPlanes::from(&p)));
+        } else {
+            planes.extend(each);
+        }
     });
 }
 

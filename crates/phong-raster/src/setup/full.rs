@@ -29,6 +29,7 @@ impl Stage<'_> {
         let view = self.plan.objects[oi].view;
         let mesh = &obj.mesh;
         let gouraud = interpolation == Interpolation::Gouraud;
+        let colour = self.plan.colour_planes;
         let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
         let colors = mesh.colors();
         let tangents = mesh.tangents();
@@ -117,7 +118,7 @@ impl Stage<'_> {
                     out.tris.push(t);
                     out.corners.extend(c);
                     if keep.planes {
-                        out.planes.push(p);
+                        out.push_planes(colour, &p);
                         out.uv.extend(uv);
                     }
                 }

@@ -13,7 +13,7 @@ use crate::binning::{Binned, bin_entries};
 use crate::clip::ClipVertex;
 use crate::fixed::{HALF, ONE};
 use crate::plan::{FramePlan, Mode, SetupKind};
-use crate::simd::Planes;
+use crate::simd::{ColourPlanes, Planes};
 use crate::vertex::{FastVertex, Projected, project};
 use glam::Vec3;
 use phong_core::limits::SUBPIXEL_BITS;
@@ -124,6 +124,9 @@ pub(crate) struct Chunk {
     /// The fast path's plane equations (Phong: world position and normal, flipped on a back
     /// face; Gouraud: the colour seen), same index; empty for scalar-shaded objects.
     pub planes: Vec<Planes>,
+    /// Instead of `planes` in a frame whose planes are [`ColourPlanes`]
+    /// ([`FramePlan::colour_planes`]), same index.
+    pub colour: Vec<ColourPlanes>,
     pub corners: Vec<Corners>,
     /// Gouraud triangles whose planes wait for their vertices' colours (see [`Pending`]).
     pub pending: Vec<Pending>,
@@ -139,6 +142,17 @@ pub(crate) struct Chunk {
 }
 
 impl Chunk {
+    /// Keeps `p` as the frame's planes are kept: whole, or its colour part
+    /// ([`FramePlan::colour_planes`]).
+    #[inline]
+    pub fn push_planes(&mut self, colour: bool, p: &Planes) {
+        if colour {
+            self.colour.push(ColourPlanes::from(p));
+        } else {
+            self.planes.push(*p);
+        }
+    }
+
     /// An empty chunk for `object` with room for `n` triangles, from `spare` if it has one.
     pub fn reuse(spare: &Mutex<Vec<Chunk>>, object: usize, n: usize) -> Chunk {
         let mut c = spare.lock().ok().and_then(|mut s| s.pop()).unwrap_or_default();
@@ -152,6 +166,7 @@ impl Chunk {
         self.uv.clear();
         self.tris.clear();
         self.planes.clear();
+        self.colour.clear();
         self.corners.clear();
         self.pending.clear();
         self.binned.clear();
@@ -464,6 +479,10 @@ mod tests {
         use std::mem::size_of;
         assert_eq!(size_of::<Tri>(), 80);
         assert_eq!(size_of::<Planes>(), 96);
+        assert_eq!(
+            (size_of::<ColourPlanes>(), std::mem::align_of::<ColourPlanes>()),
+            (64, 64)
+        );
         assert_eq!(size_of::<Pending>(), 16);
     }
 

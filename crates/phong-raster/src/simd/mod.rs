@@ -28,6 +28,7 @@ use crate::Kernels;
 use glam::Vec3;
 pub use kernel::{Batch, LANES, Planes, Prepared, Shaded8, Term, VertexTerm};
 pub use lean::Lean;
+pub use planes::ColourPlanes;
 pub use project::WindowVertex;
 pub use sampler::{Unsampled, VectorMaps};
 pub(crate) use tile::covered_span;
@@ -664,8 +665,9 @@ pub(crate) fn prefetch<T>(x: &T) {
         use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let first = (x as *const T).cast::<i8>();
         _mm_prefetch::<_MM_HINT_T0>(first);
-        // A record that crosses into the next line (80- and 96-byte records mostly do).
-        if size_of::<T>() > 1 {
+        // A record that crosses into the next line (80- and 96-byte records mostly do; a
+        // 64-byte record aligned to 64 never does).
+        if size_of::<T>() > 1 && !(align_of::<T>() >= 64 && size_of::<T>() <= 64) {
             _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(size_of::<T>() - 1));
         }
     }

@@ -24,6 +24,50 @@ pub struct Planes {
     pub pad: f32,
 }
 
+/// The first 14 floats of a Gouraud triangle's [`Planes`] (origin, `1/w` and the colour, the
+/// rest unused), in one 64-byte line: what an all-Gouraud frame of one sample keeps per drawn
+/// triangle (`FramePlan::colour_planes`), a third less memory traffic than the whole record
+/// in a set-up bound by it (BENCHMARKS.md, C14).
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(64))]
+pub struct ColourPlanes {
+    /// As [`Planes::origin`].
+    pub origin: [f32; 2],
+    /// As [`Planes::inv_w`].
+    pub inv_w: [f32; 3],
+    /// Red, green and blue over `w`, as [`Planes::attr`]'s first three.
+    pub attr: [[f32; 3]; 3],
+    /// Padding to 16 floats.
+    pub pad: [f32; 2],
+}
+
+impl From<&Planes> for ColourPlanes {
+    #[inline(always)]
+    fn from(p: &Planes) -> ColourPlanes {
+        ColourPlanes {
+            origin: p.origin,
+            inv_w: p.inv_w,
+            attr: [p.attr[0], p.attr[1], p.attr[2]],
+            pad: [0.0; 2],
+        }
+    }
+}
+
+impl From<&ColourPlanes> for Planes {
+    /// The whole record, its other attributes 0 (for the kernels that read [`Planes`]).
+    #[inline(always)]
+    fn from(c: &ColourPlanes) -> Planes {
+        let mut attr = [[0.0; 3]; 6];
+        attr[..3].copy_from_slice(&c.attr);
+        Planes {
+            origin: c.origin,
+            inv_w: c.inv_w,
+            attr,
+            pad: 0.0,
+        }
+    }
+}
+
 impl Planes {
     /// The 24 floats as three rows of 8.
     #[inline(always)]

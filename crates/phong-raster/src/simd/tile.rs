@@ -24,7 +24,7 @@
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code, unused_imports))]
 
 use super::Isa;
-use super::kernel::Planes;
+use super::planes::ColourPlanes;
 
 /// The most windows of 4 a triangle's columns may span in a tile to be drawn by
 /// `narrow_triangle` (every row's windows stepped down and tested) rather than row by row
@@ -102,7 +102,7 @@ pub struct GouraudTri<'p> {
     pub rows: (u32, u32),
     /// The colour planes: `attr[0..3]` red, green and blue over `w`, `inv_w` the `1/w` plane,
     /// each `[c, g_x, g_y]` about `origin`.
-    pub planes: &'p Planes,
+    pub planes: &'p ColourPlanes,
 }
 
 /// Draws `n` triangles, `tri(0)` first, into a tile at `(x0, y0)` of the frame: `depth`

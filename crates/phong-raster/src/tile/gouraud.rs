@@ -49,7 +49,7 @@ impl Tiles<'_> {
             // scattered through memory; a fine mesh's tile draws thousands).
             if let Some(&ahead) = bin.get(k + PREFETCH_AHEAD) {
                 prefetch(self.binned.tri(ahead));
-                prefetch(self.binned.planes(ahead));
+                prefetch(self.binned.colour(ahead));
             }
             self.gouraud_tri(bin[k], (x0, y0, x1, y1))
         };
@@ -60,7 +60,7 @@ impl Tiles<'_> {
         for &ti in bin {
             let scan = Scan::new(self.binned.tri(ti), 0, self.plan.pattern[0], (x0, x1));
             let forward = Forward {
-                planes: ColorPlanes::new(self.binned.planes(ti)),
+                planes: ColorPlanes::new(self.binned.colour(ti)),
                 rows: &mut *rows,
             };
             visible_single::<false, T>(scan, (x0, y0, tw, y1), depth, &mut [], Some(forward), |_, _| true);
@@ -86,7 +86,7 @@ impl Tiles<'_> {
             z: t.z,
             cols: (bx0 - x0, bb[2].min(x1).max(bx0) - x0),
             rows: (by0 - y0, bb[3].min(y1).max(by0) - y0),
-            planes: self.binned.planes(ti),
+            planes: self.binned.colour(ti),
         }
     }
 }

@@ -201,6 +201,10 @@ impl Tiles<'_> {
             TilePlan::Covered => {
                 if let Some(Some(n)) = target.draw_linear8(|rows| self.tile_covered8(tile, rows, covered)) {
                     n
+                } else if self.plan.colour_planes {
+                    // The `f32` tile's shading reads whole planes: drawn as the frame's other tiles.
+                    let kernel = self.plan.isa.is_avx2();
+                    target.draw(local, |rows, _| self.tile_gouraud(tile, rows, depth, kernel))
                 } else {
                     target.draw(local, |rows, store| self.tile_covered(tile, rows, store, ids))
                 }

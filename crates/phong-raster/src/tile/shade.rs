@@ -344,7 +344,14 @@ impl Tiles<'_> {
         let (tw, th) = (tile.width() as u32, tile.height() as u32);
         let pixels = covered.of(tw, th);
         let at = |p: u32| ((p >> 16) as usize, (p & 0xffff) as usize);
-        let planes = self.binned.planes(id);
+        // Its colour planes alone where the frame keeps only those (one triangle: one copy).
+        let whole;
+        let planes = if self.plan.colour_planes {
+            whole = Planes::from(self.binned.colour(id));
+            &whole
+        } else {
+            self.binned.planes(id)
+        };
         let done = if pixels.len() < group_lanes(self.plan.isa) {
             0
         } else {

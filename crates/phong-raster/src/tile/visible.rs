@@ -13,7 +13,8 @@ use crate::fixed::{HALF, each3, map3};
 use crate::plan::{Mode, Visibility};
 use crate::setup::Tri;
 use crate::simd::{
-    Isa, Planes, SampleBuffers, TilePixel, covered_span, multi_visible, multi_visible_run, prefetch, single_visible,
+    ColourPlanes, Isa, SampleBuffers, TilePixel, covered_span, multi_visible, multi_visible_run, prefetch,
+    single_visible,
 };
 use crate::stats::Marks;
 use crate::target::{Store, resolve};
@@ -34,7 +35,7 @@ pub(super) struct Forward<'r, 'i, T> {
     pub rows: &'r mut [&'i mut [T]],
 }
 
-/// A triangle's Gouraud planes (see [`Planes`]) as columns of four, `[r/w, g/w, b/w, 1/w]`, so
+/// A triangle's Gouraud planes (see [`ColourPlanes`]) as columns of four, `[r/w, g/w, b/w, 1/w]`, so
 /// that a pixel's colour is one 4-wide vector from start to store, the layout of the
 /// `[f32; 4]` pixel it is written to (BENCHMARKS.md, C6).
 #[derive(Clone, Copy)]
@@ -47,7 +48,7 @@ pub(super) struct ColorPlanes {
 
 impl ColorPlanes {
     #[inline(always)]
-    pub fn new(p: &Planes) -> ColorPlanes {
+    pub fn new(p: &ColourPlanes) -> ColorPlanes {
         let column = |k: usize| [p.attr[0][k], p.attr[1][k], p.attr[2][k], p.inv_w[k]];
         ColorPlanes {
             c: column(0),
@@ -174,7 +175,7 @@ impl Tiles<'_> {
                 }
                 Visibility::Opaque if matches!(self.plan.objects[self.binned.object(ti)].mode, Mode::Gouraud) => {
                     let forward = Forward {
-                        planes: ColorPlanes::new(self.binned.planes(ti)),
+                        planes: ColorPlanes::new(&ColourPlanes::from(self.binned.planes(ti))),
                         rows: &mut *rows,
                     };
                     visible_single::<true, _>(scan, span, depth, ids, Some(forward), |_, _| true);
