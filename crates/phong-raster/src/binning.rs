@@ -136,7 +136,7 @@ pub(crate) fn misses_tile(t: &Tri, tx: u32, ty: u32) -> bool {
     (0..3).any(|i| {
         let x = if t.a[i] >= 0 { x0 + side } else { x0 };
         let y = if t.b[i] >= 0 { y0 + side } else { y0 };
-        t.a(i) * x + t.b(i) * y + t.c[i] - t.bias(i) < 0
+        t.edge(i, x, y) - t.bias(i) < 0
     })
 }
 

@@ -27,14 +27,18 @@ pub(crate) const SETUP_CHUNK: usize = 4096;
 /// Low bits of a triangle id that index within its setup chunk (4096 · 7 < 2^15).
 pub(crate) const ID_INDEX_BITS: u32 = 15;
 
-/// A triangle ready for the tiles: what visibility reads, 80 bytes. Its object, shading planes
-/// and (where kept) [`Corners`] are in its [`Chunk`].
+/// A triangle ready for the tiles: what visibility reads, 64 bytes in one cache line (the
+/// tiles read a fine mesh's triangles scattered through memory: BENCHMARKS.md, C15). Its
+/// object, shading planes and (where kept) [`Corners`] are in its [`Chunk`].
+#[repr(align(64))]
 pub(crate) struct Tri {
     /// Edge functions `E_i(X, Y) = a·X + b·Y + c` (edge i opposite vertex i), in 1/256 pixel;
-    /// `a` and `b` are coordinate differences (below 2^25), `c` needs 64 bits.
+    /// `a` and `b` are coordinate differences (below 2^25). `E_i` is evaluated from a vertex on
+    /// edge `i` ([`Tri::edges_at`]), so `c` is not kept.
     pub a: [i32; 3],
     pub b: [i32; 3],
-    pub c: [i64; 3],
+    /// Vertex 0, snapped (1/256 pixel): on edges 1 and 2, and with edge 2's `a` and `b`, vertex 1.
+    pub v0: [i32; 2],
     /// 1 / (twice the signed area): barycentrics are `E_i · inv_area`.
     pub inv_area: f64,
     /// Window depth in [0, 1] per vertex.
@@ -48,6 +52,24 @@ pub(crate) struct Tri {
 }
 
 impl Tri {
+    /// Edge function `E_i` at `(x, y)` (1/256 pixel) as `a_i·(x − x_v) + b_i·(y − y_v)` from a
+    /// vertex `v` on edge `i`: vertex 0 for edges 1 and 2, vertex 1 (`v0 + (b_2, −a_2)`, the
+    /// end of edge 2) for edge 0. Exact, as `a·x + b·y + c` (below 2^51 within the guard band).
+    #[inline(always)]
+    pub fn edge(&self, i: usize, x: i64, y: i64) -> i64 {
+        let (mut vx, mut vy) = (i64::from(self.v0[0]), i64::from(self.v0[1]));
+        if i == 0 {
+            (vx, vy) = (vx + self.b(2), vy - self.a(2));
+        }
+        self.a(i) * (x - vx) + self.b(i) * (y - vy)
+    }
+
+    /// The three edge functions at `(x, y)` ([`Tri::edge`]).
+    #[inline(always)]
+    pub fn edges_at(&self, x: i64, y: i64) -> [i64; 3] {
+        crate::fixed::each3(|i| self.edge(i, x, y))
+    }
+
     #[inline(always)]
     pub fn a(&self, i: usize) -> i64 {
         i64::from(self.a[i])
@@ -69,7 +91,7 @@ impl Tri {
     /// covered (top-left rule).
     #[inline]
     pub fn covers(&self, sx: i64, sy: i64) -> Option<[i64; 3]> {
-        let e = crate::fixed::each3(|i| self.a(i) * sx + self.b(i) * sy + self.c[i]);
+        let e = self.edges_at(sx, sy);
         if (0..3).any(|i| e[i] - self.bias(i) < 0) {
             None
         } else {
@@ -257,7 +279,6 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
     }
     let mut a = [0i32; 3];
     let mut b = [0i32; 3];
-    let mut c = [0i64; 3];
     let mut bias = 0u8;
     for i in 0..3 {
         // Edge opposite vertex i, from vertex j to vertex k.
@@ -267,7 +288,6 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
         let (ai, bi) = (-(yb - ya), xb - xa);
         a[i] = ai as i32;
         b[i] = bi as i32;
-        c[i] = -(ai * xa + bi * ya);
         // Top edge: horizontal, going right; left edge: going up (y down). Both inclusive.
         let top_left = (ya == yb && xb > xa) || yb < ya;
         bias |= u8::from(!top_left) << i;
@@ -277,7 +297,7 @@ pub(crate) fn setup_edges(proj: [Projected; 3], two_sided: bool, w: u32, h: u32,
         tri: Tri {
             a,
             b,
-            c,
+            v0: [xy[0].0 as i32, xy[0].1 as i32],
             inv_area: 1.0 / area as f64,
             z: [proj[order[0]].2, proj[order[1]].2, proj[order[2]].2],
             bbox: [px0 as u16, py0 as u16, px1 as u16, py1 as u16],
@@ -477,13 +497,51 @@ mod tests {
     #[test]
     fn record_sizes() {
         use std::mem::size_of;
-        assert_eq!(size_of::<Tri>(), 80);
+        assert_eq!((size_of::<Tri>(), std::mem::align_of::<Tri>()), (64, 64));
         assert_eq!(size_of::<Planes>(), 96);
         assert_eq!(
             (size_of::<ColourPlanes>(), std::mem::align_of::<ColourPlanes>()),
             (64, 64)
         );
         assert_eq!(size_of::<Pending>(), 16);
+    }
+
+    /// A set-up triangle's edge functions ([`Tri::edge`], from vertex 0 and the edges) are
+    /// those of its edges through the input vertices: `E_i = 0` at both ends of edge `i` and,
+    /// at a random point, the cross product of edge `i` with the point taken from the input
+    /// vertices, for random triangles of every size and place, front and back.
+    #[test]
+    fn edge_constants_put_each_edge_through_its_vertices() {
+        let mut next = xorshift(0x5eed_c0de);
+        let mut checked = 0;
+        for k in 0..20_000 {
+            // Snapped coordinates up to ±2^23 (32768 pixels), small triangles often.
+            let scale = [1u64 << 8, 1 << 12, 1 << 18, 1 << 23][k % 4];
+            let within = |v: u64, s: u64| (v % (2 * s)) as i64 - s as i64;
+            let (cx, cy) = (within(next(), scale), within(next(), scale));
+            let local = (scale >> 2).max(64);
+            let proj: [Projected; 3] = std::array::from_fn(|_| {
+                let x = (cx + within(next(), local)).clamp(-(1 << 23), 1 << 23);
+                let y = (cy + within(next(), local)).clamp(-(1 << 23), 1 << 23);
+                Projected(x as i32, y as i32, 0.5, 1.0)
+            });
+            let Some(s) = setup_edges(proj, true, 16384, 16384, SampleSpan::of(&[(128, 128)])) else {
+                continue;
+            };
+            let t = &s.tri;
+            let xy = s.order.map(|o| (i64::from(proj[o].0), i64::from(proj[o].1)));
+            let (px, py) = (within(next(), scale), within(next(), scale));
+            for i in 0..3 {
+                for v in [(i + 1) % 3, (i + 2) % 3] {
+                    assert_eq!(t.edge(i, xy[v].0, xy[v].1), 0, "edge {i}, vertex {v}");
+                }
+                // (xb − xa)(Y − ya) − (yb − ya)(X − xa), from vertex j to vertex k.
+                let ((xa, ya), (xb, yb)) = (xy[(i + 1) % 3], xy[(i + 2) % 3]);
+                assert_eq!(t.edges_at(px, py)[i], (xb - xa) * (py - ya) - (yb - ya) * (px - xa));
+            }
+            checked += 1;
+        }
+        assert!(checked > 2_000, "{checked} triangles set up");
     }
 
     /// A triangle's bounding box holds every sample it covers, for each pattern, checked pixel

@@ -108,7 +108,8 @@ fn multi_visible_avx2<'t>(
         let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
         for py in bb[1].max(y0)..bb[3].min(y1) {
             let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
-            let mut row: [f64; 3] = std::array::from_fn(|i| (t.a(i) * cx + t.b(i) * cy + t.c[i]) as f64);
+            let e = t.edges_at(cx, cy);
+            let mut row: [f64; 3] = std::array::from_fn(|i| e[i] as f64);
             let mut base = ((py - y0) as usize * tw + (bx0 - x0) as usize) * ns;
             for _ in bx0..bx1 {
                 for (g, o) in off[..groups].iter().enumerate() {
@@ -185,12 +186,9 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
             (i64::from(x0) + base) << SUBPIXEL_BITS,
             i64::from(first) << SUBPIXEL_BITS,
         );
-        let e: [__m256d; 3] = std::array::from_fn(|i| {
-            _mm256_add_pd(
-                _mm256_set1_pd((t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]) as f64),
-                lane_step[i],
-            )
-        });
+        let e0 = t.edges_at(cx, cy);
+        let e: [__m256d; 3] =
+            std::array::from_fn(|i| _mm256_add_pd(_mm256_set1_pd((e0[i] + o[i]) as f64), lane_step[i]));
         let step_y: [__m256d; 3] = std::array::from_fn(|i| _mm256_set1_pd((t.b(i) << SUBPIXEL_BITS) as f64));
         let at = (first - y0) as usize * tw as usize + base as usize;
         let rows = (first..bb[3].min(y1)).len();
@@ -205,7 +203,8 @@ fn single_visible_avx2(t: &Tri, id: u32, o: [i64; 3], (bx0, bx1): (u32, u32), bu
     for py in bb[1].max(y0)..bb[3].min(y1) {
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
         // e − bias at the row's first pixel, and the exact span of covered pixels.
-        let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
+        let e = t.edges_at(cx, cy);
+        let row = each3(|i| e[i] + o[i]);
         let (lo, hi) = covered_span(row, step, n);
         if lo >= hi {
             continue;

@@ -78,7 +78,10 @@ impl Tiles<'_> {
         let (bx0, by0) = (bb[0].max(x0), bb[1].max(y0));
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(by0) << SUBPIXEL_BITS);
         GouraudTri {
-            start: each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + t.a(i) * ox + t.b(i) * oy - t.bias(i)),
+            start: {
+                let e = t.edges_at(cx + ox, cy + oy);
+                each3(|i| e[i] - t.bias(i))
+            },
             step_x: each3(|i| t.a(i) << SUBPIXEL_BITS),
             step_y: each3(|i| t.b(i) << SUBPIXEL_BITS),
             bias: each3(|i| t.bias(i)),

@@ -647,7 +647,8 @@ impl Tiles<'_> {
     fn weights(t: &Tri, corners: &Corners, px: u32, py: u32) -> [f32; 3] {
         let sx = (i64::from(px) << SUBPIXEL_BITS) + HALF;
         let sy = (i64::from(py) << SUBPIXEL_BITS) + HALF;
-        let e = each3(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area);
+        let (e, k) = (t.edges_at(sx, sy), t.inv_area);
+        let e = each3(|i| e[i] as f64 * k);
         let q = each3(|i| e[i] as f32 * corners.inv_w[i]);
         let sum = q[0] + q[1] + q[2];
         map3(q, |x| x / sum)
@@ -664,7 +665,8 @@ impl Tiles<'_> {
         let step = f64::from(1u32 << SUBPIXEL_BITS) * t.inv_area;
         let inv_w = corners.inv_w.map(f64::from);
         let uv = corners.v.map(|v| set(&v).as_dvec2());
-        let q = each3(|i| (t.a(i) * sx + t.b(i) * sy + t.c[i]) as f64 * t.inv_area * inv_w[i]);
+        let e = t.edges_at(sx, sy);
+        let q = each3(|i| e[i] as f64 * t.inv_area * inv_w[i]);
         let qx = each3(|i| t.a(i) as f64 * step * inv_w[i]);
         let qy = each3(|i| t.b(i) as f64 * step * inv_w[i]);
         let sum = |w: [f64; 3]| uv[0] * w[0] + uv[1] * w[1] + uv[2] * w[2];

@@ -317,7 +317,7 @@ impl Tiles<'_> {
             let (bx0, bx1) = (bb[0].max(x0), bb[2].min(x1));
             for py in bb[1].max(y0)..bb[3].min(y1) {
                 let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
-                let mut row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i]);
+                let mut row = t.edges_at(cx, cy);
                 for px in bx0..bx1 {
                     let base = ((py - y0) as usize * tw + (px - x0) as usize) * ns;
                     for (s, o) in offsets[..ns].iter().enumerate() {
@@ -362,7 +362,7 @@ impl Tiles<'_> {
         let mut zs = [0f32; 16];
         for py in bb[1].max(y0)..bb[3].min(y1) {
             let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
-            let mut row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i]);
+            let mut row = t.edges_at(cx, cy);
             for px in bx0..bx1 {
                 let mut covered = 0u32;
                 for (s, o) in offsets[..ns].iter().enumerate() {
@@ -434,7 +434,8 @@ pub(super) fn visible_single<const IDS: bool, T: TilePixel>(
     for py in bb[1].max(y0)..bb[3].min(y1) {
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
         // e − bias at the row's first pixel.
-        let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
+        let e = t.edges_at(cx, cy);
+        let row = each3(|i| e[i] + o[i]);
         let (lo, hi) = covered_span(row, step, n);
         let line = (py - y0) as usize * tw + (bx0 - x0) as usize;
         let mut eb = each3(|i| row[i] + step[i] * lo);
@@ -490,7 +491,8 @@ pub(super) fn covered_single(
     let n = i64::from(bx1 - bx0);
     for py in bb[1].max(y0)..bb[3].min(y1) {
         let (cx, cy) = (i64::from(bx0) << SUBPIXEL_BITS, i64::from(py) << SUBPIXEL_BITS);
-        let row = each3(|i| t.a(i) * cx + t.b(i) * cy + t.c[i] + o[i]);
+        let e = t.edges_at(cx, cy);
+        let row = each3(|i| e[i] + o[i]);
         let (lo, hi) = covered_span(row, step, n);
         let mut eb = each3(|i| row[i] + step[i] * lo);
         for k in lo..hi {
