@@ -26,7 +26,7 @@ impl Stage<'_> {
         let obj = &self.scene.objects[oi];
         let plan = &self.plan.objects[oi];
         let (isa, clip_from_world) = (self.plan.isa, self.plan.clip_from_world);
-        let two_sided = obj.shading.options.two_sided;
+        let (two_sided, colour) = (obj.shading.options.two_sided, self.plan.colour_planes);
         let mesh = &obj.mesh;
         let (positions, normals) = (mesh.positions(), mesh.normals());
         let vertices = &mut scratch.vertices;
@@ -75,12 +75,7 @@ impl Stage<'_> {
         };
         let setup_chunk = |chunk: &[[u32; 3]]| {
             let mut out = Chunk::reuse(spare, oi, chunk.len());
-            // Room for every triangle, so that a recycled chunk never grows (fresh pages).
-            if self.plan.colour_planes {
-                out.colour.reserve(chunk.len());
-            } else {
-                out.planes.reserve(chunk.len());
-            }
+            out.reserve_planes(colour, chunk.len());
             for &tri in chunk {
                 let v = [
                     vertices[tri[0] as usize],
@@ -170,13 +165,7 @@ impl Stage<'_> {
             // Lit straight into the colour arrays, which keep last frame's values: only the
             // used vertices' colours are read.
             lighting.light_used(positions, normals, used, &mut scratch.colors);
-            gouraud_planes(
-                &mut chunks,
-                vertices,
-                &scratch.colors,
-                textured,
-                self.plan.colour_planes,
-            );
+            gouraud_planes(&mut chunks, vertices, &scratch.colors, textured, colour);
         }
         chunks
     }

@@ -28,8 +28,7 @@ impl Stage<'_> {
         let two_sided = obj.shading.options.two_sided;
         let view = self.plan.objects[oi].view;
         let mesh = &obj.mesh;
-        let gouraud = interpolation == Interpolation::Gouraud;
-        let colour = self.plan.colour_planes;
+        let (gouraud, colour) = (interpolation == Interpolation::Gouraud, self.plan.colour_planes);
         let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
         let colors = mesh.colors();
         let tangents = mesh.tangents();

@@ -175,6 +175,17 @@ impl Chunk {
         }
     }
 
+    /// Room for `n` triangles' planes as the frame keeps them ([`Chunk::push_planes`]), so
+    /// that a recycled chunk does not grow into fresh pages (BENCHMARKS.md, C14).
+    #[inline]
+    pub fn reserve_planes(&mut self, colour: bool, n: usize) {
+        if colour {
+            self.colour.reserve(n);
+        } else {
+            self.planes.reserve(n);
+        }
+    }
+
     /// An empty chunk for `object` with room for `n` triangles, from `spare` if it has one.
     pub fn reuse(spare: &Mutex<Vec<Chunk>>, object: usize, n: usize) -> Chunk {
         let mut c = spare.lock().ok().and_then(|mut s| s.pop()).unwrap_or_default();
@@ -511,7 +522,7 @@ mod tests {
     /// at a random point, the cross product of edge `i` with the point taken from the input
     /// vertices, for random triangles of every size and place, front and back.
     #[test]
-    fn edge_constants_put_each_edge_through_its_vertices() {
+    fn edge_functions_put_each_edge_through_its_vertices() {
         let mut next = xorshift(0x5eed_c0de);
         let mut checked = 0;
         for k in 0..20_000 {
