@@ -68,6 +68,22 @@ pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
     (p2 - p1).cross(p3 - p1).normalize_or_zero()
 }
 
+/// A per-vertex attribute given to each corner of `triangles` in turn (three vertices a
+/// triangle); empty for an empty one. Each array sized once and written triangle by
+/// triangle, no growth check per vertex (a large glTF without normals takes this path).
+fn per_corner<T: Copy + Default>(from: &[T], triangles: &[[u32; 3]]) -> Vec<T> {
+    if from.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![T::default(); 3 * triangles.len()];
+    for (o, t) in out.chunks_exact_mut(3).zip(triangles) {
+        o[0] = from[t[0] as usize];
+        o[1] = from[t[1] as usize];
+        o[2] = from[t[2] as usize];
+    }
+    out
+}
+
 impl Mesh {
     /// A mesh from positions, per-vertex normals (same length) and triangles;
     /// every index must be in range and every position finite.
@@ -368,20 +384,6 @@ impl Mesh {
 
     /// Flat normals: every triangle gets its own three vertices carrying its facet normal.
     pub fn with_flat_normals(&self) -> Mesh {
-        // Each array sized once and written triangle by triangle, no growth check per
-        // vertex (a large glTF without normals takes this path).
-        fn per_corner<T: Copy + Default>(from: &[T], triangles: &[[u32; 3]]) -> Vec<T> {
-            if from.is_empty() {
-                return Vec::new();
-            }
-            let mut out = vec![T::default(); 3 * triangles.len()];
-            for (o, t) in out.chunks_exact_mut(3).zip(triangles) {
-                o[0] = from[t[0] as usize];
-                o[1] = from[t[1] as usize];
-                o[2] = from[t[2] as usize];
-            }
-            out
-        }
         let positions = per_corner(&self.positions, &self.triangles);
         let mut normals = vec![Vec3::ZERO; positions.len()];
         for (n, c) in normals.chunks_exact_mut(3).zip(positions.chunks_exact(3)) {
@@ -392,6 +394,39 @@ impl Mesh {
             normals,
             triangles: (0..self.triangles.len() as u32)
                 .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            uvs: per_corner(&self.uvs, &self.triangles),
+            uvs1: per_corner(&self.uvs1, &self.triangles),
+            colors: per_corner(&self.colors, &self.triangles),
+            tangents: Vec::new(),
+        }
+    }
+
+    /// `self.with_flat_normals().into_transformed(m)`, bit for bit, in one pass: each
+    /// position transformed once (not once a corner) and each facet normal once a triangle
+    /// (not once a corner), the three-vertices-a-triangle arrays written once. For a model
+    /// without normals (a glTF's flat ones) placed in the scene.
+    pub fn flat_transformed(&self, m: &Mat4) -> Mesh {
+        let nm = Mat3::from_mat4(*m).inverse().transpose();
+        let flip = Mat3::from_mat4(*m).determinant() < 0.0;
+        let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
+        let count = 3 * self.triangles.len();
+        let mut positions = vec![Vec3::ZERO; count];
+        let mut normals = vec![Vec3::ZERO; count];
+        let corners = positions.chunks_exact_mut(3).zip(normals.chunks_exact_mut(3));
+        for ((p, n), t) in corners.zip(&self.triangles) {
+            let [a, b, c] = t.map(|i| i as usize);
+            let facet = facet_normal(self.positions[a], self.positions[b], self.positions[c]);
+            n.fill((nm * facet).normalize_or_zero());
+            p.copy_from_slice(&[moved[a], moved[b], moved[c]]);
+        }
+        // A mirror reverses each triangle, as `into_transformed` does.
+        let (second, third) = if flip { (2, 1) } else { (1, 2) };
+        Mesh {
+            positions,
+            normals,
+            triangles: (0..self.triangles.len() as u32)
+                .map(|t| [3 * t, 3 * t + second, 3 * t + third])
                 .collect(),
             uvs: per_corner(&self.uvs, &self.triangles),
             uvs1: per_corner(&self.uvs1, &self.triangles),
@@ -583,6 +618,47 @@ mod tests {
             }
         }
         assert!(m.colors().is_empty() && m.tangents().is_empty());
+    }
+
+    /// The one-pass flat placement gives the two-step one's bits: positions, normals,
+    /// triangles (a mirror reversing them), texture coordinates and colours, for a rotation
+    /// with a non-uniform scale and a move, a mirror, and the identity.
+    #[test]
+    fn flat_transformed_is_flat_then_transformed() {
+        let base = folded();
+        let n = base.positions().len();
+        let uvs: Vec<Vec2> = (0..n).map(|i| Vec2::new(i as f32 * 0.3, 0.7)).collect();
+        let colors: Vec<Color> = (0..n).map(|i| Color::new(0.1 * i as f32, 0.5, 1.0)).collect();
+        // A degenerate triangle too (its normal zero either way).
+        let mut p = base.positions().to_vec();
+        p.push(Vec3::new(2.0, 2.0, 2.0));
+        let mut t = base.triangles().to_vec();
+        t.push([0, 5, 5]);
+        let shapes = [
+            Mesh::from_triangles(p, t).unwrap(),
+            base.clone().with_uvs(uvs).unwrap().with_colors(colors).unwrap(),
+        ];
+        let moves = [
+            Mat4::IDENTITY,
+            Mat4::from_scale_rotation_translation(
+                Vec3::new(2.0, 0.5, 1.3),
+                glam::Quat::from_euler(glam::EulerRot::ZYX, 0.3, -1.1, 0.7),
+                Vec3::new(-4.0, 1.5, 1e3),
+            ),
+            Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
+        ];
+        let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        for mesh in &shapes {
+            for m in &moves {
+                let (a, b) = (mesh.flat_transformed(m), mesh.with_flat_normals().into_transformed(m));
+                assert_eq!(bits(a.positions()), bits(b.positions()));
+                assert_eq!(bits(a.normals()), bits(b.normals()));
+                assert_eq!(a.triangles(), b.triangles());
+                assert_eq!(a.uvs(), b.uvs());
+                assert_eq!(a.colors(), b.colors());
+                assert!(a.tangents().is_empty() && a.uvs1().is_empty());
+            }
+        }
     }
 
     #[test]

@@ -214,11 +214,16 @@ fn computed_normals(p: &ModelPart) -> &'static str {
 /// A part's mesh as its object draws it: fitted to `fit_frame` (centre and radius, where the
 /// object has `fit`) and given the normals of `choice` (`crease` degrees for `"angle"`).
 pub(crate) fn drawn_mesh(
-    mut mesh: Mesh,
+    mesh: Mesh,
     fit_frame: Option<(glam::DVec3, f64)>,
     choice: &str,
     crease: f32,
 ) -> Result<Mesh, phong_core::Error> {
+    Ok(with_normals(fitted(mesh, fit_frame)?, choice, crease))
+}
+
+/// `mesh` fitted to `fit_frame` (centre and radius), where given.
+fn fitted(mut mesh: Mesh, fit_frame: Option<(glam::DVec3, f64)>) -> Result<Mesh, phong_core::Error> {
     if let Some((centre, radius)) = fit_frame {
         // In f64 (coordinates near f32's largest, a radius whose inverse is below its
         // smallest normal number). A uniform scale and a move: the file's normals keep
@@ -231,7 +236,7 @@ pub(crate) fn drawn_mesh(
             .collect();
         mesh = mesh.with_positions(positions)?;
     }
-    Ok(with_normals(mesh, choice, crease))
+    Ok(mesh)
 }
 
 /// `mesh` with the normals of `choice` (`"flat"`, `"smooth"`, `"angle"` at `crease` degrees;
@@ -333,18 +338,28 @@ fn mesh_objects(
             Some(a) => a,
             None => default_normals(&p),
         };
+        let model_error = |e: phong_core::Error| Error::Model {
+            path: ctx.path.to_path_buf(),
+            message: format!("{}: {e}", p.name),
+        };
+        // Flat normals are made with the placement below (one pass), unless tangents need
+        // them first.
+        let mut flat = false;
         let mesh = match p.drawn.take() {
             // Computed beside the model-alone scene's framing by this same function, for the
             // choice and crease it would be given here.
             Some(drawn) if fit && asked.is_none() && o.crease.is_none() => drawn,
-            _ => drawn_mesh(std::mem::take(&mut p.mesh), fit_frame, choice, crease).map_err(|e| Error::Model {
-                path: ctx.path.to_path_buf(),
-                message: format!("{}: {e}", p.name),
-            })?,
+            _ if choice == "flat" => {
+                flat = true;
+                fitted(std::mem::take(&mut p.mesh), fit_frame).map_err(model_error)?
+            }
+            _ => drawn_mesh(std::mem::take(&mut p.mesh), fit_frame, choice, crease).map_err(model_error)?,
         };
         // The scene's material replaces the file's, maps and all.
         let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));
-        let maps = if !maps.is_empty() && !mesh.has_uvs() {
+        // (Flat normals give each triangle's corners their coordinates: none without triangles.)
+        let has_uvs = mesh.has_uvs() && !(flat && mesh.triangles().is_empty());
+        let maps = if !maps.is_empty() && !has_uvs {
             warnings.push(format!(
                 "{}: its material has texture maps but the model has no texture coordinates: maps not used",
                 p.name
@@ -356,10 +371,15 @@ fn mesh_objects(
         } else {
             maps
         };
-        let mesh = tangents_for(mesh, &maps);
+        let mesh = if flat && maps.normal.is_none() {
+            crate::timing::timed(|t| &mut t.normals, || mesh.flat_transformed(&world_from_file))
+        } else {
+            let mesh = if flat { with_normals(mesh, "flat", crease) } else { mesh };
+            tangents_for(mesh, &maps).into_transformed(&world_from_file)
+        };
         out.push(Object {
             name: p.name,
-            mesh: mesh.into_transformed(&world_from_file),
+            mesh,
             material,
             shading,
             maps,
