@@ -342,11 +342,39 @@ impl Mesh {
     /// Axis-aligned bounds `(min, max)`, `None` for an empty mesh.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.positions.first()?;
-        Some(
-            self.positions
-                .iter()
-                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
-        )
+        let fold = |(lo, hi): (Vec3, Vec3), p: &Vec3| (lo.min(*p), hi.max(*p));
+        let ordered = || self.positions.iter().fold((first, first), fold);
+        if first.is_nan() {
+            return Some(ordered());
+        }
+        // Four vertices at a time in 4-lane vectors: the same bounds in another order of
+        // comparisons (about a tenth of the instructions), except where a bound is zero (the
+        // sign of that zero may depend on the order) or a coordinate NaN (which the ordered
+        // fold lets through): the ordered fold gives those.
+        let blocks = self.positions.chunks_exact(4);
+        let rest = blocks.remainder();
+        let start: [f32; 12] = bytemuck::cast([first; 4]);
+        let (mut lo, mut hi) = (start, start);
+        let mut nan = [false; 12];
+        for block in blocks {
+            let v: &[f32; 12] = bytemuck::cast_ref(<&[Vec3; 4]>::try_from(block).expect("4 vertices"));
+            for i in 0..12 {
+                lo[i] = if v[i] < lo[i] { v[i] } else { lo[i] };
+                hi[i] = if v[i] > hi[i] { v[i] } else { hi[i] };
+                nan[i] |= v[i].is_nan();
+            }
+        }
+        // Lane i holds coordinate i % 3.
+        let (mut l, mut h) = rest.iter().fold((first, first), fold);
+        for i in 0..12 {
+            l[i % 3] = l[i % 3].min(lo[i]);
+            h[i % 3] = h[i % 3].max(hi[i]);
+        }
+        let exact = !(nan.contains(&true) || rest.iter().any(|p| p.is_nan()));
+        if !exact || l.cmpeq(Vec3::ZERO).any() || h.cmpeq(Vec3::ZERO).any() {
+            return Some(ordered());
+        }
+        Some((l, h))
     }
 
     /// The mesh in another space: positions by `m`, normals by the inverse
@@ -621,6 +649,41 @@ mod tests {
     }
 
     /// The one-pass flat placement gives the two-step one's bits: positions, normals,
+    /// The blocked bounds are the vertex-by-vertex fold's, bit for bit: meshes of 1 to 40
+    /// vertices (every remainder of the blocks) from a small set of values, zeros of both signs
+    /// among them, and meshes whose first vertex or others have a NaN or an infinity.
+    #[test]
+    fn bounds_are_the_ordered_folds() {
+        let values = [-0.0f32, 0.0, 1.5, -2.25, 3.0e7, -1e-30, 7.0, f32::MAX, -f32::MAX];
+        let mut seed = 0x2545_f491_u32;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            values[seed as usize % values.len()]
+        };
+        let fold = |p: &[Vec3]| p.iter().fold((p[0], p[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let bits = |(a, b): (Vec3, Vec3)| (a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits));
+        let mesh = |positions: Vec<Vec3>| Mesh {
+            normals: vec![Vec3::ZERO; positions.len()],
+            positions,
+            ..Mesh::default()
+        };
+        for round in 0..400 {
+            let n = 1 + round % 40;
+            let mut p: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next())).collect();
+            if round % 7 == 0 {
+                p[round % n].y = f32::NAN;
+            }
+            if round % 11 == 0 {
+                p[(round / 11) % n].z = f32::INFINITY;
+            }
+            let want = fold(&p);
+            assert_eq!(bits(mesh(p.clone()).bounds().unwrap()), bits(want), "{p:?}");
+        }
+        assert_eq!(Mesh::default().bounds(), None);
+    }
+
     /// triangles (a mirror reversing them), texture coordinates and colours, for a rotation
     /// with a non-uniform scale and a move, a mirror, and the identity.
     #[test]

@@ -122,8 +122,8 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     // The framing (its closedness check) and the parts as drawn (their normals) do not depend
     // on each other and take milliseconds each for a large model: side by side. What the scene
     // reader would compute for the model-alone scene's object, by its own function.
-    let fit = fit_of(&model.parts);
     let draw = |parts: &[ModelPart]| -> Vec<Option<Mesh>> {
+        let fit = fit_of(parts);
         parts
             .iter()
             .map(|p| drawn_mesh(p.mesh.clone(), fit, default_normals(p), DEFAULT_CREASE).ok())

@@ -217,9 +217,10 @@ fn ply_triangles_of_int_indices() {
     let _ = std::fs::remove_dir_all(d);
 }
 
-/// The common binary layout read without the general reader's dispatch: float x, y, z among
-/// other scalar properties (a `uchar` between y and z, a `double` after), faces all triangles.
-/// In both byte orders and both index types, the corners are the ones written; a negative
+/// The common binary layout read without the general reader's dispatch: float x, y, z alone
+/// (the bytes copied whole where little-endian) or among other scalar properties (a `uchar`
+/// between y and z, a `double` after), faces all triangles. In both byte orders and both index
+/// types, the corners are the ones written; a negative
 /// index, an index past the vertices, a position not finite, bytes after the faces and a file
 /// that ends early are read or refused as the general reader reads or refuses them.
 #[test]
@@ -230,11 +231,16 @@ fn ply_plain_binary_triangles() {
         .iter()
         .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
         .collect();
-    let file = |big: bool, index: &str, bad: Option<(usize, u32)>, nan: bool| {
+    let file = |(big, extras): (bool, bool), index: &str, bad: Option<(usize, u32)>, nan: bool| {
         let order = ply_order(big);
+        let (flags, quality) = if extras {
+            ("property uchar flags\n", "property double quality\n")
+        } else {
+            ("", "")
+        };
         let mut b = format!(
             "ply\nformat {order} 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
-             property uchar flags\nproperty float z\nproperty double quality\nelement face {}\n\
+             {flags}property float z\n{quality}element face {}\n\
              property list uchar {index} vertex_indices\nend_header\n",
             faces.len()
         )
@@ -244,13 +250,17 @@ fn ply_plain_binary_triangles() {
             let f = |x: f32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
             b.extend(f(v[0]));
             b.extend(f(v[1]));
-            b.push(7);
+            if extras {
+                b.push(7);
+            }
             b.extend(f(v[2]));
-            b.extend(if big {
-                0.5f64.to_be_bytes()
-            } else {
-                0.5f64.to_le_bytes()
-            });
+            if extras {
+                b.extend(if big {
+                    0.5f64.to_be_bytes()
+                } else {
+                    0.5f64.to_le_bytes()
+                });
+            }
         }
         for (k, f) in faces.iter().enumerate() {
             b.push(3);
@@ -269,8 +279,9 @@ fn ply_plain_binary_triangles() {
         load_model(&p, &mut Vec::new()).map(|parts| corners(&parts[0].mesh))
     };
     for big in [false, true] {
-        for index in ["int", "uint"] {
-            let name = format!("{big}-{index}.ply");
+        for (extras, index) in [(true, "int"), (true, "uint"), (false, "int"), (false, "uint")] {
+            let big = (big, extras);
+            let name = format!("{big:?}-{index}.ply");
             assert_eq!(read(&name, &file(big, index, None, false)).unwrap(), want, "{name}");
             let mut longer = file(big, index, None, false);
             longer.extend(b"\n\n");

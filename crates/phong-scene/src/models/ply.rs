@@ -767,21 +767,29 @@ fn plain_binary(h: &Header, bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> 
             u32::from_le_bytes(a)
         }
     };
-    let positions: Vec<Vec3> = body[..vertex_bytes]
-        .chunks_exact(stride)
-        .map(|row| Vec3::from_array(offsets.map(|o| f32::from_bits(word(row, o)))))
-        .collect();
+    let positions: Vec<Vec3> = if !big && stride == 12 && offsets == [0, 4, 8] {
+        // Little-endian x, y, z alone: the bytes are the vertex array (a copy, as the file's
+        // bytes need not be aligned).
+        bytemuck::pod_collect_to_vec(&body[..vertex_bytes])
+    } else {
+        body[..vertex_bytes]
+            .chunks_exact(stride)
+            .map(|row| Vec3::from_array(offsets.map(|o| f32::from_bits(word(row, o)))))
+            .collect()
+    };
     if !positions.iter().all(|p| p.is_finite()) {
         return None;
     }
-    let mut ok = true;
+    // Every face checked without a branch: its count 3, its largest index below `n`.
+    let (mut counts_ok, mut largest) = (true, 0u32);
     let triangles: Vec<[u32; 3]> = body[vertex_bytes..]
         .chunks_exact(13)
         .map(|face| {
             let tri = [1, 5, 9].map(|o| word(face, o));
-            ok &= face[0] == 3 && tri.iter().all(|&i| (i as usize) < n);
+            counts_ok &= face[0] == 3;
+            largest = largest.max(tri[0]).max(tri[1]).max(tri[2]);
             tri
         })
         .collect();
-    ok.then_some((positions, triangles))
+    (counts_ok && (triangles.is_empty() || (largest as usize) < n)).then_some((positions, triangles))
 }
