@@ -258,15 +258,16 @@ fn facets_of(positions: &[Vec3], tris: &[[u32; 3]], sums: bool) -> Facets {
 #[inline(always)]
 fn facets_summed<const SUMS: bool>(positions: &[Vec3], tris: &[[u32; 3]]) -> Facets {
     let n = positions.len();
-    let mut facet = Vec::with_capacity(tris.len());
-    let mut unit = Vec::with_capacity(tris.len());
+    // (Sized at once and written in place: a push per face checked its room.)
+    let mut facet = vec![Vec3::ZERO; tris.len()];
+    let mut unit = vec![Vec3::ZERO; tris.len()];
     let mut sum = vec![Vec3::ZERO; if SUMS { n } else { 0 }];
     let mut count = vec![0u32; n];
-    for t in tris {
+    for ((t, f_out), u_out) in tris.iter().zip(&mut facet).zip(&mut unit) {
         let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
         let f = (b - a).cross(c - a);
-        facet.push(f);
-        unit.push(f.normalize_or_zero());
+        *f_out = f;
+        *u_out = f.normalize_or_zero();
         for &v in t {
             count[v as usize] += 1;
             if SUMS {
