@@ -33,8 +33,14 @@ pub(crate) enum Mode {
     /// (`shade_batch_lit`) and the maps sampled per pixel from the planes of its texture
     /// coordinates. With `per_vertex` (Gouraud and flat, always with the vector sampler), the
     /// vertices (flat: the triangle) are lit into primary and specular colours, which the
-    /// triangle's planes carry instead of position and normal.
-    Textured { prep: Prepared, per_vertex: bool },
+    /// triangle's planes carry instead of position and normal. `lean`: the lean kernel's
+    /// data where it lights the object's pixels (per pixel, no map that changes the light or
+    /// needs the light's terms apart).
+    Textured {
+        prep: Prepared,
+        per_vertex: bool,
+        lean: Option<Lean>,
+    },
     /// One pixel at a time, as the reference path (textured objects the vector kernels do not
     /// cover, normal and depth outputs, blended objects).
     Scalar,
@@ -215,14 +221,19 @@ fn mode(
         || (second_set && colors)
         || (m.normal.is_some() && (second_set || colors));
     match object.shading.interpolation {
-        Interpolation::Phong if !per_pixel_light => Mode::Textured {
-            prep: if split {
+        Interpolation::Phong if !per_pixel_light => {
+            let prep = if split {
                 prepared().emission_apart(lighting, &object.material)
             } else {
                 prepared()
-            },
-            per_vertex: false,
-        },
+            };
+            let lean = if split || changes_light { None } else { Lean::of(&prep) };
+            Mode::Textured {
+                prep,
+                per_vertex: false,
+                lean,
+            }
+        }
         // Gouraud and flat: only the diffuse and specular maps apply, by the sampler
         // (`VectorMaps::lit_per_vertex`); the second set takes the colours' planes.
         Interpolation::Gouraud | Interpolation::Flat
@@ -231,6 +242,7 @@ fn mode(
             Mode::Textured {
                 prep: prepared(),
                 per_vertex: true,
+                lean: None,
             }
         }
         _ => Mode::Scalar,

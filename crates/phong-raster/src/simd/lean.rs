@@ -160,11 +160,75 @@ fn ld3<V: Vf32>(s: &[Splat; 3]) -> V3<V> {
 /// 8-bit encoding, which does both). One variant of the code per highlight model and gate.
 #[inline(always)]
 pub(super) fn shade_color_lean<V: Vf32, const RAW: bool>(p: &Prepared, lean: &Lean, pos: V3<V>, nrm: V3<V>) -> [V; 3] {
+    let base = [ld(&lean.base[0]), ld(&lean.base[1]), ld(&lean.base[2])];
     match (lean.blinn, lean.gate) {
-        (true, true) => lean_variant::<V, RAW, true, true>(p, lean, pos, nrm),
-        (true, false) => lean_variant::<V, RAW, true, false>(p, lean, pos, nrm),
-        (false, true) => lean_variant::<V, RAW, false, true>(p, lean, pos, nrm),
-        (false, false) => lean_variant::<V, RAW, false, false>(p, lean, pos, nrm),
+        (true, true) => lean_variant::<V, _, RAW, true, true>(p, lean, pos, nrm, base),
+        (true, false) => lean_variant::<V, _, RAW, true, false>(p, lean, pos, nrm, base),
+        (false, true) => lean_variant::<V, _, RAW, false, true>(p, lean, pos, nrm, base),
+        (false, false) => lean_variant::<V, _, RAW, false, false>(p, lean, pos, nrm, base),
+    }
+}
+
+/// The light of `shade` before a texture modulates it, `[primary, specular]` as
+/// `phong_core::light` gives them where the emission is not apart (primary: emission, ambient
+/// and diffuse), each clamped where the options clamp: [`shade_color_lean`]'s two sums kept
+/// apart. For the textured kernels' common form (diffuse and specular maps).
+#[inline(always)]
+pub(super) fn lit_lean<V: Vf32>(p: &Prepared, lean: &Lean, pos: V3<V>, nrm: V3<V>) -> [[V; 3]; 2] {
+    let zero = V::splat(0.0);
+    let two = [[ld(&lean.base[0]), ld(&lean.base[1]), ld(&lean.base[2])], [zero; 3]];
+    match (lean.blinn, lean.gate) {
+        (true, true) => lean_variant::<V, _, false, true, true>(p, lean, pos, nrm, two),
+        (true, false) => lean_variant::<V, _, false, true, false>(p, lean, pos, nrm, two),
+        (false, true) => lean_variant::<V, _, false, false, true>(p, lean, pos, nrm, two),
+        (false, false) => lean_variant::<V, _, false, false, false>(p, lean, pos, nrm, two),
+    }
+}
+
+/// Where the lean kernel adds a light's terms: one colour (`[V; 3]`: every term in it), or
+/// two (`[[V; 3]; 2]`: the highlights in the second).
+trait Sums<V: Vf32> {
+    /// The colour the ambient and diffuse terms go to.
+    fn lit(&mut self) -> &mut [V; 3];
+    /// The colour the highlights go to.
+    fn highlight(&mut self) -> &mut [V; 3];
+    /// NaN to 0 and, where `clamp`, each channel into `[0, 1]`.
+    fn finish(&mut self, clamp: bool);
+}
+
+impl<V: Vf32> Sums<V> for [V; 3] {
+    #[inline(always)]
+    fn lit(&mut self) -> &mut [V; 3] {
+        self
+    }
+    #[inline(always)]
+    fn highlight(&mut self) -> &mut [V; 3] {
+        self
+    }
+    #[inline(always)]
+    fn finish(&mut self, clamp: bool) {
+        for c in self {
+            *c = fin(*c);
+            if clamp {
+                *c = c.max(V::splat(0.0)).min(V::splat(1.0));
+            }
+        }
+    }
+}
+
+impl<V: Vf32> Sums<V> for [[V; 3]; 2] {
+    #[inline(always)]
+    fn lit(&mut self) -> &mut [V; 3] {
+        &mut self[0]
+    }
+    #[inline(always)]
+    fn highlight(&mut self) -> &mut [V; 3] {
+        &mut self[1]
+    }
+    #[inline(always)]
+    fn finish(&mut self, clamp: bool) {
+        self[0].finish(clamp);
+        self[1].finish(clamp);
     }
 }
 
@@ -180,7 +244,7 @@ struct Point<V> {
 }
 
 /// [`shade_color_lean`] for Blinn-Phong (`BLINN`) or Phong, the highlight gated by `N·L > 0`
-/// where `GATE`.
+/// where `GATE`, added to `sums` (which start with the emission and global ambient).
 ///
 /// The highlight's vectors come from dot products the diffuse term has already taken: with
 /// `D` the vector to a point light and `r = 1/|D|`, `N·L = r·(N·D)`; Blinn-Phong's
@@ -191,12 +255,13 @@ struct Point<V> {
 /// `normalize_or_zero`, for the finite vectors interpolation gives; the squared length is
 /// raised to `f32::MIN_POSITIVE` before its inverse square root, so a zero vector stays zero).
 #[inline(always)]
-fn lean_variant<V: Vf32, const RAW: bool, const BLINN: bool, const GATE: bool>(
+fn lean_variant<V: Vf32, S: Sums<V>, const RAW: bool, const BLINN: bool, const GATE: bool>(
     p: &Prepared,
     lean: &Lean,
     pos: V3<V>,
     nrm: V3<V>,
-) -> [V; 3] {
+    mut sums: S,
+) -> S {
     let zero = V::splat(0.0);
     let tiny = V::splat(f32::MIN_POSITIVE);
     let (v, v_ok) = match p.view {
@@ -234,38 +299,32 @@ fn lean_variant<V: Vf32, const RAW: bool, const BLINN: bool, const GATE: bool>(
         (v_spec, nv.add(nv))
     };
     let at = Point { pos, n, v, v_spec, nv };
-    let mut col = [ld(&lean.base[0]), ld(&lean.base[1]), ld(&lean.base[2])];
     // (Functions and loops, no closures: a closure is not always inlined into the AVX2
     // builds, and its intrinsics then become calls: BENCHMARKS.md, C11.)
     let s = p.shininess;
     for light in &lean.lights[..lean.plain] {
-        light_term::<V, BLINN, GATE, true, true>(light, &at, s, &mut col);
+        light_term::<V, S, BLINN, GATE, true, true>(light, &at, s, &mut sums);
     }
     for light in &lean.lights[lean.plain..lean.directional] {
-        light_term::<V, BLINN, GATE, true, false>(light, &at, s, &mut col);
+        light_term::<V, S, BLINN, GATE, true, false>(light, &at, s, &mut sums);
     }
     for light in &lean.lights[lean.directional..] {
-        light_term::<V, BLINN, GATE, false, false>(light, &at, s, &mut col);
+        light_term::<V, S, BLINN, GATE, false, false>(light, &at, s, &mut sums);
     }
     if !RAW {
-        for c in &mut col {
-            *c = fin(*c);
-            if p.options.clamp {
-                *c = c.max(zero).min(V::splat(1.0));
-            }
-        }
+        sums.finish(p.options.clamp);
     }
-    col
+    sums
 }
 
-/// Adds one light's terms at `at` to `col`: a point light (`POINT`) whose factor is not 1
+/// Adds one light's terms at `at` to `sums`: a point light (`POINT`) whose factor is not 1
 /// (`ATTENUATED`), or a directional light.
 #[inline(always)]
-fn light_term<V: Vf32, const BLINN: bool, const GATE: bool, const POINT: bool, const ATTENUATED: bool>(
+fn light_term<V: Vf32, S: Sums<V>, const BLINN: bool, const GATE: bool, const POINT: bool, const ATTENUATED: bool>(
     light: &LeanLight,
     at: &Point<V>,
     shininess: f32,
-    col: &mut [V; 3],
+    sums: &mut S,
 ) {
     let zero = V::splat(0.0);
     let tiny = V::splat(f32::MIN_POSITIVE);
@@ -302,9 +361,9 @@ fn light_term<V: Vf32, const BLINN: bool, const GATE: bool, const POINT: bool, c
         }
     };
     if light.ambient {
-        add(col, &light.amb, factor);
+        add(sums.lit(), &light.amb, factor);
     }
-    add(col, &light.dif, factor.mul(ndotl.max(zero)));
+    add(sums.lit(), &light.dif, factor.mul(ndotl.max(zero)));
     if light.dark {
         return;
     }
@@ -319,7 +378,7 @@ fn light_term<V: Vf32, const BLINN: bool, const GATE: bool, const POINT: bool, c
     if !V::any(x.ge(ld(&light.threshold))) {
         return;
     }
-    add(col, &light.spe, factor.mul(pow_lean(x, shininess)));
+    add(sums.highlight(), &light.spe, factor.mul(pow_lean(x, shininess)));
 }
 
 /// `log2(1 + u)/u` on `[√½ − 1, √2 − 1)`, degree 5, fitted for relative error (7.5e-6

@@ -189,7 +189,7 @@ pub fn shade_batch_lit<'p>(
 
 avx2_and_wide! {
     fn shade_batch_textured_avx2 / shade_batch_textured_wide ['p, const FULL: bool, const PER_VERTEX: bool] (
-        prep: &Prepared,
+        prep: (&Prepared, Option<&Lean>),
         maps: &VectorMaps,
         n: usize,
         lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
@@ -203,11 +203,12 @@ avx2_and_wide! {
 /// Interpolates, lights and textures `n` pixels of an object whose maps the vector sampler
 /// covers ([`VectorMaps`]): `lane(i)` gives pixel `i`'s centre, its triangle's planes and its
 /// texture coordinates' planes; `out(i, rgb)` takes its colour, or `unsampled` its light where
-/// the maps must be sampled per pixel ([`Unsampled`]).
+/// the maps must be sampled per pixel ([`Unsampled`]). The light by the lean kernel where
+/// `prep` comes with its data.
 #[inline]
 pub fn shade_batch_textured<'p>(
     isa: Isa,
-    prep: &Prepared,
+    prep: (&Prepared, Option<&Lean>),
     maps: &VectorMaps,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
@@ -246,7 +247,7 @@ pub fn shade_batch_textured<'p>(
 
 avx2_and_wide! {
     fn shade_group_textured_avx2 / shade_group_textured_wide [const FULL: bool, const PER_VERTEX: bool] (
-        prep: &Prepared,
+        prep: (&Prepared, Option<&Lean>),
         maps: &VectorMaps,
         planes: (&Planes, &Planes),
         origin: (u32, u32),
@@ -266,7 +267,7 @@ avx2_and_wide! {
 #[inline]
 pub fn shade_group_textured(
     isa: Isa,
-    (prep, maps): (&Prepared, &VectorMaps),
+    (prep, maps): ((&Prepared, Option<&Lean>), &VectorMaps),
     planes: (&Planes, &Planes),
     origin: (u32, u32),
     pixels: &[u32],

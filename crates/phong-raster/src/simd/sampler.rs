@@ -18,6 +18,7 @@ use super::kernel::{
     Broadcast, MAX_LANES, Planes, Prepared, V3, centres, coefficients, interpolate, perturb, position_normal,
     shade_shininess,
 };
+use super::lean::Lean;
 use super::vector::{Portable, Vf32};
 use phong_core::{Channel, Maps, MetalRough, NormalMap, TextureMap, UvTransform};
 
@@ -249,7 +250,7 @@ pub(crate) trait Sampling: Vf32 {
     fn bilinear(map: &VectorMap, level: Option<Self>, u: Self, v: Self) -> [Self; 3];
     /// [`textured_lanes`].
     fn textured<const FULL: bool, const PER_VERTEX: bool>(
-        prep: &Prepared,
+        prep: (&Prepared, Option<&Lean>),
         maps: &VectorMaps,
         q: [Self; 6],
         at: (Self, Self, Self),
@@ -267,7 +268,7 @@ macro_rules! sampling {
             }
             #[$inline]
             fn textured<const FULL: bool, const PER_VERTEX: bool>(
-                prep: &Prepared,
+                prep: (&Prepared, Option<&Lean>),
                 maps: &VectorMaps,
                 q: [Self; 6],
                 at: (Self, Self, Self),
@@ -451,7 +452,7 @@ pub type Unsampled<I> = (I, [[f32; 3]; 3]);
 /// cannot wrap the coordinates exactly.
 #[inline(always)]
 fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
-    prep: &Prepared,
+    (prep, lean): (&Prepared, Option<&Lean>),
     maps: &VectorMaps,
     q: [V; 6],
     at: (V, V, V),
@@ -474,12 +475,23 @@ fn textured_lanes<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
         (nrm, None, None)
     };
     let texels = colour_texels::<V, FULL>(maps, uv, uv1);
-    let lit = if PER_VERTEX {
-        None
-    } else {
-        Some(shade_shininess(prep, pos, nrm, sv))
+    let (primary, specular, ambient) = match lean {
+        // The common form lit by the lean kernel (no term kept apart, no map that changes
+        // the light: `Mode::Textured`), its primary and specular colours as
+        // `lit_colours` makes them.
+        Some(lean) if !PER_VERTEX && !FULL => {
+            let [primary, specular] = super::lean::lit_lean(prep, lean, pos, nrm);
+            (primary, specular, [zero; 3])
+        }
+        _ => {
+            let lit = if PER_VERTEX {
+                None
+            } else {
+                Some(shade_shininess(prep, pos, nrm, sv))
+            };
+            lit_colours::<V, FULL>(prep, maps, q, lit)
+        }
     };
-    let (primary, specular, ambient) = lit_colours::<V, FULL>(prep, maps, q, lit);
     let Texels { td, ts, ta, te, ao } = texels;
     let unwrapped = matches!(td, Some(None)) || matches!(ts, Some(None));
     if unwrapped || matches!(ta, Some(None)) || matches!(te, Some(None)) || matches!(ao, Some(None)) {
@@ -735,7 +747,7 @@ fn emit<V: Vf32, I>(
 /// coordinates.
 #[inline(always)]
 pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
-    prep: &Prepared,
+    prep: (&Prepared, Option<&Lean>),
     maps: &VectorMaps,
     n: usize,
     lane: impl Fn(usize) -> (f32, f32, &'p Planes, &'p Planes),
@@ -774,7 +786,7 @@ pub(crate) fn shade_batch_textured<'p, V: Sampling, const FULL: bool, const PER_
 /// Whole vectors only: returns how many of `pixels` (from the start) were shaded.
 #[inline(always)]
 pub(crate) fn shade_group_textured<V: Sampling, const FULL: bool, const PER_VERTEX: bool>(
-    prep: &Prepared,
+    prep: (&Prepared, Option<&Lean>),
     maps: &VectorMaps,
     (planes, uv): (&Planes, &Planes),
     origin: (u32, u32),

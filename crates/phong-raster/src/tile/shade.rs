@@ -177,13 +177,13 @@ impl Tiles<'_> {
                 continue;
             }
             let object = self.binned.object(id);
-            if let Mode::Textured { prep, .. } = &self.plan.objects[object].mode {
+            if let Mode::Textured { prep, lean, .. } = &self.plan.objects[object].mode {
                 // Whole vectors of one triangle with its planes broadcast where the vector
                 // sampler covers the maps; the rest batched with the object's other pixels.
                 let done = match &self.plan.objects[object].maps {
                     Some(maps) if pixels.len() >= group => shade_group_textured(
                         self.plan.isa,
-                        (prep, maps),
+                        ((prep, lean.as_ref()), maps),
                         (self.binned.planes(id), self.binned.uv_planes(id)),
                         (x0, y0),
                         pixels,
@@ -393,10 +393,14 @@ impl Tiles<'_> {
     ) {
         let tinted = !self.scene.objects[object].mesh.colors().is_empty();
         if let Some(maps) = &self.plan.objects[object].maps {
+            let lean = match &self.plan.objects[object].mode {
+                Mode::Textured { lean, .. } => lean.as_ref(),
+                _ => None,
+            };
             let mut unsampled = Vec::new();
             shade_batch_textured(
                 self.plan.isa,
-                prep,
+                (prep, lean),
                 maps,
                 items.len(),
                 |i| {
