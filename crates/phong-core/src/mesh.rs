@@ -348,7 +348,7 @@ impl Mesh {
             return Some(ordered());
         }
         // Four vertices at a time in 4-lane vectors: the same bounds in another order of
-        // comparisons (about a tenth of the instructions), except where a bound is zero (the
+        // comparisons (about a fifth of the instructions), except where a bound is zero (the
         // sign of that zero may depend on the order) or a coordinate NaN (which the ordered
         // fold lets through): the ordered fold gives those.
         let blocks = self.positions.chunks_exact(4);
@@ -648,7 +648,6 @@ mod tests {
         assert!(m.colors().is_empty() && m.tangents().is_empty());
     }
 
-    /// The one-pass flat placement gives the two-step one's bits: positions, normals,
     /// The blocked bounds are the vertex-by-vertex fold's, bit for bit: meshes of 1 to 40
     /// vertices (every remainder of the blocks) from a small set of values, zeros of both signs
     /// among them, and meshes whose first vertex or others have a NaN or an infinity.
@@ -684,6 +683,7 @@ mod tests {
         assert_eq!(Mesh::default().bounds(), None);
     }
 
+    /// The one-pass flat placement gives the two-step one's bits: positions, normals,
     /// triangles (a mirror reversing them), texture coordinates and colours, for a rotation
     /// with a non-uniform scale and a move, a mirror, and the identity.
     #[test]
