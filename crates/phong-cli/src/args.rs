@@ -51,8 +51,8 @@ pub struct RunArgs {
     /// CPU: the scalar reference path instead of the fast path.
     #[arg(long)]
     pub reference: bool,
-    /// CPU: which builds of the fast path's vector kernels may run. The images are the same,
-    /// bit for bit; for comparisons.
+    /// CPU: which builds of the fast path's vector kernels may run, for comparisons. The AVX2
+    /// builds' images are the same, bit for bit; the portable build's within 1/255 of them.
     #[arg(long, value_enum, default_value_t = KernelsArg::Auto)]
     pub kernels: KernelsArg,
     /// The same as `--kernels avx2` (kept for scripts that use it).

@@ -318,7 +318,9 @@ fn flags_override_the_file() {
     assert!(flat <= 64 && smooth > 300, "{flat} flat normals, {smooth} interpolated");
 }
 
-/// `--kernels`: every build of the vector kernels draws the same bytes.
+/// `--kernels`: the AVX2 builds (with and without AVX-512's registers) draw the same bytes; the
+/// portable build (exact reciprocals and square roots, where AVX2 refines the hardware's
+/// estimates) draws within 1/255 of them on every pixel.
 #[test]
 fn every_kernel_build_draws_the_same_image() {
     let image = |kernels: &str| {
@@ -341,9 +343,12 @@ fn every_kernel_build_draws_the_same_image() {
     };
     let (auto, avx2, portable) = (image("auto"), image("avx2"), image("portable"));
     assert!(portable.0.contains("portable kernels"), "{}", portable.0);
+    assert!(auto.1 == avx2.1, "the AVX2 builds' images differ");
+    assert_eq!(avx2.1.len(), portable.1.len());
+    let worst = avx2.1.iter().zip(&portable.1).map(|(a, b)| a.abs_diff(*b)).max();
     assert!(
-        auto.1 == portable.1 && avx2.1 == portable.1,
-        "the builds' images differ"
+        worst <= Some(1),
+        "the portable build is {worst:?}/255 from the AVX2 build"
     );
     let o = phong(&["render", "examples/scenes/tour.toml", "-o", "x.png", "--kernels", "sse"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
