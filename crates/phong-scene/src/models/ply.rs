@@ -767,9 +767,9 @@ fn plain_binary(h: &Header, bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> 
             u32::from_le_bytes(a)
         }
     };
-    let positions: Vec<Vec3> = if !big && stride == 12 && offsets == [0, 4, 8] {
-        // Little-endian x, y, z alone: the bytes are the vertex array (a copy, as the file's
-        // bytes need not be aligned).
+    let positions: Vec<Vec3> = if !big && cfg!(target_endian = "little") && stride == 12 && offsets == [0, 4, 8] {
+        // Little-endian x, y, z alone on a little-endian machine: the bytes are the vertex
+        // array (a copy, as the file's bytes need not be aligned).
         bytemuck::pod_collect_to_vec(&body[..vertex_bytes])
     } else {
         body[..vertex_bytes]
