@@ -68,6 +68,16 @@ pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
     (p2 - p1).cross(p3 - p1).normalize_or_zero()
 }
 
+/// Triangles in each half of a mesh from which [`Mesh::flat_transformed`] takes two threads:
+/// a thread's start (tens of µs) is small beside the work of 10,000 triangles.
+const FLAT_HALF_MIN: usize = 10_000;
+
+/// `n` zero vectors from zeroed memory (a fresh allocation's pages are not written here, but
+/// first where they are filled).
+fn zeroed(n: usize) -> Vec<Vec3> {
+    bytemuck::allocation::try_cast_vec(vec![0f32; 3 * n]).unwrap_or_else(|_| vec![Vec3::ZERO; n])
+}
+
 /// A per-vertex attribute given to each corner of `triangles` in turn (three vertices a
 /// triangle); empty for an empty one. Each array sized once and written triangle by
 /// triangle, no growth check per vertex (a large glTF without normals takes this path).
@@ -439,14 +449,29 @@ impl Mesh {
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
         let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
         let count = 3 * self.triangles.len();
-        let mut positions = vec![Vec3::ZERO; count];
-        let mut normals = vec![Vec3::ZERO; count];
-        let corners = positions.chunks_exact_mut(3).zip(normals.chunks_exact_mut(3));
-        for ((p, n), t) in corners.zip(&self.triangles) {
-            let [a, b, c] = t.map(|i| i as usize);
-            let facet = facet_normal(self.positions[a], self.positions[b], self.positions[c]);
-            n.fill((nm * facet).normalize_or_zero());
-            p.copy_from_slice(&[moved[a], moved[b], moved[c]]);
+        let (mut positions, mut normals) = (zeroed(count), zeroed(count));
+        let fill = |triangles: &[[u32; 3]], positions: &mut [Vec3], normals: &mut [Vec3]| {
+            let corners = positions.chunks_exact_mut(3).zip(normals.chunks_exact_mut(3));
+            for ((p, n), t) in corners.zip(triangles) {
+                let [a, b, c] = t.map(|i| i as usize);
+                let facet = facet_normal(self.positions[a], self.positions[b], self.positions[c]);
+                n.fill((nm * facet).normalize_or_zero());
+                p.copy_from_slice(&[moved[a], moved[b], moved[c]]);
+            }
+        };
+        // A large mesh's second half on a second thread (each triangle's vertices are its own:
+        // the same values), its fresh memory first touched there too.
+        let half = self.triangles.len() / 2;
+        if half >= FLAT_HALF_MIN && std::thread::available_parallelism().is_ok_and(|n| n.get() > 1) {
+            let (t0, t1) = self.triangles.split_at(half);
+            let (p0, p1) = positions.split_at_mut(3 * half);
+            let (n0, n1) = normals.split_at_mut(3 * half);
+            std::thread::scope(|scope| {
+                scope.spawn(|| fill(t1, p1, n1));
+                fill(t0, p0, n0);
+            });
+        } else {
+            fill(&self.triangles, &mut positions, &mut normals);
         }
         // A mirror reverses each triangle, as `into_transformed` does.
         let (second, third) = if flip { (2, 1) } else { (1, 2) };
@@ -711,6 +736,10 @@ mod tests {
             Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
         ];
         let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        // Large enough for two threads (halves of at least `FLAT_HALF_MIN` triangles).
+        let large = crate::primitives::sphere(160);
+        assert!(large.triangles().len() >= 2 * FLAT_HALF_MIN);
+        let shapes = [&shapes[..], &[large]].concat();
         for mesh in &shapes {
             for m in &moves {
                 let (a, b) = (mesh.flat_transformed(m), mesh.with_flat_normals().into_transformed(m));
