@@ -466,9 +466,18 @@ impl Mesh {
             let (t0, t1) = self.triangles.split_at(half);
             let (p0, p1) = positions.split_at_mut(3 * half);
             let (n0, n1) = normals.split_at_mut(3 * half);
+            // The second half goes to whichever takes it first: the thread, or this one after
+            // its own half (where the thread could not be started, or has not started yet).
+            let rest = std::sync::Mutex::new(Some((p1, n1)));
+            let second = || {
+                if let Some((p, n)) = rest.lock().ok().and_then(|mut r| r.take()) {
+                    fill(t1, p, n);
+                }
+            };
             std::thread::scope(|scope| {
-                scope.spawn(|| fill(t1, p1, n1));
+                let _ = std::thread::Builder::new().spawn_scoped(scope, second);
                 fill(t0, p0, n0);
+                second();
             });
         } else {
             fill(&self.triangles, &mut positions, &mut normals);
