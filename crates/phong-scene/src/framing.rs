@@ -132,9 +132,16 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     let (json, notes) = if beside_worth_it(&model) {
         let (framing, drawn) = std::thread::scope(|scope| {
             let parts = &model.parts;
-            let other = scope.spawn(move || (draw(parts), crate::timing::take_times()));
+            let other =
+                std::thread::Builder::new().spawn_scoped(scope, move || (draw(parts), crate::timing::take_times()));
             let framing = framed(path, &model, options);
-            (framing, other.join().expect("the normals' thread panicked"))
+            // (Where the thread could not be started, the normals here, after the framing:
+            // their times are then this thread's already.)
+            let drawn = match other {
+                Ok(h) => h.join().expect("the normals' thread panicked"),
+                Err(_) => (draw(parts), Default::default()),
+            };
+            (framing, drawn)
         });
         crate::timing::add_times(drawn.1);
         for (p, d) in model.parts.iter_mut().zip(drawn.0) {

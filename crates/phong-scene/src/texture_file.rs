@@ -246,23 +246,27 @@ impl TextureCache {
             .min(wanted.len());
         let next = std::sync::atomic::AtomicUsize::new(0);
         let results: Vec<(usize, Result<Arc<Texture>, String>, TextureStats)> = std::thread::scope(|scope| {
+            // (A worker that cannot be started is skipped: a map no worker decoded is decoded
+            // where it is used, `TextureCache::load`.)
             let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut mine = Vec::new();
-                        loop {
-                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                            let Some(((_, srgb), bytes)) = wanted.get(i) else {
-                                break mine;
-                            };
-                            let mut stats = TextureStats::default();
-                            let r = match bytes {
-                                Ok(b) => shared_or_decoded(b, *srgb, Instant::now(), &mut stats),
-                                Err(e) => Err(e.clone()),
-                            };
-                            mine.push((i, r, stats));
-                        }
-                    })
+                .filter_map(|_| {
+                    std::thread::Builder::new()
+                        .spawn_scoped(scope, || {
+                            let mut mine = Vec::new();
+                            loop {
+                                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                                let Some(((_, srgb), bytes)) = wanted.get(i) else {
+                                    break mine;
+                                };
+                                let mut stats = TextureStats::default();
+                                let r = match bytes {
+                                    Ok(b) => shared_or_decoded(b, *srgb, Instant::now(), &mut stats),
+                                    Err(e) => Err(e.clone()),
+                                };
+                                mine.push((i, r, stats));
+                            }
+                        })
+                        .ok()
                 })
                 .collect();
             workers.into_iter().flat_map(|w| w.join().unwrap_or_default()).collect()

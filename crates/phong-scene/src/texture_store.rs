@@ -171,11 +171,16 @@ fn read_levels(f: &File, start: u64, len: u64) -> Option<SharedBytes> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
     let per = pieces.len().div_ceil(threads).max(1);
     let ok = std::thread::scope(|s| {
+        // (Where a piece's thread cannot be started the read fails: the cache entry is then
+        // missed, and the map decoded from its file.)
         let handles: Vec<_> = pieces
             .chunks_mut(per)
-            .map(|mine| s.spawn(move || mine.iter_mut().all(|(at, buf)| read_at(f, buf, *at))))
+            .map(|mine| {
+                std::thread::Builder::new()
+                    .spawn_scoped(s, move || mine.iter_mut().all(|(at, buf)| read_at(f, buf, *at)))
+            })
             .collect();
-        handles.into_iter().all(|h| h.join().unwrap_or(false))
+        handles.into_iter().all(|h| h.is_ok_and(|h| h.join().unwrap_or(false)))
     });
     let map = map.make_read_only().ok()?;
     ok.then(|| Arc::new(map) as SharedBytes)

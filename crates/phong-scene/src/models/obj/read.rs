@@ -605,13 +605,22 @@ fn read_in_chunks(
     Ok(all.expect("at least one run").finish(g))
 }
 
-/// `f` of each item, the first on this thread and the others on threads of their own.
+/// `f` of each item, the first on this thread and the others on threads of their own (on this
+/// one too, after the first, where a thread cannot be started).
 fn side_by_side<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let f = &f;
     std::thread::scope(|scope| {
-        let others: Vec<_> = items[1..].iter().map(|item| scope.spawn(move || f(item))).collect();
+        let others: Vec<_> = items[1..]
+            .iter()
+            .map(|item| std::thread::Builder::new().spawn_scoped(scope, move || f(item)))
+            .collect();
         let mut out = vec![f(&items[0])];
-        out.extend(others.into_iter().map(|h| h.join().expect("a reading thread panicked")));
+        for (item, h) in items[1..].iter().zip(others) {
+            out.push(match h {
+                Ok(h) => h.join().expect("a reading thread panicked"),
+                Err(_) => f(item),
+            });
+        }
         out
     })
 }
