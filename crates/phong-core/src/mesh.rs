@@ -72,12 +72,6 @@ pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
 /// a thread's start (tens of µs) is small beside the work of 10,000 triangles.
 const FLAT_HALF_MIN: usize = 10_000;
 
-/// `n` zero vectors from zeroed memory (a fresh allocation's pages are not written here, but
-/// first where they are filled).
-fn zeroed(n: usize) -> Vec<Vec3> {
-    bytemuck::allocation::try_cast_vec(vec![0f32; 3 * n]).unwrap_or_else(|_| vec![Vec3::ZERO; n])
-}
-
 /// A per-vertex attribute given to each corner of `triangles` in turn (three vertices a
 /// triangle); empty for an empty one. Each array sized once and written triangle by
 /// triangle, no growth check per vertex (a large glTF without normals takes this path).
@@ -449,7 +443,7 @@ impl Mesh {
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
         let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
         let count = 3 * self.triangles.len();
-        let (mut positions, mut normals) = (zeroed(count), zeroed(count));
+        let (mut positions, mut normals) = (vec![Vec3::ZERO; count], vec![Vec3::ZERO; count]);
         let fill = |triangles: &[[u32; 3]], positions: &mut [Vec3], normals: &mut [Vec3]| {
             let corners = positions.chunks_exact_mut(3).zip(normals.chunks_exact_mut(3));
             for ((p, n), t) in corners.zip(triangles) {
@@ -460,7 +454,7 @@ impl Mesh {
             }
         };
         // A large mesh's second half on a second thread (each triangle's vertices are its own:
-        // the same values), its fresh memory first touched there too.
+        // the same values).
         let half = self.triangles.len() / 2;
         if half >= FLAT_HALF_MIN && std::thread::available_parallelism().is_ok_and(|n| n.get() > 1) {
             let (t0, t1) = self.triangles.split_at(half);
