@@ -31,6 +31,7 @@ mod camera;
 mod color;
 mod error;
 mod image;
+pub mod join;
 mod light;
 pub mod limits;
 mod maps;

@@ -2,6 +2,7 @@
 //! the cross product, vertex normals from the facet normals or from the
 //! surface's formula).
 
+use crate::join::Join;
 use crate::{Color, Error};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rustc_hash::FxHashMap;
@@ -68,8 +69,8 @@ pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
     (p2 - p1).cross(p3 - p1).normalize_or_zero()
 }
 
-/// Triangles in each half of a mesh from which [`Mesh::flat_transformed`] takes two threads:
-/// a thread's start (tens of µs) is small beside the work of 10,000 triangles.
+/// Triangles in each half of a mesh from which [`Mesh::flat_transformed`] hands its two halves
+/// to its [`Join`]: a thread's start (tens of µs) is small beside the work of 10,000 triangles.
 const FLAT_HALF_MIN: usize = 10_000;
 
 /// A per-vertex attribute given to each corner of `triangles` in turn (three vertices a
@@ -438,7 +439,7 @@ impl Mesh {
     /// position transformed once (not once a corner) and each facet normal once a triangle
     /// (not once a corner), the three-vertices-a-triangle arrays written once. For a model
     /// without normals (a glTF's flat ones) placed in the scene.
-    pub fn flat_transformed(&self, m: &Mat4) -> Mesh {
+    pub fn flat_transformed(&self, m: &Mat4, join: &impl Join) -> Mesh {
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
         let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
@@ -453,26 +454,14 @@ impl Mesh {
                 p.copy_from_slice(&[moved[a], moved[b], moved[c]]);
             }
         };
-        // A large mesh's second half on a second thread (each triangle's vertices are its own:
-        // the same values).
+        // A large mesh in two halves, which `join` may draw side by side (each triangle's
+        // vertices are its own: the same values).
         let half = self.triangles.len() / 2;
-        if half >= FLAT_HALF_MIN && std::thread::available_parallelism().is_ok_and(|n| n.get() > 1) {
+        if half >= FLAT_HALF_MIN {
             let (t0, t1) = self.triangles.split_at(half);
             let (p0, p1) = positions.split_at_mut(3 * half);
             let (n0, n1) = normals.split_at_mut(3 * half);
-            // The second half goes to whichever takes it first: the thread, or this one after
-            // its own half (where the thread could not be started, or has not started yet).
-            let rest = std::sync::Mutex::new(Some((p1, n1)));
-            let second = || {
-                if let Some((p, n)) = rest.lock().ok().and_then(|mut r| r.take()) {
-                    fill(t1, p, n);
-                }
-            };
-            std::thread::scope(|scope| {
-                let _ = std::thread::Builder::new().spawn_scoped(scope, second);
-                fill(t0, p0, n0);
-                second();
-            });
+            join.join(|| fill(t0, p0, n0), || fill(t1, p1, n1));
         } else {
             fill(&self.triangles, &mut positions, &mut normals);
         }
@@ -739,13 +728,27 @@ mod tests {
             Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
         ];
         let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-        // Large enough for two threads (halves of at least `FLAT_HALF_MIN` triangles).
+        // Large enough for two halves (at least `FLAT_HALF_MIN` triangles each), drawn in turn
+        // and in the other order.
+        struct Reversed;
+        impl Join for Reversed {
+            fn join<A, B: Send>(&self, a: impl FnOnce() -> A, b: impl FnOnce() -> B + Send) -> (A, B) {
+                let b = b();
+                (a(), b)
+            }
+        }
         let large = crate::primitives::sphere(160);
         assert!(large.triangles().len() >= 2 * FLAT_HALF_MIN);
         let shapes = [&shapes[..], &[large]].concat();
         for mesh in &shapes {
             for m in &moves {
-                let (a, b) = (mesh.flat_transformed(m), mesh.with_flat_normals().into_transformed(m));
+                let b = mesh.with_flat_normals().into_transformed(m);
+                let (a, reversed) = (
+                    mesh.flat_transformed(m, &crate::join::InTurn),
+                    mesh.flat_transformed(m, &Reversed),
+                );
+                assert_eq!(bits(reversed.positions()), bits(b.positions()));
+                assert_eq!(bits(reversed.normals()), bits(b.normals()));
                 assert_eq!(bits(a.positions()), bits(b.positions()));
                 assert_eq!(bits(a.normals()), bits(b.normals()));
                 assert_eq!(a.triangles(), b.triangles());

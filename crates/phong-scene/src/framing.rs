@@ -6,10 +6,12 @@
 //! framed by the same arithmetic. The view is built in the model's frame: its up axis (given,
 //! or detected), its front, and the camera placed so that every vertex is inside the frame.
 
+use crate::beside::Beside;
 use crate::toml_scene::object::{DEFAULT_CREASE, default_normals, drawn_mesh};
 use crate::{Error, Loaded, ModelFile, ModelFormat, ModelPart};
 use glam::{DVec3, Vec3};
 use phong_core::Mesh;
+use phong_core::join::Join;
 use std::path::Path;
 
 /// An axis, signed: the model's up (`--up`).
@@ -130,19 +132,12 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
             .collect()
     };
     let (json, notes) = if beside_worth_it(&model) {
-        let (framing, drawn) = std::thread::scope(|scope| {
-            let parts = &model.parts;
-            let other =
-                std::thread::Builder::new().spawn_scoped(scope, move || (draw(parts), crate::timing::take_times()));
-            let framing = framed(path, &model, options);
-            // (Where the thread could not be started, the normals here, after the framing:
-            // their times are then this thread's already.)
-            let drawn = match other {
-                Ok(h) => h.join().expect("the normals' thread panicked"),
-                Err(_) => (draw(parts), Default::default()),
-            };
-            (framing, drawn)
-        });
+        let parts = &model.parts;
+        // (The normals' times are taken where they ran and added to this thread's.)
+        let (framing, drawn) = Beside.join(
+            || framed(path, &model, options),
+            || (draw(parts), crate::timing::take_times()),
+        );
         crate::timing::add_times(drawn.1);
         for (p, d) in model.parts.iter_mut().zip(drawn.0) {
             p.drawn = d;
@@ -182,7 +177,7 @@ fn beside_worth_it(model: &ModelFile) -> bool {
     model.format != ModelFormat::Gltf
         && (MIN_TRIANGLES..=MAX_CLOSED_CHECK).contains(&triangles)
         && parts.iter().any(|p| default_normals(p) == "angle")
-        && std::thread::available_parallelism().is_ok_and(|n| n.get() > 1)
+        && crate::beside::cores() > 1
 }
 
 /// The scene of a model alone (as `phong render MODEL` frames it) for a model already read

@@ -7,6 +7,7 @@
 //! Every error names the file, and for parse and validation errors the line,
 //! column and key (`scene.toml:12:13: \`shininess\`: must be >= 0, got -1`).
 
+mod beside;
 mod error;
 mod framing;
 mod json_scene;

@@ -241,39 +241,22 @@ impl TextureCache {
         if wanted.is_empty() {
             return;
         }
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(wanted.len());
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        let results: Vec<(usize, Result<Arc<Texture>, String>, TextureStats)> = std::thread::scope(|scope| {
-            // (A worker that cannot be started is skipped: a map no worker decoded is decoded
-            // where it is used, `TextureCache::load`.)
-            let workers: Vec<_> = (0..threads)
-                .filter_map(|_| {
-                    std::thread::Builder::new()
-                        .spawn_scoped(scope, || {
-                            let mut mine = Vec::new();
-                            loop {
-                                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                                let Some(((_, srgb), bytes)) = wanted.get(i) else {
-                                    break mine;
-                                };
-                                let mut stats = TextureStats::default();
-                                let r = match bytes {
-                                    Ok(b) => shared_or_decoded(b, *srgb, Instant::now(), &mut stats),
-                                    Err(e) => Err(e.clone()),
-                                };
-                                mine.push((i, r, stats));
-                            }
-                        })
-                        .ok()
-                })
-                .collect();
-            workers.into_iter().flat_map(|w| w.join().unwrap_or_default()).collect()
-        });
-        for (i, r, stats) in results {
+        let threads = crate::beside::cores().min(wanted.len());
+        let results = crate::beside::map(
+            wanted.iter().map(|(key, bytes)| (key.1, bytes)).collect(),
+            threads,
+            |(srgb, bytes)| {
+                let mut stats = TextureStats::default();
+                let r = match bytes {
+                    Ok(b) => shared_or_decoded(b, srgb, Instant::now(), &mut stats),
+                    Err(e) => Err(e.clone()),
+                };
+                (r, stats)
+            },
+        );
+        for ((key, _), (r, stats)) in wanted.into_iter().zip(results) {
             add_stats(&stats);
-            self.ready.insert(wanted[i].0.clone(), r);
+            self.ready.insert(key, r);
         }
     }
 }

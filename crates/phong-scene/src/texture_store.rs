@@ -163,25 +163,14 @@ fn read_levels(f: &File, start: u64, len: u64) -> Option<SharedBytes> {
     #[cfg(target_os = "linux")]
     let _ = map.advise(memmap2::Advice::HugePage);
     const PIECE: usize = 4 << 20;
-    let mut pieces: Vec<(u64, &mut [u8])> = map
+    let pieces: Vec<(u64, &mut [u8])> = map
         .chunks_mut(PIECE)
         .enumerate()
         .map(|(i, piece)| (start + (i * PIECE) as u64, piece))
         .collect();
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
-    let per = pieces.len().div_ceil(threads).max(1);
-    let ok = std::thread::scope(|s| {
-        // (Where a piece's thread cannot be started the read fails: the cache entry is then
-        // missed, and the map decoded from its file.)
-        let handles: Vec<_> = pieces
-            .chunks_mut(per)
-            .map(|mine| {
-                std::thread::Builder::new()
-                    .spawn_scoped(s, move || mine.iter_mut().all(|(at, buf)| read_at(f, buf, *at)))
-            })
-            .collect();
-        handles.into_iter().all(|h| h.is_ok_and(|h| h.join().unwrap_or(false)))
-    });
+    let threads = crate::beside::cores().min(8);
+    let read = crate::beside::map(pieces, threads, |(at, buf)| read_at(f, buf, at));
+    let ok = read.into_iter().all(|ok| ok);
     let map = map.make_read_only().ok()?;
     ok.then(|| Arc::new(map) as SharedBytes)
 }

@@ -372,7 +372,10 @@ fn mesh_objects(
             maps
         };
         let mesh = if flat && maps.normal.is_none() {
-            crate::timing::timed(|t| &mut t.normals, || mesh.flat_transformed(&world_from_file))
+            crate::timing::timed(
+                |t| &mut t.normals,
+                || mesh.flat_transformed(&world_from_file, &crate::beside::Beside),
+            )
         } else {
             let mesh = if flat { with_normals(mesh, "flat", crease) } else { mesh };
             tangents_for(mesh, &maps).into_transformed(&world_from_file)

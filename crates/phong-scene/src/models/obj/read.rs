@@ -13,6 +13,7 @@ use super::text::{
     Checker, NO_MATERIAL, lines, plain_decimal, plain_decimal_at, plain_index, slashed, strtod, vertex_kind, words,
 };
 use crate::Error;
+use crate::beside::map;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 use std::path::Path;
@@ -547,7 +548,7 @@ pub(super) fn read_obj(
     /// Bytes a chunk has at least: a 256 KiB chunk reads in about 1 ms here, against a thread's
     /// start of tens of µs (the threshold itself not tuned by measurement).
     const CHUNK: usize = 1 << 18;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
+    let threads = crate::beside::cores().min(8);
     read_in_chunks(path, src, load_mtl, (src.len() / CHUNK).clamp(1, threads))
 }
 
@@ -562,10 +563,11 @@ fn read_in_chunks(
     let passes: Vec<(Reader, Option<Error>)> = if runs.len() == 1 {
         vec![pass(path, src, runs[0], [0; 3])]
     } else {
-        // The vertex statements before each run, then the runs read side by side (the first
-        // on this thread).
-        // (The last run's count is no run's base.)
-        let mut counts = side_by_side(&runs[..runs.len() - 1], |run| vertex_counts(&src[run.0..run.1]));
+        // The vertex statements before each run, then the runs read side by side, a thread a
+        // run. (The last run's count is no run's base.)
+        let mut counts = map(runs[..runs.len() - 1].to_vec(), runs.len(), |run| {
+            vertex_counts(&src[run.0..run.1])
+        });
         counts.push([0; 3]);
         let mut base = [0i64; 3];
         let bases: Vec<(usize, usize, [i64; 3])> = runs
@@ -577,7 +579,9 @@ fn read_in_chunks(
                 (start, end, b)
             })
             .collect();
-        side_by_side(&bases, |&(start, end, base)| pass(path, src, (start, end), base))
+        map(bases, runs.len(), |(start, end, base)| {
+            pass(path, src, (start, end), base)
+        })
     };
     let mut g = Groups {
         groups: Vec::new(),
@@ -603,26 +607,6 @@ fn read_in_chunks(
         }
     }
     Ok(all.expect("at least one run").finish(g))
-}
-
-/// `f` of each item, the first on this thread and the others on threads of their own (on this
-/// one too, after the first, where a thread cannot be started).
-fn side_by_side<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let f = &f;
-    std::thread::scope(|scope| {
-        let others: Vec<_> = items[1..]
-            .iter()
-            .map(|item| std::thread::Builder::new().spawn_scoped(scope, move || f(item)))
-            .collect();
-        let mut out = vec![f(&items[0])];
-        for (item, h) in items[1..].iter().zip(others) {
-            out.push(match h {
-                Ok(h) => h.join().expect("a reading thread panicked"),
-                Err(_) => f(item),
-            });
-        }
-        out
-    })
 }
 
 /// `src` cut into at most `n` runs `(start, end)` of whole lines, in order, none empty
