@@ -4,7 +4,7 @@
 
 use crate::join::Join;
 use crate::{Color, Error};
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat3, Mat3A, Mat4, Vec2, Vec3, Vec3A, Vec4};
 use rustc_hash::FxHashMap;
 
 mod crease;
@@ -445,13 +445,17 @@ impl Mesh {
         let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
         let count = 3 * self.triangles.len();
         let (mut positions, mut normals) = (vec![Vec3::ZERO; count], vec![Vec3::ZERO; count]);
+        // (In `Vec3A`, glam's SSE form of the same operations in the same order: the same
+        // bits as `facet_normal` and `Mat3 * Vec3`, in fewer instructions.)
+        let nm_a = Mat3A::from(nm);
         let fill = |triangles: &[[u32; 3]], positions: &mut [Vec3], normals: &mut [Vec3]| {
-            let corners = positions.chunks_exact_mut(3).zip(normals.chunks_exact_mut(3));
+            let corners = positions.as_chunks_mut::<3>().0.iter_mut().zip(normals.as_chunks_mut::<3>().0);
             for ((p, n), t) in corners.zip(triangles) {
                 let [a, b, c] = t.map(|i| i as usize);
-                let facet = facet_normal(self.positions[a], self.positions[b], self.positions[c]);
-                n.fill((nm * facet).normalize_or_zero());
-                p.copy_from_slice(&[moved[a], moved[b], moved[c]]);
+                let [pa, pb, pc] = [a, b, c].map(|i| Vec3A::from(self.positions[i]));
+                let facet = (pb - pa).cross(pc - pa).normalize_or_zero();
+                *n = [Vec3::from((nm_a * facet).normalize_or_zero()); 3];
+                *p = [moved[a], moved[b], moved[c]];
             }
         };
         // A large mesh in two halves, which `join` may draw side by side (each triangle's
