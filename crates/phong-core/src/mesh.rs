@@ -449,7 +449,11 @@ impl Mesh {
         // bits as `facet_normal` and `Mat3 * Vec3`, in fewer instructions.)
         let nm_a = Mat3A::from(nm);
         let fill = |triangles: &[[u32; 3]], positions: &mut [Vec3], normals: &mut [Vec3]| {
-            let corners = positions.as_chunks_mut::<3>().0.iter_mut().zip(normals.as_chunks_mut::<3>().0);
+            let corners = positions
+                .as_chunks_mut::<3>()
+                .0
+                .iter_mut()
+                .zip(normals.as_chunks_mut::<3>().0);
             for ((p, n), t) in corners.zip(triangles) {
                 let [a, b, c] = t.map(|i| i as usize);
                 let [pa, pb, pc] = [a, b, c].map(|i| Vec3A::from(self.positions[i]));
