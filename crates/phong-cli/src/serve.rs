@@ -37,6 +37,13 @@ pub(crate) fn serve(a: ServeArgs) -> Result<()> {
         Some(g) => phong_serve::Backend::Gpu(Box::new(std::sync::Mutex::new(g))),
         None => phong_serve::Backend::cpu(a.threads).map_err(|e| anyhow::anyhow!(e))?,
     };
+    // The runtime starts its workers when it first runs, and panics where the system refuses
+    // them (a process's or container's thread limit): a thread is asked for first.
+    std::thread::Builder::new()
+        .spawn(|| ())
+        .map(|t| t.join())
+        .context("starting the server's threads")?
+        .map_err(|_| anyhow::anyhow!("starting the server's threads"))?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

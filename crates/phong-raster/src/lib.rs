@@ -68,12 +68,12 @@ pub enum Error {
     #[error("threads must be from 1 to {max}, got {0}", max = phong_core::limits::MAX_THREADS)]
     ThreadCount(usize),
     /// The thread pool could not be built.
-    #[error("could not start {threads} rendering threads: {source}")]
+    #[error("could not start {threads} rendering threads: {reason}")]
     Threads {
         /// Threads asked for.
         threads: usize,
-        /// The cause.
-        source: rayon::ThreadPoolBuildError,
+        /// Why (the system's words).
+        reason: String,
     },
     /// An invalid image (from the core crate).
     #[error(transparent)]
