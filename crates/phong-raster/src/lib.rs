@@ -92,7 +92,7 @@ impl Error {
 #[derive(Default)]
 pub struct RenderOptions<'a> {
     /// Worker threads, 1 to [`MAX_THREADS`](phong_core::limits::MAX_THREADS); `None`: all cores
-    /// (rayon's global pool).
+    /// (rayon's global pool). See [`Pool`] for where the system refuses threads.
     pub threads: Option<usize>,
     /// Called with (tiles done, tiles in all) as tiles finish, from any thread.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,

@@ -28,7 +28,8 @@ impl Pool {
         }
     }
 
-    /// A pool of `threads`, or the global pool for `None`.
+    /// A pool of `threads`, or the global pool for `None` (the calling thread where the global
+    /// pool cannot start its threads).
     pub fn new(threads: Option<usize>) -> Result<Pool, Error> {
         match threads {
             None if global_starts() => Ok(Pool(Threads::Global)),

@@ -167,7 +167,8 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     Ok(loaded)
 }
 
-/// Whether the framing and the normals of `parts` are worth a second thread: where both
+/// Whether the framing and the normals of `parts` are worth computing side by side ([`Beside`]
+/// takes a second thread where there are two cores): where both
 /// are computed (a model without normals of its own, not a glTF, whose closedness the framing
 /// checks) and large enough that a thread's start (tens of µs) is small beside them.
 fn beside_worth_it(model: &ModelFile) -> bool {
@@ -177,7 +178,6 @@ fn beside_worth_it(model: &ModelFile) -> bool {
     model.format != ModelFormat::Gltf
         && (MIN_TRIANGLES..=MAX_CLOSED_CHECK).contains(&triangles)
         && parts.iter().any(|p| default_normals(p) == "angle")
-        && crate::beside::cores() > 1
 }
 
 /// The scene of a model alone (as `phong render MODEL` frames it) for a model already read
