@@ -1463,3 +1463,126 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         }
     }
 }
+
+/// Quantized attributes (KHR_mesh_quantization, as gltfpack and glTF-Transform write them; and
+/// the core's normalized texture coordinates and colours): every component type an attribute
+/// may have is read as the specification maps it, through strided views. A triangle with
+/// positions in normalized shorts (moved and scaled by its node), normals and tangents in
+/// normalized signed bytes, texture coordinates in normalized signed bytes (which the `gltf`
+/// crate's reader met with a panic) and in plain unsigned shorts, colours in normalized
+/// unsigned shorts: the values below are the specification's formulas worked by hand. A
+/// component type the specification does not allow for an attribute is an error naming it.
+#[test]
+fn gltf_quantized_attributes_are_read() {
+    let d = dir("gltf_quantized");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(d.join("t.png"))
+        .unwrap();
+    let mut bin: Vec<u8> = Vec::new();
+    // Positions (i16, a stride of 8), normals (i8, stride 4), TEXCOORD_0 (i8, stride 4),
+    // TEXCOORD_1 (u16), COLOR_0 (u16 RGBA), TANGENT (i8 RGBA).
+    for p in [[0i16, 0, 0], [16384, 0, 0], [0, 32767, -32767]] {
+        p.iter().for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
+        bin.extend_from_slice(&[0, 0]);
+    }
+    for _ in 0..3 {
+        bin.extend_from_slice(&[0, 0, 127, 0]);
+    }
+    for uv in [[0i8, 0], [127, 0], [0, -127]] {
+        bin.extend_from_slice(&[uv[0] as u8, uv[1] as u8, 0, 0]);
+    }
+    for uv in [[0u16, 0], [2, 0], [0, 3]] {
+        uv.iter().for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
+    }
+    for _ in 0..3 {
+        [65535u16, 32768, 0, 65535]
+            .iter()
+            .for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
+    }
+    for _ in 0..3 {
+        bin.extend_from_slice(&[127, 0, 0, (-127i8) as u8]);
+    }
+    assert_eq!(bin.len(), 96);
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    // `types`: the component types of NORMAL, TEXCOORD_0 and COLOR_0 (with "normalized").
+    let gltf = |types: [&str; 3]| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_mesh_quantization"],
+  "extensionsRequired": ["KHR_mesh_quantization"],
+  "buffers": [{{"byteLength": 96, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 24, "byteStride": 8}},
+                  {{"buffer": 0, "byteOffset": 24, "byteLength": 12, "byteStride": 4}},
+                  {{"buffer": 0, "byteOffset": 36, "byteLength": 12, "byteStride": 4}},
+                  {{"buffer": 0, "byteOffset": 48, "byteLength": 12}},
+                  {{"buffer": 0, "byteOffset": 60, "byteLength": 24}},
+                  {{"buffer": 0, "byteOffset": 84, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5122, "normalized": true, "count": 3, "type": "VEC3", "min": [0,0,-32767], "max": [16384,32767,0]}},
+    {{"bufferView": 1, {n}, "count": 3, "type": "VEC3"}},
+    {{"bufferView": 2, {t}, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 3, "componentType": 5123, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 4, {c}, "count": 3, "type": "VEC4"}},
+    {{"bufferView": 5, "componentType": 5120, "normalized": true, "count": 3, "type": "VEC4"}}],
+  "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}}}, "normalTexture": {{"index": 0}},
+                  "occlusionTexture": {{"index": 0, "texCoord": 1}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TEXCOORD_1": 3,
+                                                "COLOR_0": 4, "TANGENT": 5}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0, "translation": [1, 0, 0], "scale": [2, 2, 2]}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+            n = types[0],
+            t = types[1],
+            c = types[2],
+        )
+    };
+    let (i8n, u16n) = (
+        r#""componentType": 5120, "normalized": true"#,
+        r#""componentType": 5123, "normalized": true"#,
+    );
+    let p = write(&d, "q.gltf", gltf([i8n, i8n, u16n]).as_bytes());
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    let mesh = &parts[0].mesh;
+    // Position: node · (c / 32767) = 1 + 2 c / 32767 in x, 2 c / 32767 in y and z.
+    let q = |c: f64| 2.0 * c / 32767.0;
+    let want = [[1.0, 0.0, 0.0], [1.0 + q(16384.0), 0.0, 0.0], [1.0, 2.0, -2.0]];
+    for (got, want) in mesh.positions().iter().zip(want) {
+        assert!(
+            (got.as_dvec3() - DVec3::from_array(want)).abs().max_element() < 1e-6,
+            "{got} vs {want:?}"
+        );
+    }
+    assert_eq!(mesh.normals(), &[Vec3::Z; 3][..], "127 / 127 = 1");
+    // Normalized signed bytes: c / 127, v flipped to OpenGL's (1 − v).
+    assert_eq!(
+        mesh.uvs(),
+        &[Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 2.0)][..]
+    );
+    // Plain shorts: their values.
+    assert_eq!(
+        mesh.uvs1(),
+        &[Vec2::new(0.0, 1.0), Vec2::new(2.0, 1.0), Vec2::new(0.0, -2.0)][..]
+    );
+    for c in mesh.colors() {
+        let want = [1.0, 32768.0 / 65535.0, 0.0];
+        assert!(
+            c.to_array().iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-7),
+            "{c:?}"
+        );
+    }
+    assert_eq!(mesh.tangents(), &[glam::Vec4::new(1.0, 0.0, 0.0, -1.0); 3][..]);
+    assert!(w.is_empty(), "{w:?}");
+    // Types the specification does not allow: unsigned normals, 32-bit texture coordinates,
+    // signed colours.
+    for (types, name) in [
+        ([r#""componentType": 5121, "normalized": true"#, i8n, u16n], "NORMAL"),
+        ([i8n, r#""componentType": 5125"#, u16n], "TEXCOORD_0"),
+        ([i8n, i8n, i8n], "COLOR_0"),
+    ] {
+        let p = write(&d, "bad.gltf", gltf(types).as_bytes());
+        let e = load_model(&p, &mut Vec::new()).unwrap_err().to_string();
+        assert!(
+            e.contains("bad.gltf") && e.contains(name) && e.contains("component type"),
+            "{e}"
+        );
+    }
+}

@@ -114,19 +114,61 @@ pub(super) fn packed<'b>(
     Some((bytes, a.data_type()))
 }
 
+/// The component types an attribute may have: the specification's, and KHR_mesh_quantization's
+/// (read whether or not the file names the extension).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Components {
+    /// Positions and texture coordinates: 32-bit floats, or 8- and 16-bit integers, signed or
+    /// not, normalized or not.
+    Any,
+    /// Normals and tangents: 32-bit floats, or normalized signed 8- and 16-bit integers.
+    Unit,
+    /// Vertex colours: 32-bit floats, or normalized unsigned 8- and 16-bit integers.
+    Colour,
+    /// Indices (checked by the caller).
+    Index,
+}
+
+impl Components {
+    fn allow(self, a: &::gltf::Accessor) -> bool {
+        use ::gltf::accessor::DataType as T;
+        match (self, a.data_type(), a.normalized()) {
+            (Components::Index, ..) => true,
+            // A normalized float is no type at all.
+            (_, T::F32, normalized) => !normalized,
+            (_, T::U32, _) => false,
+            (Components::Any, ..) => true,
+            (Components::Unit, T::I8 | T::I16, true) => true,
+            (Components::Colour, T::U8 | T::U16, true) => true,
+            _ => false,
+        }
+    }
+
+    fn allowed(self) -> &'static str {
+        match self {
+            Components::Any => "32-bit floats or 8- and 16-bit integers",
+            Components::Unit => "32-bit floats or normalized signed 8- and 16-bit integers",
+            Components::Colour => "32-bit floats or normalized unsigned 8- and 16-bit integers",
+            Components::Index => "unsigned integers",
+        }
+    }
+}
+
 pub(super) fn check_accessor(
     a: &::gltf::Accessor,
     buffers: &[Buffer],
     dims: &[::gltf::accessor::Dimensions],
-    float: bool,
+    components: Components,
 ) -> Result<(), String> {
     if !dims.contains(&a.dimensions()) {
         return Err(format!("type {:?}, expected {:?}", a.dimensions(), dims[0]));
     }
-    if float && (a.data_type() != ::gltf::accessor::DataType::F32 || a.normalized()) {
+    if !components.allow(a) {
         return Err(format!(
-            "component type {:?}; phong reads 32-bit floats here (quantized meshes are not read)",
-            a.data_type()
+            "component type {:?}{}; phong reads {} here",
+            a.data_type(),
+            if a.normalized() { " (normalized)" } else { "" },
+            components.allowed()
         ));
     }
     if a.count() == 0 {
@@ -162,6 +204,57 @@ pub(super) fn check_accessor(
         ));
     }
     Ok(())
+}
+
+/// A checked accessor's elements as `N` floats each (its first `N` components), whatever its
+/// component type: 32-bit floats as they are; integers, where normalized, mapped as the
+/// specification says (unsigned `c / MAX`, signed `max(c / MAX, −1)`), else their values
+/// (KHR_mesh_quantization; the node's transform or the texture transform scales them). `None`
+/// where an element lies outside its buffer (not after [`check_accessor`]) or the type has
+/// fewer than `N` components.
+pub(super) fn floats<const N: usize>(a: &::gltf::Accessor, buffers: &[Buffer]) -> Option<Vec<[f32; N]>> {
+    use ::gltf::accessor::DataType as T;
+    let view = a.view()?;
+    let (size, width) = (a.size(), a.data_type().size());
+    if a.dimensions().multiplicity() < N {
+        return None;
+    }
+    let stride = view.stride().unwrap_or(size);
+    let bytes = buffers
+        .get(view.buffer().index())?
+        .get(view.offset().checked_add(a.offset())?..)?;
+    let normalized = a.normalized();
+    let decode: fn(&[u8], bool) -> f32 = match a.data_type() {
+        T::F32 => |c, _| f32::from_le_bytes([c[0], c[1], c[2], c[3]]),
+        // (Unsigned, times `1 / MAX`, as the `gltf` crate's reader made them: within an ulp
+        // of `c / MAX`, and the images made before unchanged.)
+        T::U8 => |c, n| {
+            if n {
+                f32::from(c[0]) * 255.0_f32.recip()
+            } else {
+                f32::from(c[0])
+            }
+        },
+        T::U16 => |c, n| {
+            let v = f32::from(u16::from_le_bytes([c[0], c[1]]));
+            if n { v * 65535.0_f32.recip() } else { v }
+        },
+        T::I8 => |c, n| {
+            let v = f32::from(c[0] as i8);
+            if n { (v / 127.0).max(-1.0) } else { v }
+        },
+        T::I16 => |c, n| {
+            let v = f32::from(i16::from_le_bytes([c[0], c[1]]));
+            if n { (v / 32767.0).max(-1.0) } else { v }
+        },
+        T::U32 => return None,
+    };
+    (0..a.count())
+        .map(|k| {
+            let e = bytes.get(k.checked_mul(stride)?..)?.get(..size)?;
+            Some(std::array::from_fn(|j| decode(&e[j * width..], normalized)))
+        })
+        .collect()
 }
 
 /// `%20` and the like decoded (glTF URIs are percent-encoded).

@@ -27,7 +27,9 @@ use super::far_origin;
 use crate::Error;
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use base64::Engine;
-use buffers::{Buffer, check_accessor, load_buffers, packed_indices, packed_positions, percent_decode};
+use buffers::{
+    Buffer, Components, check_accessor, floats, load_buffers, packed_indices, packed_positions, percent_decode,
+};
 use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
 use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
 use std::collections::BTreeSet;
@@ -35,7 +37,8 @@ use std::path::Path;
 
 /// Extensions phong reads (or whose absence of support is harmless to the geometry); any
 /// other required extension is refused.
-const SUPPORTED: [&str; 5] = [
+const SUPPORTED: [&str; 6] = [
+    "KHR_mesh_quantization",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
@@ -104,9 +107,13 @@ pub fn read_gltf(
     } else {
         (std::borrow::Cow::Borrowed(bytes), None)
     };
-    let root: ::gltf::json::Root =
+    let mut root: ::gltf::json::Root =
         ::gltf::json::deserialize::from_slice(&json).map_err(|e| gltf_err(::gltf::Error::Deserialize(e)))?;
     check_before_validation(&root, &fail)?;
+    // Every required extension is one phong reads or can do without (checked above); the
+    // crate's validation would refuse those it does not parse itself (KHR_mesh_quantization,
+    // KHR_materials_unlit).
+    root.extensions_required.clear();
     let document = ::gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
     let buffers = load_buffers(doc, bin, resource, &fail)?;
@@ -278,15 +285,15 @@ fn check_primitive(
     let pos = prim
         .get(&::gltf::Semantic::Positions)
         .ok_or_else(|| fail(format!("{what} has no POSITION")))?;
-    check_accessor(&pos, buffers, &[Dimensions::Vec3], true)
+    check_accessor(&pos, buffers, &[Dimensions::Vec3], Components::Any)
         .map_err(|m| fail(format!("{what}: POSITION (accessor {}): {m}", pos.index())))?;
     let normal = prim.get(&::gltf::Semantic::Normals);
     if let Some(a) = &normal {
-        check_accessor(a, buffers, &[Dimensions::Vec3], true)
+        check_accessor(a, buffers, &[Dimensions::Vec3], Components::Unit)
             .map_err(|m| fail(format!("{what}: NORMAL (accessor {}): {m}", a.index())))?;
     }
     if let Some(a) = prim.indices() {
-        check_accessor(&a, buffers, &[Dimensions::Scalar], false)
+        check_accessor(&a, buffers, &[Dimensions::Scalar], Components::Index)
             .map_err(|m| fail(format!("{what}: indices (accessor {}): {m}", a.index())))?;
         // Unsigned integers only, as the specification says (the crate's reader treats any
         // other component type as unreachable: found by the `gltf` fuzz target).
@@ -301,12 +308,12 @@ fn check_primitive(
     let sets: BTreeSet<u32> = texture_infos(&prim.material()).iter().map(|t| t.set).collect();
     for &set in &sets {
         if let Some(a) = prim.get(&::gltf::Semantic::TexCoords(set)) {
-            check_accessor(&a, buffers, &[Dimensions::Vec2], false)
+            check_accessor(&a, buffers, &[Dimensions::Vec2], Components::Any)
                 .map_err(|m| fail(format!("{what}: TEXCOORD_{set} (accessor {}): {m}", a.index())))?;
         }
     }
     if let Some(a) = prim.get(&::gltf::Semantic::Colors(0)) {
-        check_accessor(&a, buffers, &[Dimensions::Vec3, Dimensions::Vec4], false)
+        check_accessor(&a, buffers, &[Dimensions::Vec3, Dimensions::Vec4], Components::Colour)
             .map_err(|m| fail(format!("{what}: COLOR_0 (accessor {}): {m}", a.index())))?;
     }
     Ok(normal.is_some())
@@ -376,8 +383,9 @@ fn geometry(
     let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
     let mirrored = DMat3::from_mat4(*world).determinant() < 0.0;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|b| &b[..]));
+    let attribute = |s: ::gltf::Semantic| prim.get(&s);
     let positions = packed_positions(prim, buffers)
-        .map_or_else(|| reader.read_positions().map(Iterator::collect), Some)
+        .or_else(|| floats::<3>(&attribute(::gltf::Semantic::Positions)?, buffers))
         .ok_or_else(|| fail(format!("{what}: POSITION cannot be read")))?;
     if let Some(i) = phong_core::mesh::not_finite_at(bytemuck::cast_slice(&positions)) {
         let p = positions[i];
@@ -385,10 +393,17 @@ fn geometry(
     }
     let n = positions.len();
     // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
-    let (colors, colours_dropped) = match reader.read_colors(0) {
+    let colours = attribute(::gltf::Semantic::Colors(0)).map(|a| match a.dimensions() {
+        ::gltf::accessor::Dimensions::Vec4 => {
+            floats::<4>(&a, buffers).map(|c| c.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
+        }
+        _ => floats::<3>(&a, buffers),
+    });
+    let (colors, colours_dropped) = match colours {
         Some(c) => {
             let c: Vec<Color> = c
-                .into_rgb_f32()
+                .unwrap_or_default()
+                .into_iter()
                 .map(|[r, g, b]| Color::new(r.max(0.0), g.max(0.0), b.max(0.0)))
                 .collect();
             if c.len() == n && c.iter().all(|c| c.is_finite()) {
@@ -434,9 +449,11 @@ fn geometry(
                 .collect(),
         )
     };
-    let (normals, has_normals) = match reader.read_normals().filter(|_| has_normal_accessor) {
+    let file_normals = attribute(::gltf::Semantic::Normals).filter(|_| has_normal_accessor);
+    let (normals, has_normals) = match file_normals.map(|a| floats::<3>(&a, buffers).unwrap_or_default()) {
         Some(ns) => {
             let ns: Vec<Vec3> = ns
+                .into_iter()
                 .map(|v| {
                     (normal_matrix * DVec3::from_array(v.map(f64::from)))
                         .normalize_or_zero()
@@ -452,13 +469,12 @@ fn geometry(
     // by the node's matrix itself; a mirror flips the bitangent's sign.
     let tangents: Vec<Vec4> = match prim.get(&::gltf::Semantic::Tangents) {
         Some(a) if has_normals => {
-            check_accessor(&a, buffers, &[::gltf::accessor::Dimensions::Vec4], true)
+            check_accessor(&a, buffers, &[::gltf::accessor::Dimensions::Vec4], Components::Unit)
                 .map_err(|m| fail(format!("{what}: TANGENT (accessor {}): {m}", a.index())))?;
             let linear = DMat3::from_mat4(*world);
-            let t: Vec<Vec4> = reader
-                .read_tangents()
+            let t: Vec<Vec4> = floats::<4>(&a, buffers)
+                .unwrap_or_default()
                 .into_iter()
-                .flatten()
                 .map(|[x, y, z, w]| {
                     let d = (linear * DVec3::new(x.into(), y.into(), z.into())).normalize_or_zero();
                     d.as_vec3().extend(if mirrored { -w } else { w })
@@ -506,7 +522,6 @@ impl Textures<'_> {
     ) -> (Maps, Vec<Vec2>, Vec<Vec2>) {
         let path = self.path;
         let mat = &prim.material();
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|b| &b[..]));
         // The mesh's first set is the normal texture's (its tangents are made from it), else
         // the base colour's (else the first used); its second, the other of TEXCOORD_0 and
         // TEXCOORD_1 used, if any. A third set is not read.
@@ -518,9 +533,9 @@ impl Textures<'_> {
             .map(|t| t.set);
         let second = infos.iter().map(|t| t.set).find(|&s| Some(s) != first && s <= 1);
         let read_set = |set: Option<u32>| -> Vec<Vec2> {
-            match set.and_then(|s| reader.read_tex_coords(s)) {
+            match set.and_then(|s| floats::<2>(&prim.get(&::gltf::Semantic::TexCoords(s))?, buffers)) {
                 Some(t) => {
-                    let uv: Vec<Vec2> = t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
+                    let uv: Vec<Vec2> = t.into_iter().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect();
                     if uv.len() == n && uv.iter().all(|u| u.is_finite()) {
                         uv
                     } else {
