@@ -212,8 +212,18 @@ pub(super) fn check_accessor(
 /// (KHR_mesh_quantization; the node's transform or the texture transform scales them). `None`
 /// where an element lies outside its buffer (not after [`check_accessor`]) or the type has
 /// fewer than `N` components.
-pub(super) fn floats<const N: usize>(a: &::gltf::Accessor, buffers: &[Buffer]) -> Option<Vec<[f32; N]>> {
+pub(super) fn floats<const N: usize>(a: &::gltf::Accessor, buffers: &[Buffer]) -> Option<Vec<[f32; N]>>
+where
+    [f32; N]: bytemuck::Pod,
+{
     use ::gltf::accessor::DataType as T;
+    // Packed floats of exactly `N` components (most files): the bytes are the values.
+    if let Some((bytes, T::F32)) = packed(a, buffers)
+        && cfg!(target_endian = "little")
+        && a.dimensions().multiplicity() == N
+    {
+        return Some(bytemuck::pod_collect_to_vec(bytes));
+    }
     let view = a.view()?;
     let (size, width) = (a.size(), a.data_type().size());
     if a.dimensions().multiplicity() < N {
