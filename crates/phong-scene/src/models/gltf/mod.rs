@@ -330,8 +330,10 @@ enum Placed {
 impl Placed {
     /// A node without a transform: what the identity gives in f64, without the f64 (the same
     /// numbers, a zero's sign made + as adding the matrix's translation makes it).
-    fn file(positions: &[[f32; 3]]) -> Placed {
-        Placed::File(positions.iter().map(|p| Vec3::from_array(*p) + Vec3::ZERO).collect())
+    fn file(positions: Vec<[f32; 3]>) -> Placed {
+        let mut p: Vec<Vec3> = bytemuck::cast_vec(positions);
+        p.iter_mut().for_each(|p| *p += Vec3::ZERO);
+        Placed::File(p)
     }
 
     fn len(&self) -> usize {
@@ -414,7 +416,7 @@ fn geometry(
         }
         None => (Vec::new(), false),
     };
-    let indices: Vec<u32> = match (packed_indices(prim, buffers), reader.read_indices()) {
+    let mut indices: Vec<u32> = match (packed_indices(prim, buffers), reader.read_indices()) {
         (Some(i), _) => i,
         (None, Some(i)) => i.into_u32().collect(),
         (None, None) => (0..n as u32).collect(),
@@ -434,13 +436,18 @@ fn geometry(
         ::gltf::mesh::Mode::TriangleFan => (2..indices.len())
             .map(|k| [indices[0], indices[k - 1], indices[k]])
             .collect(),
-        _ => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        _ => {
+            // The indices' own memory where its size allows (most files), else a copy.
+            indices.truncate(indices.len() / 3 * 3);
+            bytemuck::try_cast_vec(indices)
+                .unwrap_or_else(|(_, i)| i.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
+        }
     };
     if mirrored {
         tris.iter_mut().for_each(|t| t.swap(1, 2));
     }
     let placed = if *world == DMat4::IDENTITY {
-        Placed::file(&positions)
+        Placed::file(positions)
     } else {
         Placed::World(
             positions
@@ -905,7 +912,7 @@ mod tests {
                 .map(|v| v.to_array().map(f32::to_bits))
                 .collect()
         };
-        let placed = || Placed::file(&file);
+        let placed = || Placed::file(file.to_vec());
         for origin in [DVec3::ZERO, DVec3::new(1.0e6, -2.0, 0.5)] {
             let ours: Vec<[u32; 3]> = placed()
                 .less(origin)
