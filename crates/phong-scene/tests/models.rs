@@ -1571,6 +1571,11 @@ fn gltf_quantized_attributes_are_read() {
     }
     assert_eq!(mesh.tangents(), &[glam::Vec4::new(1.0, 0.0, 0.0, -1.0); 3][..]);
     assert!(w.is_empty(), "{w:?}");
+    // Unsigned colours without the `normalized` flag (which the specification asks for) are
+    // read as normalized all the same, as before.
+    let p = write(&d, "q2.gltf", gltf([i8n, i8n, r#""componentType": 5123"#]).as_bytes());
+    let parts2 = load_model(&p, &mut Vec::new()).unwrap();
+    assert_eq!(parts2[0].mesh.colors(), mesh.colors());
     // Types the specification does not allow: unsigned normals, 32-bit texture coordinates,
     // signed colours.
     for (types, name) in [

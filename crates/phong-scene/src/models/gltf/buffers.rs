@@ -123,7 +123,8 @@ pub(super) enum Components {
     Any,
     /// Normals and tangents: 32-bit floats, or normalized signed 8- and 16-bit integers.
     Unit,
-    /// Vertex colours: 32-bit floats, or normalized unsigned 8- and 16-bit integers.
+    /// Vertex colours: 32-bit floats, or normalized unsigned 8- and 16-bit integers (read as
+    /// normalized where a file leaves the flag out, as the `gltf` crate's reader read them).
     Colour,
     /// Indices (checked by the caller).
     Index,
@@ -139,7 +140,7 @@ impl Components {
             (_, T::U32, _) => false,
             (Components::Any, ..) => true,
             (Components::Unit, T::I8 | T::I16, true) => true,
-            (Components::Colour, T::U8 | T::U16, true) => true,
+            (Components::Colour, T::U8 | T::U16, _) => true,
             _ => false,
         }
     }
@@ -216,6 +217,19 @@ pub(super) fn floats<const N: usize>(a: &::gltf::Accessor, buffers: &[Buffer]) -
 where
     [f32; N]: bytemuck::Pod,
 {
+    floats_as(a, buffers, a.normalized())
+}
+
+/// [`floats`], integers read as normalized where `normalized` (vertex colours, whatever their
+/// flag says).
+pub(super) fn floats_as<const N: usize>(
+    a: &::gltf::Accessor,
+    buffers: &[Buffer],
+    normalized: bool,
+) -> Option<Vec<[f32; N]>>
+where
+    [f32; N]: bytemuck::Pod,
+{
     use ::gltf::accessor::DataType as T;
     // Packed floats of exactly `N` components (most files): the bytes are the values.
     if let Some((bytes, T::F32)) = packed(a, buffers)
@@ -233,7 +247,6 @@ where
     let bytes = buffers
         .get(view.buffer().index())?
         .get(view.offset().checked_add(a.offset())?..)?;
-    let normalized = a.normalized();
     let decode: fn(&[u8], bool) -> f32 = match a.data_type() {
         T::F32 => |c, _| f32::from_le_bytes([c[0], c[1], c[2], c[3]]),
         // (Unsigned, times `1 / MAX`, as the `gltf` crate's reader made them: within an ulp

@@ -28,7 +28,8 @@ use crate::Error;
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use base64::Engine;
 use buffers::{
-    Buffer, Components, check_accessor, floats, load_buffers, packed_indices, packed_positions, percent_decode,
+    Buffer, Components, check_accessor, floats, floats_as, load_buffers, packed_indices, packed_positions,
+    percent_decode,
 };
 use glam::{DMat3, DMat4, DVec3, Mat2, Vec2, Vec3, Vec4};
 use phong_core::{Color, Filter, Maps, Material, Mesh, MetalRough, MipFilter, Sampler, UvTransform, Wrap};
@@ -397,9 +398,9 @@ fn geometry(
     // COLOR_0 multiplies the base colour (the specification): a tint of the diffuse.
     let colours = attribute(::gltf::Semantic::Colors(0)).map(|a| match a.dimensions() {
         ::gltf::accessor::Dimensions::Vec4 => {
-            floats::<4>(&a, buffers).map(|c| c.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
+            floats_as::<4>(&a, buffers, true).map(|c| c.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
         }
-        _ => floats::<3>(&a, buffers),
+        _ => floats_as::<3>(&a, buffers, true),
     });
     let (colors, colours_dropped) = match colours {
         Some(c) => {
