@@ -1591,3 +1591,72 @@ fn gltf_quantized_attributes_are_read() {
         );
     }
 }
+
+/// EXT_texture_webp (glTF-Transform's and gltfpack's WebP textures): a texture whose only
+/// image is the extension's WebP is read, required or not, its texels those of the lossless
+/// WebP written here; where a texture gives both, its core image (the fallback) is read; a
+/// texture with neither is not used, with a warning naming it.
+#[test]
+fn gltf_webp_textures_are_read() {
+    let d = dir("gltf_webp");
+    let webp = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([255 * x as u8, 255 * y as u8, 0, 255]));
+    let mut bytes = Vec::new();
+    image::codecs::webp::WebPEncoder::new_lossless(&mut bytes)
+        .encode(webp.as_raw(), 2, 2, image::ExtendedColorType::Rgba8)
+        .unwrap();
+    write(&d, "t.webp", &bytes);
+    image::RgbImage::from_pixel(2, 2, image::Rgb([0, 0, 255]))
+        .save(d.join("t.png"))
+        .unwrap();
+    let mut bin = Vec::new();
+    for x in [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+    ] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let gltf = |texture: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"],
+  "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}],
+  "images": [{{"uri": "t.png"}}, {{"uri": "t.webp", "mimeType": "image/webp"}}],
+  "textures": [{texture}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+        )
+    };
+    let texels = |texture: &str| {
+        let p = write(&d, "w.gltf", gltf(texture).as_bytes());
+        let mut w = Vec::new();
+        let parts = load_model(&p, &mut w).unwrap();
+        let map = parts[0].maps.diffuse.as_ref().map(|m| {
+            let t = &m.texture;
+            [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(x, y)| t.texel(0, x, y))
+        });
+        (map, w)
+    };
+    // The WebP's corners: red grows with x, green with the image's y, which runs down (texel
+    // rows run up, OpenGL's way: texel row 0 is the image's last; sRGB 255 and 0 are 1 and 0).
+    let (webp_texels, w) = texels(r#"{"extensions": {"EXT_texture_webp": {"source": 1}}}"#);
+    assert!(w.is_empty(), "{w:?}");
+    let want = [
+        [0.0, 1.0, 0.0, 1.0],
+        [1.0, 1.0, 0.0, 1.0],
+        [0.0, 0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0, 1.0],
+    ];
+    assert_eq!(webp_texels, Some(want));
+    let (fallback, _) = texels(r#"{"source": 0, "extensions": {"EXT_texture_webp": {"source": 1}}}"#);
+    assert_eq!(fallback, Some([[0.0, 0.0, 1.0, 1.0]; 4]), "the core image, blue");
+    let (none, w) = texels("{}");
+    assert_eq!(none, None);
+    assert!(
+        w.len() == 1 && w[0].contains("w.gltf") && w[0].contains("texture 0 has no image"),
+        "{w:?}"
+    );
+}

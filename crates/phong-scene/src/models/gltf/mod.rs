@@ -38,8 +38,9 @@ use std::path::Path;
 
 /// Extensions phong reads (or whose absence of support is harmless to the geometry); any
 /// other required extension is refused.
-const SUPPORTED: [&str; 6] = [
+const SUPPORTED: [&str; 7] = [
     "KHR_mesh_quantization",
+    "EXT_texture_webp",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
@@ -123,6 +124,7 @@ pub fn read_gltf(
     let (mut skipped_modes, mut colours) = (0usize, 0usize);
     let mut textures = Textures {
         path,
+        doc,
         resource,
         cache: TextureCache::default(),
         white: None,
@@ -511,6 +513,7 @@ fn geometry(
 /// emission map (one for the file, uploaded once by the GPU).
 struct Textures<'a> {
     path: &'a Path,
+    doc: &'a ::gltf::Document,
     resource: &'a dyn Fn(&str) -> Result<Vec<u8>, String>,
     cache: TextureCache,
     white: Option<std::sync::Arc<phong_core::Texture>>,
@@ -577,7 +580,17 @@ impl Textures<'_> {
             t.set = u32::from(Some(t.set) != first);
         }
         let maps = if mat.index().is_some() && !uvs.is_empty() {
-            let requests: Vec<MapRequest> = infos.iter().filter_map(|t| texture_request(t, buffers, what)).collect();
+            for t in infos.iter().filter(|t| texture_image(&t.texture, self.doc).is_none()) {
+                warnings.push(format!(
+                    "{}: {what}: texture {} has no image phong reads (no source, nor EXT_texture_webp's): not used",
+                    path.display(),
+                    t.texture.index()
+                ));
+            }
+            let requests: Vec<MapRequest> = infos
+                .iter()
+                .filter_map(|t| texture_request(t, self.doc, buffers, what))
+                .collect();
             let mut maps = resolve(
                 &requests,
                 mat.name().unwrap_or("(unnamed)"),
@@ -817,12 +830,22 @@ fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
     out
 }
 
+/// A texture's image: its own `source`, else EXT_texture_webp's (a WebP image without a
+/// fallback; where a file gives both, the fallback is read, as before the extension was).
+fn texture_image<'d>(texture: &::gltf::Texture<'d>, doc: &'d ::gltf::Document) -> Option<::gltf::Image<'d>> {
+    texture.source().or_else(|| {
+        let i = texture.extension_value("EXT_texture_webp")?.get("source")?.as_u64()?;
+        doc.images().nth(usize::try_from(i).ok()?)
+    })
+}
+
 /// A glTF texture as a map request: its image (a buffer view's bytes, a data URI, or a file
 /// read by the loader's reader), sampler and KHR_texture_transform, in OpenGL's coordinates.
-fn texture_request(tex: &Tex, buffers: &[Buffer], what: &str) -> Option<MapRequest> {
+fn texture_request(tex: &Tex, doc: &::gltf::Document, buffers: &[Buffer], what: &str) -> Option<MapRequest> {
     let (slot, texture) = (tex.slot, tex.texture.clone());
-    let name = format!("image {}", texture.source().index());
-    let source = match texture.source().source() {
+    let image = texture_image(&texture, doc)?;
+    let name = format!("image {}", image.index());
+    let source = match image.source() {
         ::gltf::image::Source::View { view, .. } => {
             let data = buffers.get(view.buffer().index())?;
             let end = view.offset().checked_add(view.length())?;
