@@ -56,24 +56,6 @@ pub(super) fn load_buffers<'b>(
     Ok(buffers)
 }
 
-/// Checks an accessor before the reader trusts it: its type, a float component type where
-/// `float`, at least one element, and every element inside its buffer view and buffer.
-/// A primitive's positions read as a slice, where they are packed 32-bit floats.
-pub(super) fn packed_positions(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<[f32; 3]>> {
-    let (bytes, kind) = packed(&prim.get(&::gltf::Semantic::Positions)?, buffers)?;
-    (kind == ::gltf::accessor::DataType::F32).then(|| {
-        if cfg!(target_endian = "little") {
-            // The file's bytes are the floats (a copy, aligned).
-            bytemuck::pod_collect_to_vec(bytes)
-        } else {
-            bytes
-                .chunks_exact(12)
-                .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]])))
-                .collect()
-        }
-    })
-}
-
 /// A primitive's indices read as a slice, where they are packed 16- or 32-bit integers.
 pub(super) fn packed_indices(prim: &::gltf::Primitive, buffers: &[Buffer]) -> Option<Vec<u32>> {
     let (b, kind) = packed(&prim.indices()?, buffers)?;
@@ -155,6 +137,8 @@ impl Components {
     }
 }
 
+/// Checks an accessor before it is read: its type, its component type (`components`), at
+/// least one element, nothing sparse, and every element inside its buffer view and buffer.
 pub(super) fn check_accessor(
     a: &::gltf::Accessor,
     buffers: &[Buffer],
