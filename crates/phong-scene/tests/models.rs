@@ -1660,3 +1660,73 @@ fn gltf_webp_textures_are_read() {
         "{w:?}"
     );
 }
+
+/// KHR_materials_unlit (photogrammetry scans and baked models): the base colour as it is,
+/// whatever the lights, so the material is all emission (its factor, its alpha) with no
+/// ambient, diffuse or specular term, and the base colour texture is its emission map; the
+/// other textures do not apply, and vertex colours (a tint of the diffuse) are left out with
+/// a warning. Required or only used, it is read alike.
+#[test]
+fn gltf_unlit_materials_are_emission() {
+    let d = dir("gltf_unlit");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0]))
+        .save(d.join("t.png"))
+        .unwrap();
+    let mut bin = Vec::new();
+    for x in [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+    ] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    for _ in 0..3 {
+        bin.extend_from_slice(&[255, 255, 0, 255]);
+    }
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let gltf = |required: &str, unlit: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_materials_unlit"], {required}
+  "buffers": [{{"byteLength": 72, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}},
+                  {{"buffer": 0, "byteOffset": 60, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC4"}}],
+  "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.2, 0.4, 0.6, 0.5], "metallicFactor": 0,
+                                           "baseColorTexture": {{"index": 0}}}},
+                  "normalTexture": {{"index": 0}}, "emissiveFactor": [1, 1, 1]{unlit}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1, "COLOR_0": 2}}, "material": 0}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#
+        )
+    };
+    let unlit = r#", "extensions": {"KHR_materials_unlit": {}}"#;
+    for required in ["", r#""extensionsRequired": ["KHR_materials_unlit"],"#] {
+        let p = write(&d, "u.gltf", gltf(required, unlit).as_bytes());
+        let mut w = Vec::new();
+        let parts = load_model(&p, &mut w).unwrap();
+        let (m, maps) = (parts[0].material.unwrap(), &parts[0].maps);
+        let black = phong_core::Color::BLACK;
+        assert_eq!((m.ambient(), m.diffuse(), m.specular()), (black, black, black));
+        assert_eq!((m.emission(), m.alpha()), (phong_core::Color::new(0.2, 0.4, 0.6), 0.5));
+        let emission = maps
+            .emission
+            .as_ref()
+            .expect("the base colour texture as the emission map");
+        assert_eq!(emission.texture.texel(0, 0, 0), [1.0, 0.0, 0.0, 1.0]);
+        assert!(maps.diffuse.is_none() && maps.normal.is_none());
+        assert!(parts[0].mesh.colors().is_empty());
+        assert!(
+            w.len() == 1 && w[0].contains("u.gltf") && w[0].contains("COLOR_0") && w[0].contains("unlit"),
+            "{w:?}"
+        );
+    }
+    // The same material lit: the base colour is its diffuse, the texture its diffuse map.
+    let p = write(&d, "l.gltf", gltf("", "").as_bytes());
+    let parts = load_model(&p, &mut Vec::new()).unwrap();
+    assert_eq!(
+        parts[0].material.unwrap().diffuse(),
+        phong_core::Color::new(0.2, 0.4, 0.6)
+    );
+    assert!(parts[0].maps.diffuse.is_some());
+}

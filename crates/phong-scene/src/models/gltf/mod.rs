@@ -9,7 +9,8 @@
 //! shininess from the roughness as Blinn-Phong's equivalent of the Beckmann distribution:
 //! `α = roughness²`, `s = 2/α² − 2` (capped at [`MetalRough::MAX_SHININESS`]).
 //! KHR_materials_pbrSpecularGlossiness: `diffuse`, `specular` as given, `roughness = 1 −
-//! glossiness`. A primitive without a material gets OpenGL's default material (as an OBJ
+//! glossiness`. KHR_materials_unlit: the base colour as emission, nothing lit. A primitive
+//! without a material gets OpenGL's default material (as an OBJ
 //! without MTL), not glTF's metallic default, which would be a black mirror here.
 //!
 //! Textures: the base colour texture (sRGB) is the diffuse map (modulating the diffuse and
@@ -34,8 +35,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use textures::{Textures, texture_infos};
 
-/// Extensions phong reads (or whose absence of support is harmless to the geometry); any
-/// other required extension is refused.
+/// Extensions phong reads; any other required extension is refused.
 const SUPPORTED: [&str; 7] = [
     "KHR_mesh_quantization",
     "EXT_texture_webp",
@@ -110,9 +110,8 @@ pub fn read_gltf(
     let mut root: ::gltf::json::Root =
         ::gltf::json::deserialize::from_slice(&json).map_err(|e| gltf_err(::gltf::Error::Deserialize(e)))?;
     check_before_validation(&root, &fail)?;
-    // Every required extension is one phong reads or can do without (checked above); the
-    // crate's validation would refuse those it does not parse itself (KHR_mesh_quantization,
-    // KHR_materials_unlit).
+    // Every required extension is one phong reads (checked above); the crate's validation
+    // would refuse those it does not parse itself (KHR_mesh_quantization).
     root.extensions_required.clear();
     let document = ::gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
@@ -169,6 +168,16 @@ pub fn read_gltf(
             );
             // The file's tangents serve a normal map; without one they are not kept.
             let tangents = if maps.normal.is_some() { g.tangents } else { Vec::new() };
+            // Vertex colours tint the diffuse term, which an unlit material has none of.
+            let colors = if mat.unlit() && !g.colors.is_empty() {
+                warnings.push(format!(
+                    "{}: {what}: vertex colours (COLOR_0) not used: its material is unlit (KHR_materials_unlit)",
+                    path.display()
+                ));
+                Vec::new()
+            } else {
+                g.colors
+            };
             pending.push(Pending {
                 name,
                 tangents,
@@ -179,7 +188,7 @@ pub fn read_gltf(
                 has_normals: g.has_normals,
                 uvs,
                 uvs1,
-                colors: g.colors,
+                colors,
                 maps,
             });
         }
@@ -591,6 +600,14 @@ struct Pending {
 fn phong_material(m: &::gltf::Material) -> Material {
     let pbr = m.pbr_metallic_roughness();
     let base = pbr.base_color_factor();
+    let clean = |x: f32| if x.is_finite() { x.max(0.0) } else { 0.0 };
+    if m.unlit() {
+        // KHR_materials_unlit: the base colour as it is, whatever the lights: all emission
+        // (its texture the emission map, see `texture_infos`).
+        let e = Color::new(clean(base[0]), clean(base[1]), clean(base[2]));
+        let built = Material::new(Color::BLACK, Color::BLACK, Color::BLACK, e, 1.0).unwrap_or_default();
+        return built.with_alpha(clean(base[3]).min(1.0)).unwrap_or(built);
+    }
     let (diffuse, specular, roughness, alpha) = match m.pbr_specular_glossiness() {
         Some(sg) => {
             let d = sg.diffuse_factor();
@@ -615,7 +632,7 @@ fn phong_material(m: &::gltf::Material) -> Material {
     let shininess = MetalRough::shininess(roughness);
     let strength = m.emissive_strength().unwrap_or(1.0);
     let col = |c: [f32; 3]| {
-        let c = c.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+        let c = c.map(clean);
         Color::new(c[0], c[1], c[2])
     };
     let d = col(diffuse);

@@ -171,6 +171,12 @@ impl<'a> Tex<'a> {
 /// occlusion, normal.
 pub(super) fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
     let mut out = Vec::new();
+    if mat.unlit() {
+        // KHR_materials_unlit: the base colour texture alone, as the emission map (the
+        // material is all emission); the other textures do not apply.
+        let base = mat.pbr_metallic_roughness().base_color_texture();
+        return base.map(|t| vec![Tex::of(Slot::Emission, t)]).unwrap_or_default();
+    }
     let diffuse = match mat.pbr_specular_glossiness() {
         Some(sg) => sg.diffuse_texture(),
         None => mat.pbr_metallic_roughness().base_color_texture(),
