@@ -1721,6 +1721,11 @@ fn gltf_unlit_materials_are_emission() {
             "{w:?}"
         );
     }
+    assert!(parts_alpha(&gltf("", unlit), &d).is_none(), "opaque: no alpha map");
+    // Cut out: the base colour texture's alpha is the alpha map, tested at the cutoff.
+    let mask = r#", "alphaMode": "MASK", "alphaCutoff": 0.25, "extensions": {"KHR_materials_unlit": {}}"#;
+    let (channel, cutoff) = parts_alpha(&gltf("", mask), &d).expect("an alpha map");
+    assert_eq!((channel, cutoff), (phong_core::Channel::A, Some(0.25)));
     // The same material lit: the base colour is its diffuse, the texture its diffuse map.
     let p = write(&d, "l.gltf", gltf("", "").as_bytes());
     let parts = load_model(&p, &mut Vec::new()).unwrap();
@@ -1729,4 +1734,13 @@ fn gltf_unlit_materials_are_emission() {
         phong_core::Color::new(0.2, 0.4, 0.6)
     );
     assert!(parts[0].maps.diffuse.is_some());
+}
+
+/// The alpha map's channel and the alpha test's cutoff of the first part of the glTF `json`
+/// (written in `d`), if it has an alpha map.
+fn parts_alpha(json: &str, d: &Path) -> Option<(phong_core::Channel, Option<f32>)> {
+    let p = write(d, "a.gltf", json.as_bytes());
+    let parts = load_model(&p, &mut Vec::new()).unwrap();
+    let maps = &parts[0].maps;
+    maps.alpha.as_ref().map(|(_, c)| (*c, maps.alpha_cutoff))
 }

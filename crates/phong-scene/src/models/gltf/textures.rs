@@ -6,7 +6,7 @@ use super::buffers::{Buffer, floats, percent_decode};
 use crate::texture_file::{MapRequest, Slot, Source, TextureCache, resolve};
 use base64::Engine;
 use glam::{Mat2, Vec2};
-use phong_core::{Color, Filter, Maps, Material, MipFilter, Sampler, UvTransform, Wrap};
+use phong_core::{Channel, Color, Filter, Maps, Material, MipFilter, Sampler, UvTransform, Wrap};
 use std::path::Path;
 
 /// The file's textures as they are read: where from, the images decoded so far, and the white
@@ -98,9 +98,10 @@ impl Textures<'_> {
                 &mut self.cache,
                 warnings,
             );
-            if mat.alpha_mode() == ::gltf::material::AlphaMode::Mask {
-                maps.alpha_cutoff = Some(mat.alpha_cutoff().unwrap_or(0.5));
-            }
+            // The alpha test where the material asks for it (an alpha map alone would
+            // bring one).
+            maps.alpha_cutoff =
+                (mat.alpha_mode() == ::gltf::material::AlphaMode::Mask).then(|| mat.alpha_cutoff().unwrap_or(0.5));
             // The factors go with the map, and the material becomes the one it scales.
             if let (Some(mr), Some(m)) = (&mut maps.metal_rough, &mut *material) {
                 let pbr = mat.pbr_metallic_roughness();
@@ -173,9 +174,16 @@ pub(super) fn texture_infos<'a>(mat: &::gltf::Material<'a>) -> Vec<Tex<'a>> {
     let mut out = Vec::new();
     if mat.unlit() {
         // KHR_materials_unlit: the base colour texture alone, as the emission map (the
-        // material is all emission); the other textures do not apply.
-        let base = mat.pbr_metallic_roughness().base_color_texture();
-        return base.map(|t| vec![Tex::of(Slot::Emission, t)]).unwrap_or_default();
+        // material is all emission) and, where the material is cut out or blended, as the
+        // alpha map; the other textures do not apply.
+        let Some(base) = mat.pbr_metallic_roughness().base_color_texture() else {
+            return out;
+        };
+        if mat.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
+            out.push(Tex::of(Slot::Alpha, base.clone()));
+        }
+        out.insert(0, Tex::of(Slot::Emission, base));
+        return out;
     }
     let diffuse = match mat.pbr_specular_glossiness() {
         Some(sg) => sg.diffuse_texture(),
@@ -291,7 +299,8 @@ fn texture_request(tex: &Tex, doc: &::gltf::Document, buffers: &[Buffer], what: 
         source,
         transform: flip.after(&m.after(&flip)),
         sampler,
-        channel: None,
+        // (An unlit material's alpha map: its base colour texture's alpha.)
+        channel: (slot == Slot::Alpha).then_some(Channel::A),
         srgb: true,
         at: what.to_string(),
         scale: tex.scale,
