@@ -270,6 +270,21 @@ impl Mesh {
         Ok(self)
     }
 
+    /// The mesh with each vertex moved to `f` of its position (which must stay finite), in
+    /// place, every other attribute kept.
+    pub fn with_positions_mapped(mut self, f: impl Fn(Vec3) -> Vec3) -> Result<Self, Error> {
+        for p in &mut self.positions {
+            *p = f(*p);
+        }
+        match first_not_finite(&self.positions) {
+            Some(p) => Err(Error::InvalidPosition {
+                what: "mesh vertex",
+                value: p.to_array(),
+            }),
+            None => Ok(self),
+        }
+    }
+
     /// The mesh with a second set of texture coordinates (glTF's `TEXCOORD_1`, read by the
     /// maps whose [`crate::TextureMap::set`] is 1), as [`Mesh::with_uvs`].
     pub fn with_uvs1(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
@@ -554,6 +569,14 @@ impl Mesh {
     /// the last of the chain are further apart than the crease angle.
     pub fn with_crease_normals(&self, crease_deg: f32) -> Mesh {
         self.crease_normals(crease_deg).0
+    }
+
+    /// [`Mesh::with_crease_normals`] of a mesh no longer needed: where its positions are all
+    /// distinct and it has no other attribute, its arrays become the new mesh's (no copy).
+    pub fn into_crease_normals(mut self, crease_deg: f32) -> Mesh {
+        let positions = std::mem::take(&mut self.positions);
+        let triangles = std::mem::take(&mut self.triangles);
+        self.crease_of(positions.into(), triangles.into(), crease_deg).0
     }
 }
 

@@ -229,12 +229,7 @@ fn fitted(mut mesh: Mesh, fit_frame: Option<(glam::DVec3, f64)>) -> Result<Mesh,
         // smallest normal number). A uniform scale and a move: the file's normals keep
         // their directions. Fitted before the normals are computed (at 1e30, f32 cross
         // products overflow).
-        let positions = mesh
-            .positions()
-            .iter()
-            .map(|x| ((x.as_dvec3() - centre) / radius).as_vec3())
-            .collect();
-        mesh = mesh.with_positions(positions)?;
+        mesh = mesh.with_positions_mapped(|x| ((x.as_dvec3() - centre) / radius).as_vec3())?;
     }
     Ok(mesh)
 }
@@ -247,7 +242,7 @@ fn with_normals(mesh: Mesh, choice: &str, crease: f32) -> Mesh {
         || match choice {
             "flat" => mesh.with_flat_normals(),
             "smooth" => mesh.with_smooth_normals(),
-            "angle" => mesh.with_crease_normals(crease),
+            "angle" => mesh.into_crease_normals(crease),
             _ => mesh,
         },
     )
