@@ -920,6 +920,62 @@ mod tests {
         );
     }
 
+    /// [`closedness`] from its definition: every edge of a face of three distinct positions
+    /// counted in a map with its faces' directions.
+    fn closedness_by_map(parts: &[ModelPart]) -> Closed {
+        let key = |p: Vec3| p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), (usize, i64)> = Default::default();
+        let mut volume = 0.0f64;
+        for p in parts {
+            for t in p.mesh.triangles() {
+                let [a, b, c] = t.map(|i| p.mesh.positions()[i as usize]);
+                let [ka, kb, kc] = [a, b, c].map(key);
+                if ka == kb || kb == kc || kc == ka {
+                    continue;
+                }
+                volume += a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3()));
+                for (x, y) in [(ka, kb), (kb, kc), (kc, ka)] {
+                    let e = edges.entry((x.min(y), x.max(y))).or_default();
+                    e.0 += 1;
+                    e.1 += if x < y { 1 } else { -1 };
+                }
+            }
+        }
+        let open_edges = edges.values().filter(|e| e.0 != 2).count();
+        let inconsistent = edges.values().filter(|e| e.0 == 2 && e.1 != 0).count();
+        match (open_edges + inconsistent, volume > 0.0) {
+            (0, true) => Closed::Outward,
+            (0, false) => Closed::Inward,
+            _ => Closed::Open {
+                open_edges,
+                inconsistent,
+            },
+        }
+    }
+
+    proptest::proptest! {
+        /// Faces over a few positions (some equal, some faces repeated, turned or degenerate),
+        /// in one part or two: the counts the definition gives.
+        #[test]
+        fn closedness_is_the_maps(
+            faces in proptest::collection::vec((0u32..7, 0u32..7, 0u32..7), 1..40),
+            split in 0usize..40,
+        ) {
+            let values = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE, Vec3::new(-0.0, 0.0, 0.0), Vec3::X];
+            let mesh = |fs: &[(u32, u32, u32)]| {
+                let tris = fs.iter().map(|&(a, b, c)| [a, b, c]).collect();
+                part(Mesh::from_triangles(values.to_vec(), tris).expect("mesh"))
+            };
+            let one = [mesh(&faces)];
+            proptest::prop_assert_eq!(closedness(&one), closedness_by_map(&one));
+            let k = split.min(faces.len());
+            if k > 0 && k < faces.len() {
+                let two = [mesh(&faces[..k]), mesh(&faces[k..])];
+                proptest::prop_assert_eq!(closedness(&two), closedness_by_map(&two));
+            }
+        }
+    }
+
     /// The cube (its faces' vertices apart, joined by position) is closed; a plane is open;
     /// the cube inside out is closed and inward.
     #[test]
