@@ -1608,13 +1608,7 @@ fn gltf_webp_textures_are_read() {
     image::RgbImage::from_pixel(2, 2, image::Rgb([0, 0, 255]))
         .save(d.join("t.png"))
         .unwrap();
-    let mut bin = Vec::new();
-    for x in [
-        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
-    ] {
-        bin.extend_from_slice(&x.to_le_bytes());
-    }
-    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let b64 = triangle_with_uvs(&[]);
     let gltf = |texture: &str| {
         format!(
             r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"],
@@ -1672,16 +1666,8 @@ fn gltf_unlit_materials_are_emission() {
     image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0]))
         .save(d.join("t.png"))
         .unwrap();
-    let mut bin = Vec::new();
-    for x in [
-        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
-    ] {
-        bin.extend_from_slice(&x.to_le_bytes());
-    }
-    for _ in 0..3 {
-        bin.extend_from_slice(&[255, 255, 0, 255]);
-    }
-    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    // Three RGBA8 colours after the triangle's positions and texture coordinates.
+    let b64 = triangle_with_uvs(&[255, 255, 0, 255].repeat(3));
     let gltf = |required: &str, unlit: &str| {
         format!(
             r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_materials_unlit"], {required}
@@ -1726,6 +1712,15 @@ fn gltf_unlit_materials_are_emission() {
     let mask = r#", "alphaMode": "MASK", "alphaCutoff": 0.25, "extensions": {"KHR_materials_unlit": {}}"#;
     let (channel, cutoff) = parts_alpha(&gltf("", mask), &d).expect("an alpha map");
     assert_eq!((channel, cutoff), (phong_core::Channel::A, Some(0.25)));
+    // Cut out, its texture without an image: neither map, and one warning for the texture
+    // (it would have been both).
+    let imageless = gltf("", mask).replace(r#""textures": [{"source": 0}]"#, r#""textures": [{}]"#);
+    let p = write(&d, "n.gltf", imageless.as_bytes());
+    let mut w = Vec::new();
+    let parts = load_model(&p, &mut w).unwrap();
+    assert!(parts[0].maps.emission.is_none() && parts[0].maps.alpha.is_none());
+    let no_image: Vec<_> = w.iter().filter(|w| w.contains("texture 0 has no image")).collect();
+    assert_eq!(no_image.len(), 1, "{w:?}");
     // The same material lit: the base colour is its diffuse, the texture its diffuse map.
     let p = write(&d, "l.gltf", gltf("", "").as_bytes());
     let parts = load_model(&p, &mut Vec::new()).unwrap();
@@ -1734,6 +1729,19 @@ fn gltf_unlit_materials_are_emission() {
         phong_core::Color::new(0.2, 0.4, 0.6)
     );
     assert!(parts[0].maps.diffuse.is_some());
+}
+
+/// The buffer of a glTF triangle, base64: positions (0, 0, 0), (1, 0, 0), (0, 1, 0) in bytes
+/// 0–35, texture coordinates (0, 0), (1, 0), (0, 1) in bytes 36–59, then `extra`.
+fn triangle_with_uvs(extra: &[u8]) -> String {
+    let mut bin = Vec::new();
+    for x in [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+    ] {
+        bin.extend_from_slice(&x.to_le_bytes());
+    }
+    bin.extend_from_slice(extra);
+    base64::engine::general_purpose::STANDARD.encode(&bin)
 }
 
 /// The alpha map's channel and the alpha test's cutoff of the first part of the glTF `json`

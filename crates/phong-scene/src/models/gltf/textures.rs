@@ -80,7 +80,13 @@ impl Textures<'_> {
             t.set = u32::from(Some(t.set) != first);
         }
         let maps = if mat.index().is_some() && !uvs.is_empty() {
+            // Once a texture (an unlit material's may fill two slots).
+            let mut imageless: Vec<usize> = Vec::new();
             for t in infos.iter().filter(|t| texture_image(&t.texture, self.doc).is_none()) {
+                if imageless.contains(&t.texture.index()) {
+                    continue;
+                }
+                imageless.push(t.texture.index());
                 warnings.push(format!(
                     "{}: {what}: texture {} has no image phong reads (no source, nor EXT_texture_webp's): not used",
                     path.display(),
