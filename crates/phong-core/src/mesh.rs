@@ -731,6 +731,35 @@ mod tests {
         assert_eq!(Mesh::default().bounds(), None);
     }
 
+    proptest::proptest! {
+        /// The same on random triangles (coordinates from tiny to near f32's largest, so that
+        /// some facets are zero and some lengths overflow), for a rotation with a non-uniform
+        /// scale.
+        #[test]
+        fn flat_transformed_is_flat_then_transformed_on_any_triangles(
+            points in proptest::collection::vec(
+                (proptest::prop_oneof![-1e3f32..1e3, -1e-20f32..1e-20, -3e37f32..3e37], -2f32..2.0, -2f32..2.0),
+                3..40,
+            ),
+            picks in proptest::collection::vec((0usize..40, 0usize..40, 0usize..40), 1..40),
+            angle in -3f32..3.0,
+        ) {
+            let n = points.len();
+            let p: Vec<Vec3> = points.iter().map(|&(x, y, z)| Vec3::new(x, y, z * x.abs().max(1.0))).collect();
+            let t: Vec<[u32; 3]> = picks.iter().map(|&(a, b, c)| [a % n, b % n, c % n].map(|i| i as u32)).collect();
+            let mesh = Mesh::from_triangles(p, t).unwrap();
+            let m = Mat4::from_scale_rotation_translation(
+                Vec3::new(2.0, 0.5, 1.3),
+                glam::Quat::from_euler(glam::EulerRot::ZYX, angle, 0.4, -angle),
+                Vec3::new(1.0, -2.0, 3.0),
+            );
+            let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            let (a, b) = (mesh.flat_transformed(&m, &crate::join::InTurn), mesh.with_flat_normals().into_transformed(&m));
+            proptest::prop_assert_eq!(bits(&a.normals), bits(&b.normals));
+            proptest::prop_assert_eq!(bits(&a.positions), bits(&b.positions));
+        }
+    }
+
     /// The one-pass flat placement gives the two-step one's bits: positions, normals,
     /// triangles (a mirror reversing them), texture coordinates and colours, for a rotation
     /// with a non-uniform scale and a move, a mirror, and the identity.
