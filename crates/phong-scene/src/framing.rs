@@ -747,6 +747,19 @@ pub(crate) enum Closed {
 }
 
 impl Closed {
+    /// A model with `open_edges` edges of one face or more than two, `inconsistent` edges of
+    /// two faces wound alike, and the signed volume `volume` (six times it).
+    fn judged(open_edges: usize, inconsistent: usize, volume: f64) -> Closed {
+        match (open_edges + inconsistent, volume > 0.0) {
+            (0, true) => Closed::Outward,
+            (0, false) => Closed::Inward,
+            _ => Closed::Open {
+                open_edges,
+                inconsistent,
+            },
+        }
+    }
+
     fn closed_outward(self) -> bool {
         self == Closed::Outward
     }
@@ -858,14 +871,7 @@ fn closedness(parts: &[ModelPart]) -> Closed {
             *e = (0, 0);
         }
     }
-    match (open_edges + inconsistent, volume > 0.0) {
-        (0, true) => Closed::Outward,
-        (0, false) => Closed::Inward,
-        _ => Closed::Open {
-            open_edges,
-            inconsistent,
-        },
-    }
+    Closed::judged(open_edges, inconsistent, volume)
 }
 
 #[cfg(test)]
@@ -943,14 +949,7 @@ mod tests {
         }
         let open_edges = edges.values().filter(|e| e.0 != 2).count();
         let inconsistent = edges.values().filter(|e| e.0 == 2 && e.1 != 0).count();
-        match (open_edges + inconsistent, volume > 0.0) {
-            (0, true) => Closed::Outward,
-            (0, false) => Closed::Inward,
-            _ => Closed::Open {
-                open_edges,
-                inconsistent,
-            },
-        }
+        Closed::judged(open_edges, inconsistent, volume)
     }
 
     proptest::proptest! {
