@@ -237,9 +237,9 @@ fn merged(points: &[Vec3], ids: &[u32], distinct: usize) -> Vec<Vec3> {
 /// per point the index of its position in the order first met: point `i`'s is `i` for every
 /// `i` exactly where the count is `points.len()`. An open-addressing table sized for the
 /// positions (at most half full) whose entries hold a tag of the position's hash and the first
-/// point at that position: a probe reads one entry, and a point only where the tags agree
-/// (an entry per position and a table of ids into a list of keys read both, two cache misses a
-/// probe: Nefertiti's 50k positions 7.5M instructions).
+/// point at that position: a probe reads one entry, and a point only where the tags agree (a
+/// table of ids into a list of keys read both, two cache misses a probe; BENCHMARKS.md,
+/// "Loading against trimesh").
 pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
     let size = (points.len() * 2).next_power_of_two().max(16);
     let shift = 64 - size.trailing_zeros();
