@@ -861,16 +861,9 @@ fn gltf_metal_rough_and_occlusion_textures_are_read() {
         ("mr.png", [0, 128, 255]),
         ("ao.png", [64, 0, 0]),
     ] {
-        let img = image::RgbImage::from_pixel(2, 2, image::Rgb(rgb));
-        img.save(d.join(name)).unwrap();
+        solid_png(&d, name, rgb);
     }
-    let mut bin = Vec::new();
-    for x in [
-        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
-    ] {
-        bin.extend_from_slice(&x.to_le_bytes());
-    }
-    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let b64 = triangle_with_uvs(&[]);
     let json = format!(
         r#"{{"asset": {{"version": "2.0"}},
   "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{b64}"}}],
@@ -936,9 +929,7 @@ fn gltf_metal_rough_and_occlusion_textures_are_read() {
 #[test]
 fn gltf_tangents_are_read() {
     let d = dir("gltf_tangents");
-    image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
-        .save(d.join("n.png"))
-        .unwrap();
+    solid_png(&d, "n.png", [128, 128, 255]);
     let gltf = |tangents: bool, scale: f32| {
         let mut bin = Vec::new();
         let floats: [&[f32]; 4] = [
@@ -1071,21 +1062,17 @@ fn gltf_without_normals_is_flat() {
 #[test]
 fn gltf_second_texture_coordinate_set_is_read() {
     let d = dir("gltf_texcoord1");
-    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
-        .save(d.join("t.png"))
-        .unwrap();
+    solid_png(&d, "t.png", [200, 100, 50]);
+    // The helper's triangle and first set (set0), then the second set.
     let set0 = [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0]];
     let set1 = [[0.25f32, 0.5], [0.75, 0.5], [0.25, 1.0]];
-    let mut bin = Vec::new();
-    let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-    for x in positions
-        .into_iter()
-        .chain(set0.into_iter().flatten())
-        .chain(set1.into_iter().flatten())
-    {
-        bin.extend_from_slice(&x.to_le_bytes());
-    }
-    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let b64 = triangle_with_uvs(
+        &set1
+            .as_flattened()
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    );
     let flipped = |s: [[f32; 2]; 3]| s.map(|[u, v]| Vec2::new(u, 1.0 - v)).to_vec();
     let gltf = |material: &str| {
         format!(
@@ -1475,9 +1462,7 @@ fn normals_beside_the_framing_are_the_scene_readers() {
 #[test]
 fn gltf_quantized_attributes_are_read() {
     let d = dir("gltf_quantized");
-    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
-        .save(d.join("t.png"))
-        .unwrap();
+    solid_png(&d, "t.png", [200, 100, 50]);
     let mut bin: Vec<u8> = Vec::new();
     // Positions (i16, a stride of 8), normals (i8, stride 4), TEXCOORD_0 (i8, stride 4),
     // TEXCOORD_1 (u16), COLOR_0 (u16 RGBA), TANGENT (i8 RGBA).
@@ -1605,9 +1590,7 @@ fn gltf_webp_textures_are_read() {
         .encode(webp.as_raw(), 2, 2, image::ExtendedColorType::Rgba8)
         .unwrap();
     write(&d, "t.webp", &bytes);
-    image::RgbImage::from_pixel(2, 2, image::Rgb([0, 0, 255]))
-        .save(d.join("t.png"))
-        .unwrap();
+    solid_png(&d, "t.png", [0, 0, 255]);
     let b64 = triangle_with_uvs(&[]);
     let gltf = |texture: &str| {
         format!(
@@ -1663,9 +1646,7 @@ fn gltf_webp_textures_are_read() {
 #[test]
 fn gltf_unlit_materials_are_emission() {
     let d = dir("gltf_unlit");
-    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0]))
-        .save(d.join("t.png"))
-        .unwrap();
+    solid_png(&d, "t.png", [255, 0, 0]);
     // Three RGBA8 colours after the triangle's positions and texture coordinates.
     let b64 = triangle_with_uvs(&[255, 255, 0, 255].repeat(3));
     let gltf = |required: &str, unlit: &str| {
@@ -1729,6 +1710,13 @@ fn gltf_unlit_materials_are_emission() {
         phong_core::Color::new(0.2, 0.4, 0.6)
     );
     assert!(parts[0].maps.diffuse.is_some());
+}
+
+/// A 2×2 PNG of one colour, `name` in `d`.
+fn solid_png(d: &Path, name: &str, rgb: [u8; 3]) {
+    image::RgbImage::from_pixel(2, 2, image::Rgb(rgb))
+        .save(d.join(name))
+        .unwrap();
 }
 
 /// The buffer of a glTF triangle, base64: positions (0, 0, 0), (1, 0, 0), (0, 1, 0) in bytes
