@@ -25,6 +25,9 @@ pub struct Mesh {
     colors: Vec<Color>,
     /// Tangents (`xyz`, and in `w` the bitangent's sign): empty, or one per position.
     tangents: Vec<Vec4>,
+    /// A flat mesh's normals, one per triangle, its vertices shared ([`Mesh::flat_transformed`]);
+    /// `normals` is then empty.
+    face_normals: Option<Vec<Vec3>>,
 }
 
 /// The first point with a coordinate that is not finite ([`not_finite_at`]).
@@ -121,6 +124,7 @@ impl Mesh {
             uvs1: Vec::new(),
             colors: Vec::new(),
             tangents: Vec::new(),
+            face_normals: None,
         })
     }
 
@@ -184,6 +188,9 @@ impl Mesh {
         if self.uvs.is_empty() || self.triangles.is_empty() {
             return self.clone();
         }
+        if self.face_normals.is_some() {
+            return self.with_vertex_normals().with_mikktspace_tangents();
+        }
         struct Corners<'a> {
             m: &'a Mesh,
             out: Vec<[f32; 4]>,
@@ -199,7 +206,7 @@ impl Mesh {
                 self.m.positions[self.m.triangles[f][v] as usize].to_array()
             }
             fn normal(&self, f: usize, v: usize) -> [f32; 3] {
-                self.m.normals[self.m.triangles[f][v] as usize].to_array()
+                self.m.corner_normal(f, v).to_array()
             }
             fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
                 self.m.uvs[self.m.triangles[f][v] as usize].to_array()
@@ -257,17 +264,15 @@ impl Mesh {
     /// The mesh with its vertices moved to `positions` (one per vertex, finite), every other
     /// attribute kept.
     pub fn with_positions(mut self, positions: Vec<Vec3>) -> Result<Self, Error> {
-        let moved = Mesh::new(positions, std::mem::take(&mut self.normals), Vec::new())?;
-        if moved.positions.len() != self.positions.len() {
+        if positions.len() != self.positions.len() {
             return Err(Error::OutOfRange {
                 what: "number of positions",
                 range: "the mesh's number of vertices",
-                value: moved.positions.len() as f32,
+                value: positions.len() as f32,
             });
         }
-        self.positions = moved.positions;
-        self.normals = moved.normals;
-        Ok(self)
+        self.positions = positions;
+        self.with_positions_mapped(|p| p)
     }
 
     /// The mesh with each vertex moved to `f` of its position (which must stay finite), in
@@ -319,7 +324,8 @@ impl Mesh {
     pub fn positions(&self) -> &[Vec3] {
         &self.positions
     }
-    /// Vertex normals (unit, or zero where undefined).
+    /// Vertex normals (unit, or zero where undefined); empty for a mesh of
+    /// [`Mesh::face_normals`] (see [`Mesh::corner_normal`], [`Mesh::with_vertex_normals`]).
     pub fn normals(&self) -> &[Vec3] {
         &self.normals
     }
@@ -347,6 +353,10 @@ impl Mesh {
     /// Appends `other`'s vertices and triangles. Where only one of the two has texture
     /// coordinates, colours or tangents, the other's vertices get `(0, 0)`, white or none.
     pub fn append(&mut self, other: &Mesh) {
+        if self.face_normals.is_some() || other.face_normals.is_some() {
+            *self = self.with_vertex_normals().into_owned();
+            return self.append(&other.with_vertex_normals());
+        }
         let base = self.positions.len() as u32;
         let (mine, theirs) = (self.positions.len(), other.positions.len());
         append_attribute(&mut self.uvs, &other.uvs, mine, theirs, Vec2::ZERO);
@@ -413,7 +423,7 @@ impl Mesh {
         for p in &mut self.positions {
             *p = m.transform_point3(*p);
         }
-        for n in &mut self.normals {
+        for n in self.normals.iter_mut().chain(self.face_normals.iter_mut().flatten()) {
             *n = (nm * *n).normalize_or_zero();
         }
         if flip {
@@ -447,60 +457,97 @@ impl Mesh {
             uvs1: per_corner(&self.uvs1, &self.triangles),
             colors: per_corner(&self.colors, &self.triangles),
             tangents: Vec::new(),
+            face_normals: None,
         }
     }
 
-    /// `self.with_flat_normals().into_transformed(m)`, bit for bit, in one pass: each
-    /// position transformed once (not once a corner) and each facet normal once a triangle
-    /// (not once a corner), the three-vertices-a-triangle arrays written once. For a model
-    /// without normals (a glTF's flat ones) placed in the scene.
-    pub fn flat_transformed(&self, m: &Mat4, join: &impl Join) -> Mesh {
+    /// `self.with_flat_normals().into_transformed(m)` with its vertices kept shared: each
+    /// position transformed once, each triangle's facet normal computed and transformed once
+    /// and kept per triangle ([`Mesh::face_normals`]). Its corners are those of the two-step
+    /// mesh bit for bit ([`Mesh::with_vertex_normals`] gives that mesh's form); no arrays of
+    /// three vertices a triangle are made. For a model without normals (a glTF's flat ones)
+    /// placed in the scene.
+    pub fn flat_transformed(mut self, m: &Mat4, join: &impl Join) -> Mesh {
+        if self.triangles.is_empty() {
+            return self.with_flat_normals().into_transformed(m);
+        }
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
-        let moved: Vec<Vec3> = self.positions.iter().map(|p| m.transform_point3(*p)).collect();
-        let count = 3 * self.triangles.len();
-        let (mut positions, mut normals) = (vec![Vec3::ZERO; count], vec![Vec3::ZERO; count]);
+        let mut faces = vec![Vec3::ZERO; self.triangles.len()];
         // (In `Vec3A`, glam's SSE form of the same operations in the same order: the same
         // bits as `facet_normal` and `Mat3 * Vec3`, in fewer instructions.)
         let nm_a = Mat3A::from(nm);
-        let fill = |triangles: &[[u32; 3]], positions: &mut [Vec3], normals: &mut [Vec3]| {
-            let corners = positions
-                .as_chunks_mut::<3>()
-                .0
-                .iter_mut()
-                .zip(normals.as_chunks_mut::<3>().0);
-            for ((p, n), t) in corners.zip(triangles) {
-                let [a, b, c] = t.map(|i| i as usize);
-                let [pa, pb, pc] = [a, b, c].map(|i| Vec3A::from(self.positions[i]));
+        let positions = &self.positions;
+        let fill = |triangles: &[[u32; 3]], out: &mut [Vec3]| {
+            for (n, t) in out.iter_mut().zip(triangles) {
+                let [pa, pb, pc] = t.map(|i| Vec3A::from(positions[i as usize]));
                 let facet = (pb - pa).cross(pc - pa).normalize_or_zero();
-                *n = [Vec3::from((nm_a * facet).normalize_or_zero()); 3];
-                *p = [moved[a], moved[b], moved[c]];
+                *n = Vec3::from((nm_a * facet).normalize_or_zero());
             }
         };
-        // A large mesh in two halves, which `join` may draw side by side (each triangle's
-        // vertices are its own: the same values).
+        // A large mesh's facets in two halves, which `join` may compute side by side.
         let half = self.triangles.len() / 2;
         if half >= FLAT_HALF_MIN {
             let (t0, t1) = self.triangles.split_at(half);
-            let (p0, p1) = positions.split_at_mut(3 * half);
-            let (n0, n1) = normals.split_at_mut(3 * half);
-            join.join(|| fill(t0, p0, n0), || fill(t1, p1, n1));
+            let (f0, f1) = faces.split_at_mut(half);
+            join.join(|| fill(t0, f0), || fill(t1, f1));
         } else {
-            fill(&self.triangles, &mut positions, &mut normals);
+            fill(&self.triangles, &mut faces);
+        }
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
         }
         // A mirror reverses each triangle, as `into_transformed` does.
-        let (second, third) = if flip { (2, 1) } else { (1, 2) };
+        if flip {
+            for t in &mut self.triangles {
+                t.swap(1, 2);
+            }
+        }
         Mesh {
-            positions,
+            normals: Vec::new(),
+            tangents: Vec::new(),
+            face_normals: Some(faces),
+            ..self
+        }
+    }
+
+    /// A flat mesh's normals, one per triangle ([`Mesh::flat_transformed`]); `None` where the
+    /// normals are per vertex ([`Mesh::normals`]).
+    pub fn face_normals(&self) -> Option<&[Vec3]> {
+        self.face_normals.as_deref()
+    }
+
+    /// The normal at corner `k` of triangle `t`: its vertex's, or the triangle's own.
+    pub fn corner_normal(&self, t: usize, k: usize) -> Vec3 {
+        match &self.face_normals {
+            Some(f) => f[t],
+            None => self.normals[self.triangles[t][k] as usize],
+        }
+    }
+
+    /// The mesh with one normal per vertex: itself, or for a mesh of [`Mesh::face_normals`]
+    /// three vertices a triangle carrying its normal (as [`Mesh::with_flat_normals`] makes
+    /// them), for the users of per-vertex normals (lighting per vertex, the GPU's buffers).
+    pub fn with_vertex_normals(&self) -> std::borrow::Cow<'_, Mesh> {
+        let Some(faces) = &self.face_normals else {
+            return std::borrow::Cow::Borrowed(self);
+        };
+        let mut normals = vec![Vec3::ZERO; 3 * faces.len()];
+        for (n, f) in normals.chunks_exact_mut(3).zip(faces) {
+            n.fill(*f);
+        }
+        std::borrow::Cow::Owned(Mesh {
+            positions: per_corner(&self.positions, &self.triangles),
             normals,
             triangles: (0..self.triangles.len() as u32)
-                .map(|t| [3 * t, 3 * t + second, 3 * t + third])
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
                 .collect(),
             uvs: per_corner(&self.uvs, &self.triangles),
             uvs1: per_corner(&self.uvs1, &self.triangles),
             colors: per_corner(&self.colors, &self.triangles),
-            tangents: Vec::new(),
-        }
+            tangents: per_corner(&self.tangents, &self.triangles),
+            face_normals: None,
+        })
     }
 
     /// Vertices at the same position merged (exact match), so that normals
@@ -523,6 +570,7 @@ impl Mesh {
             uvs1: Vec::new(),
             colors: Vec::new(),
             tangents: Vec::new(),
+            face_normals: None,
         };
         (mesh, remap)
     }
@@ -554,6 +602,7 @@ impl Mesh {
             uvs1: self.uvs1.clone(),
             colors: self.colors.clone(),
             tangents: Vec::new(),
+            face_normals: None,
         }
     }
 
@@ -753,10 +802,10 @@ mod tests {
                 glam::Quat::from_euler(glam::EulerRot::ZYX, angle, 0.4, -angle),
                 Vec3::new(1.0, -2.0, 3.0),
             );
-            let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-            let (a, b) = (mesh.flat_transformed(&m, &crate::join::InTurn), mesh.with_flat_normals().into_transformed(&m));
-            proptest::prop_assert_eq!(bits(&a.normals), bits(&b.normals));
-            proptest::prop_assert_eq!(bits(&a.positions), bits(&b.positions));
+            let b = mesh.with_flat_normals().into_transformed(&m);
+            let a = mesh.flat_transformed(&m, &crate::join::InTurn);
+            proptest::prop_assert_eq!(corner_bits(&a), corner_bits(&b));
+            proptest::prop_assert_eq!(corner_bits(&a.with_vertex_normals()), corner_bits(&b));
         }
     }
 
@@ -787,7 +836,6 @@ mod tests {
             ),
             Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
         ];
-        let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
         // Large enough for two halves (at least `FLAT_HALF_MIN` triangles each), drawn in turn
         // and in the other order.
         struct Reversed;
@@ -804,19 +852,56 @@ mod tests {
             for m in &moves {
                 let b = mesh.with_flat_normals().into_transformed(m);
                 let (a, reversed) = (
-                    mesh.flat_transformed(m, &crate::join::InTurn),
-                    mesh.flat_transformed(m, &Reversed),
+                    mesh.clone().flat_transformed(m, &crate::join::InTurn),
+                    mesh.clone().flat_transformed(m, &Reversed),
                 );
-                assert_eq!(bits(reversed.positions()), bits(b.positions()));
-                assert_eq!(bits(reversed.normals()), bits(b.normals()));
-                assert_eq!(bits(a.positions()), bits(b.positions()));
-                assert_eq!(bits(a.normals()), bits(b.normals()));
-                assert_eq!(a.triangles(), b.triangles());
-                assert_eq!(a.uvs(), b.uvs());
-                assert_eq!(a.colors(), b.colors());
+                assert_eq!(corner_bits(&a), corner_bits(&b));
+                assert_eq!(corner_bits(&reversed), corner_bits(&b));
+                assert_eq!(corner_bits(&a.with_vertex_normals()), corner_bits(&b));
+                // The vertices stay shared, the normals are the triangles'.
+                assert_eq!(a.positions().len(), mesh.positions().len());
+                assert!(a.normals().is_empty());
+                assert_eq!(a.face_normals().map(<[Vec3]>::len), Some(mesh.triangles().len()));
+                assert_eq!(a.uvs().len(), mesh.uvs().len());
                 assert!(a.tangents().is_empty() && a.uvs1().is_empty());
             }
         }
+    }
+
+    /// Per corner of every triangle in turn: its position's, normal's, texture coordinates'
+    /// and colour's bits (a mesh's drawing, whatever its vertices' numbering).
+    fn corner_bits(m: &Mesh) -> Vec<Vec<u32>> {
+        let mut out = Vec::new();
+        for (t, tri) in m.triangles().iter().enumerate() {
+            for (k, &i) in tri.iter().enumerate() {
+                let i = i as usize;
+                let mut c: Vec<f32> = m.positions()[i].to_array().to_vec();
+                c.extend(m.corner_normal(t, k).to_array());
+                c.extend(m.uvs().get(i).map_or([0.5; 2], |u| u.to_array()));
+                c.extend(m.uvs1().get(i).map_or([0.5; 2], |u| u.to_array()));
+                c.extend(m.colors().get(i).map_or([0.5; 3], |c| c.to_array()));
+                out.push(c.into_iter().map(f32::to_bits).collect());
+            }
+        }
+        out
+    }
+
+    /// A flat mesh's normals moved again are those of its vertex form moved, and an appended
+    /// mesh of either form draws the same corners.
+    #[test]
+    fn face_normals_transform_and_append_as_vertex_normals() {
+        let flat = folded().flat_transformed(&Mat4::from_rotation_x(0.3), &crate::join::InTurn);
+        let m = Mat4::from_scale(Vec3::new(-2.0, 1.0, 0.5));
+        assert_eq!(
+            corner_bits(&flat.clone().into_transformed(&m)),
+            corner_bits(&flat.with_vertex_normals().into_owned().into_transformed(&m))
+        );
+        let mut both = folded();
+        both.append(&flat);
+        let mut want = folded();
+        want.append(&flat.with_vertex_normals());
+        assert_eq!(corner_bits(&both), corner_bits(&want));
+        assert!(both.face_normals().is_none());
     }
 
     #[test]

@@ -58,7 +58,9 @@ impl Geometry {
             let o = &scene.objects[k];
             let view = scene.camera.view(o.shading.viewer);
             g.objects.push(GpuObject::new(&o.material, &o.shading, &view));
-            let m = &o.mesh;
+            // (A flat mesh's triangles with vertices of their own: a vertex carries its normal.)
+            let m = o.mesh.with_vertex_normals();
+            let m = &*m;
             let base = g.vertices.len();
             let first = g.indices.len() as u32;
             let uv = |k: u32| {

@@ -291,7 +291,7 @@ pub fn probe(scene: &Scene, x: u32, y: u32) -> Probe {
     let mesh = &obj.mesh;
     let tri = mesh.triangles()[ti];
     let ps = tri.map(|i| mesh.positions()[i as usize]);
-    let ns = tri.map(|i| mesh.normals()[i as usize]);
+    let ns = [0, 1, 2].map(|k| mesh.corner_normal(ti, k));
     let b = bary.map(|w| w as f32);
     let lerp = |v: [Vec3; 3]| v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
     let flip = if back { -1.0 } else { 1.0 };

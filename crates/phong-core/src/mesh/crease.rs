@@ -612,6 +612,7 @@ impl CornerVertices {
             uvs1: self.uvs1,
             colors: self.colors,
             tangents: Vec::new(),
+            face_normals: None,
         }
     }
 }

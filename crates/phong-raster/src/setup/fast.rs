@@ -16,6 +16,7 @@ use crate::simd::{ColourPlanes, Planes};
 use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -27,8 +28,22 @@ impl Stage<'_> {
         let plan = &self.plan.objects[oi];
         let (isa, clip_from_world) = (self.plan.isa, self.plan.clip_from_world);
         let (two_sided, colour) = (obj.shading.options.two_sided, self.plan.colour_planes);
-        let mesh = &obj.mesh;
-        let (positions, normals) = (mesh.positions(), mesh.normals());
+        // Lit per vertex (Gouraud, textured or not), and textured.
+        let gouraud = matches!(plan.mode, Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
+        let textured = matches!(plan.mode, Mode::Textured { .. });
+        // A flat mesh's triangles keep their normals, its vertices shared; lit per vertex, its
+        // corners are vertices of their own.
+        let mesh = if gouraud {
+            obj.mesh.with_vertex_normals()
+        } else {
+            Cow::Borrowed(&obj.mesh)
+        };
+        let (positions, normals, faces) = (mesh.positions(), mesh.normals(), mesh.face_normals());
+        // The normals at a triangle's corners.
+        let corner_normals = |f: usize, tri: [u32; 3]| match faces {
+            Some(faces) => [faces[f]; 3],
+            None => tri.map(|i| normals[i as usize]),
+        };
         let vertices = &mut scratch.vertices;
         // Every record is overwritten below: keep last frame's (no fill) where there are enough.
         vertices.truncate(positions.len());
@@ -37,9 +52,6 @@ impl Stage<'_> {
             .par_chunks_mut(SETUP_CHUNK)
             .zip(positions.par_chunks(SETUP_CHUNK))
             .for_each(|(out, ps)| fast_vertices(isa, clip_from_world, (self.plan.w, self.plan.h), ps, out));
-        // Lit per vertex (Gouraud, textured or not), and textured.
-        let gouraud = matches!(plan.mode, Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
-        let textured = matches!(plan.mode, Mode::Textured { .. });
         let uvs = mesh.uvs();
         let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
         let colors = mesh.colors();
@@ -63,20 +75,21 @@ impl Stage<'_> {
                 used[i as usize].store(true, Ordering::Relaxed);
             }
         };
-        // The planes of a set-up triangle from its input vertices' indices (Phong).
-        let phong_planes = |s: &Setup, idx: [u32; 3]| -> Planes {
-            let idx = each3(|k| idx[s.order[k]] as usize);
+        // The planes of a set-up triangle from its input vertices' indices and its normals
+        // (Phong).
+        let phong_planes = |s: &Setup, idx: [u32; 3], ns: [Vec3; 3]| -> Planes {
+            let (idx, ns) = (each3(|k| idx[s.order[k]] as usize), each3(|k| ns[s.order[k]]));
             let sign = if s.front { 1.0 } else { -1.0 };
             let attrs = [
                 [positions[idx[0]], positions[idx[1]], positions[idx[2]]],
-                [normals[idx[0]] * sign, normals[idx[1]] * sign, normals[idx[2]] * sign],
+                [ns[0] * sign, ns[1] * sign, ns[2] * sign],
             ];
             plane_equations(s.xy[0], &s.tri, s.area, s.inv_w, attrs, false)
         };
-        let setup_chunk = |chunk: &[[u32; 3]]| {
+        let setup_chunk = |(c, chunk): (usize, &[[u32; 3]])| {
             let mut out = Chunk::reuse(spare, oi, chunk.len());
             out.reserve_planes(colour, chunk.len());
-            for &tri in chunk {
+            for (f, &tri) in (c * SETUP_CHUNK..).zip(chunk) {
                 let v = [
                     vertices[tri[0] as usize],
                     vertices[tri[1] as usize],
@@ -95,7 +108,7 @@ impl Stage<'_> {
                                 idx: each3(|k| tri[s.order[k]]),
                             });
                         } else {
-                            out.planes.push(phong_planes(&s, tri));
+                            out.planes.push(phong_planes(&s, tri, corner_normals(f, tri)));
                         }
                         if textured {
                             let idx = each3(|k| tri[s.order[k]]);
@@ -107,9 +120,9 @@ impl Stage<'_> {
                 }
                 // Rare: clip, with the vertices in full (Gouraud: lit here).
                 let mut lit3 = [[Vec3::ZERO; 3]; 4];
+                let ns = corner_normals(f, tri);
                 if let Some(lighting) = &lighting {
                     let ps = tri.map(|i| positions[i as usize]);
-                    let ns = tri.map(|i| normals[i as usize]);
                     lighting.light(&ps, &ns, lit3.each_mut().map(|c| &mut c[..]));
                 }
                 let t = each3(|k| {
@@ -117,7 +130,7 @@ impl Stage<'_> {
                     ClipVertex {
                         clip: clip_from_world * Vec4::from((positions[i], 1.0)),
                         world: positions[i],
-                        normal: normals[i],
+                        normal: ns[k],
                         color: lit3[0][k],
                         color_back: lit3[1][k],
                         spec: [lit3[2][k], lit3[3][k]],
@@ -160,7 +173,12 @@ impl Stage<'_> {
             self.bin_entries(&mut out);
             out
         };
-        let mut chunks: Vec<Chunk> = mesh.triangles().par_chunks(SETUP_CHUNK).map(setup_chunk).collect();
+        let mut chunks: Vec<Chunk> = mesh
+            .triangles()
+            .par_chunks(SETUP_CHUNK)
+            .enumerate()
+            .map(setup_chunk)
+            .collect();
         if let Some(lighting) = &lighting {
             // Lit straight into the colour arrays, which keep last frame's values: only the
             // used vertices' colours are read.

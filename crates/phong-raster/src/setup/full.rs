@@ -27,7 +27,10 @@ impl Stage<'_> {
         let interpolation = obj.shading.interpolation;
         let two_sided = obj.shading.options.two_sided;
         let view = self.plan.objects[oi].view;
-        let mesh = &obj.mesh;
+        // (A flat mesh's triangles with vertices of their own: this path reads normals per
+        // vertex.)
+        let mesh = obj.mesh.with_vertex_normals();
+        let mesh = &*mesh;
         let (gouraud, colour) = (interpolation == Interpolation::Gouraud, self.plan.colour_planes);
         let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
         let colors = mesh.colors();
