@@ -1011,16 +1011,16 @@ fn gltf_without_normals_is_flat() {
     // Each corner's normal against the facet normal of its triangle's drawn positions, and
     // that facet one of the two above (not checked for the model alone, which may be turned).
     let corners_are_flat = |mesh: &phong_core::Mesh, turned: bool| {
-        let (pos, nor) = (mesh.positions(), mesh.normals());
+        let pos = mesh.positions();
         assert_eq!(mesh.triangles().len(), 2);
-        for t in mesh.triangles() {
+        for (f, t) in mesh.triangles().iter().enumerate() {
             let [a, b, c] = t.map(|i| pos[i as usize]);
             let facet = (b - a).cross(c - a).normalize();
             if !turned {
                 assert!(facets.iter().any(|f| (facet - *f).length() < 1e-6), "{facet}");
             }
-            for &i in t {
-                let n = nor[i as usize];
+            for k in 0..3 {
+                let n = mesh.corner_normal(f, k);
                 assert!((n - facet).length() < 1e-6, "corner normal {n} on a facet {facet}");
             }
         }
@@ -1380,7 +1380,7 @@ fn every_face_the_camera_sees_is_lit() {
 /// scene reader. Both give the same scene, bit for bit: camera, sides, and each object's
 /// positions, normals and triangles. Models of 20k triangles and more without normals: a
 /// smooth torus and a teapot with rims and a spout (creases, split vertices), as OBJ and as
-/// binary STL.
+/// binary STL; and as glTF, drawn flat (one normal a triangle) and read alike either way.
 #[test]
 fn normals_beside_the_framing_are_the_scene_readers() {
     let d = dir("beside");
@@ -1408,6 +1408,31 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         }
         b
     };
+    // A glTF of positions and triangles alone (drawn flat).
+    let gltf = |m: &phong_core::Mesh| {
+        let mut bin: Vec<u8> = bytemuck::cast_slice(m.positions()).to_vec();
+        bin.extend_from_slice(bytemuck::cast_slice(m.triangles()));
+        let (np, nt) = (m.positions().len(), m.triangles().len());
+        let (lo, hi) = m.bounds().unwrap();
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+        format!(
+            r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{b64}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": {pl}}}, {{"buffer": 0, "byteOffset": {pl}, "byteLength": {tl}}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": {np}, "type": "VEC3", "min": {lo:?}, "max": {hi:?}}},
+    {{"bufferView": 1, "componentType": 5125, "count": {ni}, "type": "SCALAR"}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+  "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+            len = bin.len(),
+            pl = 12 * np,
+            tl = 12 * nt,
+            ni = 3 * nt,
+            lo = lo.to_array(),
+            hi = hi.to_array(),
+        )
+        .into_bytes()
+    };
     let torus = phong_core::primitives::torus(160, 1.0, 0.35);
     let teapot = phong_core::primitives::teapot(20);
     let mut files = Vec::new();
@@ -1415,8 +1440,15 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         assert!(mesh.triangles().len() >= 20_000, "{name}: {}", mesh.triangles().len());
         files.push(write(&d, &format!("{name}.obj"), &obj(mesh)));
         files.push(write(&d, &format!("{name}.stl"), &stl(mesh)));
+        files.push(write(&d, &format!("{name}.gltf"), &gltf(mesh)));
     }
     let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+    // Each corner's normal in turn (a flat mesh's are its triangles').
+    let corner_normals = |m: &phong_core::Mesh| -> Vec<Vec3> {
+        (0..m.triangles().len())
+            .flat_map(|t| (0..3).map(move |k| m.corner_normal(t, k)))
+            .collect()
+    };
     for path in &files {
         let options = ModelOptions::default();
         let beside = load_with(path, &options).unwrap();
@@ -1430,23 +1462,27 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         same(a.objects.len() == b.objects.len(), "object counts");
         for (x, y) in a.objects.iter().zip(&b.objects) {
             same(bits(x.mesh.positions()) == bits(y.mesh.positions()), "positions");
+            let (nx, ny) = (corner_normals(&x.mesh), corner_normals(&y.mesh));
             same(bits(x.mesh.normals()) == bits(y.mesh.normals()), "normals");
+            same(bits(&nx) == bits(&ny), "corner normals");
+            same(
+                x.mesh.face_normals().is_some() == y.mesh.face_normals().is_some(),
+                "forms",
+            );
             same(x.mesh.triangles() == y.mesh.triangles(), "triangles");
             same(
                 format!("{:?}", x.shading) == format!("{:?}", y.shading),
                 "shading settings",
             );
-            let unit = x
-                .mesh
-                .normals()
-                .iter()
-                .filter(|n| (n.length() - 1.0).abs() < 1e-4)
-                .count();
+            let unit = nx.iter().filter(|n| (n.length() - 1.0).abs() < 1e-4).count();
             assert!(
-                unit * 100 >= x.mesh.normals().len() * 99,
+                !nx.is_empty() && unit * 100 >= nx.len() * 99,
                 "{}: normals computed",
                 path.display()
             );
+            // A glTF without normals is flat: one normal a triangle, the vertices shared.
+            let gltf = path.extension().is_some_and(|e| e == "gltf");
+            same(x.mesh.face_normals().is_some() == gltf, "flat form");
         }
     }
 }

@@ -370,7 +370,7 @@ fn meshes_load_relative_to_the_scene() {
     let path = dir.join("s.toml");
     let l = parse_scene("[[object]]\nmesh = \"tri.obj\"\nnormals = \"flat\"\n", &path).unwrap();
     assert_eq!(l.scene.objects.len(), 1);
-    assert_eq!(l.scene.objects[0].mesh.normals()[0], glam::Vec3::Z);
+    assert_eq!(l.scene.objects[0].mesh.corner_normal(0, 0), glam::Vec3::Z);
     let e = parse_scene("[[object]]\nmesh = \"bad.obj\"\n", &path)
         .unwrap_err()
         .to_string();
