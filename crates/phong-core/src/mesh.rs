@@ -10,8 +10,9 @@ use rustc_hash::FxHashMap;
 mod crease;
 pub use crease::{weld_ids, weld_positions};
 
-/// An indexed triangle mesh with one normal per vertex and, optionally, texture coordinates
-/// per vertex. Triangles are counter-clockwise seen from the side their normals point to.
+/// An indexed triangle mesh with one normal per vertex (or, drawn flat, one per triangle:
+/// [`Mesh::face_normals`]) and, optionally, texture coordinates per vertex. Triangles are
+/// counter-clockwise seen from the side their normals point to.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Mesh {
     positions: Vec<Vec3>,
