@@ -8,7 +8,7 @@
 //! exist.
 
 use super::Stage;
-use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, plane_equations, uv_planes};
+use super::{Chunk, Keep, Pending, SETUP_CHUNK, Scratch, Setup, VertexAttributes, plane_equations, uv_planes};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle};
 use crate::fixed::each3;
 use crate::plan::{Mode, lit_term};
@@ -31,8 +31,7 @@ impl Stage<'_> {
         // Lit per vertex (Gouraud, textured or not), and textured.
         let gouraud = matches!(plan.mode, Mode::Gouraud | Mode::Textured { per_vertex: true, .. });
         let textured = matches!(plan.mode, Mode::Textured { .. });
-        // A flat mesh's triangles keep their normals, its vertices shared; lit per vertex, its
-        // corners are vertices of their own.
+        // A flat mesh's normals per triangle; lit per vertex, three vertices a triangle.
         let mesh = if gouraud {
             obj.mesh.with_vertex_normals()
         } else {
@@ -44,24 +43,10 @@ impl Stage<'_> {
             Some(faces) => [faces[f]; 3],
             None => tri.map(|i| normals[i as usize]),
         };
-        let vertices = &mut scratch.vertices;
-        // Every record is overwritten below: keep last frame's (no fill) where there are enough.
-        vertices.truncate(positions.len());
-        vertices.resize(positions.len(), FastVertex::default());
-        vertices
-            .par_chunks_mut(SETUP_CHUNK)
-            .zip(positions.par_chunks(SETUP_CHUNK))
-            .for_each(|(out, ps)| fast_vertices(isa, clip_from_world, (self.plan.w, self.plan.h), ps, out));
-        let uvs = mesh.uvs();
-        let uv_of = |i: u32| uvs.get(i as usize).copied().unwrap_or_default();
-        let colors = mesh.colors();
-        let rgb_of = |i: u32| colors.get(i as usize).map_or(Vec3::ONE, |c| Vec3::from(c.to_array()));
-        let uvs1 = mesh.uvs1();
-        let uv1_of = |i: u32| uvs1.get(i as usize).copied().unwrap_or_default();
-        let tangents = mesh.tangents();
-        let tangent_of = |i: u32| tangents.get(i as usize).copied().unwrap_or(Vec4::ZERO);
+        self.fast_vertices(&mut scratch.vertices, positions);
+        let attrs = VertexAttributes(&mesh);
         let extra = plan.extra;
-        let extra_of = |i: u32| extra.of(rgb_of(i), uv1_of(i), tangent_of(i));
+        let extra_of = |i: u32| extra.of(attrs.rgb(i), attrs.uv1(i), attrs.tangent(i));
         let lighting = gouraud.then(|| {
             let term = lit_term(obj.shading.output).expect("Gouraud mode is a lit output");
             VertexLighting::new(isa, &self.scene.lighting, obj, plan.view, term, two_sided, textured)
@@ -69,7 +54,7 @@ impl Stage<'_> {
         if gouraud {
             unmark(&mut scratch.used, positions.len());
         }
-        let (vertices, used) = (&*vertices, &*scratch.used);
+        let (vertices, used) = (&*scratch.vertices, &*scratch.used);
         let mark = |idx: [u32; 3]| {
             for i in idx {
                 used[i as usize].store(true, Ordering::Relaxed);
@@ -112,7 +97,8 @@ impl Stage<'_> {
                         }
                         if textured {
                             let idx = each3(|k| tri[s.order[k]]);
-                            out.uv.push(uv_planes(&s, idx.map(uv_of), idx.map(extra_of), extra));
+                            out.uv
+                                .push(uv_planes(&s, idx.map(|i| attrs.uv(i)), idx.map(extra_of), extra));
                         }
                         out.tris.push(s.tri);
                     }
@@ -134,10 +120,10 @@ impl Stage<'_> {
                         color: lit3[0][k],
                         color_back: lit3[1][k],
                         spec: [lit3[2][k], lit3[3][k]],
-                        uv: uv_of(tri[k]),
-                        uv1: uv1_of(tri[k]),
-                        rgb: rgb_of(tri[k]),
-                        tangent: tangent_of(tri[k]),
+                        uv: attrs.uv(tri[k]),
+                        uv1: attrs.uv1(tri[k]),
+                        rgb: attrs.rgb(tri[k]),
+                        tangent: attrs.tangent(tri[k]),
                     }
                 });
                 let mut push = |t: [ClipVertex; 3]| {
@@ -186,6 +172,20 @@ impl Stage<'_> {
             gouraud_planes(&mut chunks, vertices, &scratch.colors, textured, colour);
         }
         chunks
+    }
+}
+
+impl Stage<'_> {
+    /// Each of `positions` projected into its [`FastVertex`] record in `vertices`.
+    fn fast_vertices(&self, vertices: &mut Vec<FastVertex>, positions: &[Vec3]) {
+        let (isa, clip_from_world) = (self.plan.isa, self.plan.clip_from_world);
+        // Every record is overwritten below: keep last frame's (no fill) where there are enough.
+        vertices.truncate(positions.len());
+        vertices.resize(positions.len(), FastVertex::default());
+        vertices
+            .par_chunks_mut(SETUP_CHUNK)
+            .zip(positions.par_chunks(SETUP_CHUNK))
+            .for_each(|(out, ps)| fast_vertices(isa, clip_from_world, (self.plan.w, self.plan.h), ps, out));
     }
 }
 

@@ -6,7 +6,7 @@
 //! kernel, all at once), [`Corners`] and planes kept as asked.
 
 use super::Stage;
-use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri};
+use super::{Chunk, Corners, Flat, Keep, SETUP_CHUNK, Tri, VertexAttributes};
 use crate::clip::{ClipVertex, Clipped, NOT_FINITE, OUTSIDE_CLIP, OUTSIDE_VIEW, clip_triangle, outcode};
 use crate::plan::lit_term;
 use crate::simd::Planes;
@@ -27,14 +27,11 @@ impl Stage<'_> {
         let interpolation = obj.shading.interpolation;
         let two_sided = obj.shading.options.two_sided;
         let view = self.plan.objects[oi].view;
-        // (A flat mesh's triangles with vertices of their own: this path reads normals per
-        // vertex.)
+        // (A flat mesh as three vertices a triangle: this path reads normals per vertex.)
         let mesh = obj.mesh.with_vertex_normals();
         let mesh = &*mesh;
         let (gouraud, colour) = (interpolation == Interpolation::Gouraud, self.plan.colour_planes);
-        let (uvs, uvs1) = (mesh.uvs(), mesh.uvs1());
-        let colors = mesh.colors();
-        let tangents = mesh.tangents();
+        let attrs = VertexAttributes(mesh);
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
         let vec3 = |c: Color| Vec3::from(c.to_array());
         let color = |v: Vec3| Color::new(v.x, v.y, v.z);
@@ -88,10 +85,10 @@ impl Stage<'_> {
                     color: vec3(front.0),
                     color_back: vec3(back.0),
                     spec: [vec3(front.1), vec3(back.1)],
-                    uv: uvs.get(i).copied().unwrap_or_default(),
-                    uv1: uvs1.get(i).copied().unwrap_or_default(),
-                    rgb: colors.get(i).map_or(Vec3::ONE, |c| Vec3::from(c.to_array())),
-                    tangent: tangents.get(i).copied().unwrap_or(Vec4::ZERO),
+                    uv: attrs.uv(i as u32),
+                    uv1: attrs.uv1(i as u32),
+                    rgb: attrs.rgb(i as u32),
+                    tangent: attrs.tangent(i as u32),
                 }
             })
             .collect();

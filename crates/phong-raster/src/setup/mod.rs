@@ -216,6 +216,29 @@ pub(crate) struct Pending {
     pub idx: [u32; 3],
 }
 
+/// A mesh's vertex attributes besides position and normal, as both set-ups read them: zero
+/// texture coordinates, white and no tangent where the mesh has none.
+#[derive(Clone, Copy)]
+pub(crate) struct VertexAttributes<'m>(pub &'m phong_core::Mesh);
+
+impl VertexAttributes<'_> {
+    pub fn uv(self, i: u32) -> glam::Vec2 {
+        self.0.uvs().get(i as usize).copied().unwrap_or_default()
+    }
+    pub fn uv1(self, i: u32) -> glam::Vec2 {
+        self.0.uvs1().get(i as usize).copied().unwrap_or_default()
+    }
+    pub fn rgb(self, i: u32) -> Vec3 {
+        self.0
+            .colors()
+            .get(i as usize)
+            .map_or(Vec3::ONE, |c| Vec3::from(c.to_array()))
+    }
+    pub fn tangent(self, i: u32) -> glam::Vec4 {
+        self.0.tangents().get(i as usize).copied().unwrap_or(glam::Vec4::ZERO)
+    }
+}
+
 /// Working memory kept between frames by a [`Renderer`](crate::Renderer): emptied, never
 /// shrunk.
 #[derive(Default)]
