@@ -4,10 +4,11 @@
 
 use crate::join::Join;
 use crate::{Color, Error};
-use glam::{Mat3, Mat3A, Mat4, Vec2, Vec3, Vec3A, Vec4};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rustc_hash::FxHashMap;
 
 mod crease;
+mod facets;
 pub use crease::{weld_ids, weld_positions};
 
 /// An indexed triangle mesh with one normal per vertex (or, drawn flat, one per triangle:
@@ -29,6 +30,42 @@ pub struct Mesh {
     /// A flat mesh's normals, one per triangle, its vertices shared ([`Mesh::flat_transformed`]);
     /// `normals` is then empty.
     face_normals: Option<Vec<Vec3>>,
+    /// A flat mesh's per-vertex form, made at its first use ([`Mesh::with_vertex_normals`]).
+    vertex_form: VertexForm,
+}
+
+/// [`Mesh::with_vertex_normals`]'s mesh, kept so that each frame lit per vertex does not make
+/// it again. A copy of the mesh starts without it, and every change of the mesh forgets it.
+#[derive(Default)]
+struct VertexForm(std::sync::OnceLock<Box<Mesh>>);
+
+impl VertexForm {
+    fn forget(&mut self) {
+        self.0 = std::sync::OnceLock::new();
+    }
+}
+
+impl Clone for VertexForm {
+    fn clone(&self) -> Self {
+        VertexForm::default()
+    }
+}
+
+/// Derived from the mesh: equal meshes are equal whether or not it was made.
+impl PartialEq for VertexForm {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for VertexForm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.get().is_some() {
+            "VertexForm(made)"
+        } else {
+            "VertexForm"
+        })
+    }
 }
 
 /// The first point with a coordinate that is not finite ([`not_finite_at`]).
@@ -126,12 +163,14 @@ impl Mesh {
             colors: Vec::new(),
             tangents: Vec::new(),
             face_normals: None,
+            vertex_form: VertexForm::default(),
         })
     }
 
     /// The mesh with vertex colours, one per vertex (linear RGB, finite and non-negative); an
     /// empty vector removes them.
     pub fn with_colors(mut self, colors: Vec<Color>) -> Result<Self, Error> {
+        self.vertex_form.forget();
         if !colors.is_empty() && colors.len() != self.positions.len() {
             return Err(Error::OutOfRange {
                 what: "number of vertex colours",
@@ -164,6 +203,7 @@ impl Mesh {
     /// sign: negative or not); an empty vector removes them. Like computed ones, they are
     /// dropped by the normals' functions.
     pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Self, Error> {
+        self.vertex_form.forget();
         if !tangents.is_empty() && tangents.len() != self.positions.len() {
             return Err(Error::OutOfRange {
                 what: "number of tangents",
@@ -258,6 +298,7 @@ impl Mesh {
     /// The mesh with texture coordinates, one per vertex, finite (`v = 0` is the image's
     /// bottom, as OBJ's `vt` and OpenGL); an empty vector removes them.
     pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
+        self.vertex_form.forget();
         self.uvs = self.checked_uvs(uvs)?;
         Ok(self)
     }
@@ -279,6 +320,7 @@ impl Mesh {
     /// The mesh with each vertex moved to `f` of its position (which must stay finite), in
     /// place, every other attribute kept.
     pub fn with_positions_mapped(mut self, f: impl Fn(Vec3) -> Vec3) -> Result<Self, Error> {
+        self.vertex_form.forget();
         for p in &mut self.positions {
             *p = f(*p);
         }
@@ -294,6 +336,7 @@ impl Mesh {
     /// The mesh with a second set of texture coordinates (glTF's `TEXCOORD_1`, read by the
     /// maps whose [`crate::TextureMap::set`] is 1), as [`Mesh::with_uvs`].
     pub fn with_uvs1(mut self, uvs: Vec<Vec2>) -> Result<Self, Error> {
+        self.vertex_form.forget();
         self.uvs1 = self.checked_uvs(uvs)?;
         Ok(self)
     }
@@ -354,9 +397,10 @@ impl Mesh {
     /// Appends `other`'s vertices and triangles. Where only one of the two has texture
     /// coordinates, colours or tangents, the other's vertices get `(0, 0)`, white or none.
     pub fn append(&mut self, other: &Mesh) {
+        self.vertex_form.forget();
         if self.face_normals.is_some() || other.face_normals.is_some() {
-            *self = self.with_vertex_normals().into_owned();
-            return self.append(&other.with_vertex_normals());
+            *self = self.with_vertex_normals().clone();
+            return self.append(other.with_vertex_normals());
         }
         let base = self.positions.len() as u32;
         let (mine, theirs) = (self.positions.len(), other.positions.len());
@@ -418,6 +462,7 @@ impl Mesh {
     /// [`Mesh::transformed`] in place: the same arithmetic, without a copy of the mesh (a
     /// loaded model's arrays are megabytes).
     pub fn into_transformed(mut self, m: &Mat4) -> Mesh {
+        self.vertex_form.forget();
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let linear = Mat3::from_mat4(*m);
         let flip = linear.determinant() < 0.0;
@@ -459,6 +504,7 @@ impl Mesh {
             colors: per_corner(&self.colors, &self.triangles),
             tangents: Vec::new(),
             face_normals: None,
+            vertex_form: VertexForm::default(),
         }
     }
 
@@ -469,22 +515,16 @@ impl Mesh {
     /// three vertices a triangle are made. For a model without normals (a glTF's flat ones)
     /// placed in the scene.
     pub fn flat_transformed(mut self, m: &Mat4, join: &impl Join) -> Mesh {
+        self.vertex_form.forget();
         if self.triangles.is_empty() {
             return self.with_flat_normals().into_transformed(m);
         }
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
         let mut faces = vec![Vec3::ZERO; self.triangles.len()];
-        // (In `Vec3A`, glam's SSE form of the same operations in the same order: the same
-        // bits as `facet_normal` and `Mat3 * Vec3`, in fewer instructions.)
-        let nm_a = Mat3A::from(nm);
         let positions = &self.positions;
         let fill = |triangles: &[[u32; 3]], out: &mut [Vec3]| {
-            for (n, t) in out.iter_mut().zip(triangles) {
-                let [pa, pb, pc] = t.map(|i| Vec3A::from(positions[i as usize]));
-                let facet = (pb - pa).cross(pc - pa).normalize_or_zero();
-                *n = Vec3::from((nm_a * facet).normalize_or_zero());
-            }
+            facets::unit_normals_through(positions, triangles, &nm, out);
         };
         // A large mesh's facets in two halves, which `join` may compute side by side.
         let half = self.triangles.len() / 2;
@@ -508,6 +548,7 @@ impl Mesh {
             normals: Vec::new(),
             tangents: Vec::new(),
             face_normals: Some(faces),
+            vertex_form: VertexForm::default(),
             ..self
         }
     }
@@ -529,25 +570,28 @@ impl Mesh {
     /// The mesh with one normal per vertex: itself, or for a mesh of [`Mesh::face_normals`]
     /// three vertices a triangle carrying its normal (as [`Mesh::with_flat_normals`] makes
     /// them), for the users of per-vertex normals (lighting per vertex, the GPU's buffers).
-    pub fn with_vertex_normals(&self) -> std::borrow::Cow<'_, Mesh> {
+    pub fn with_vertex_normals(&self) -> &Mesh {
         let Some(faces) = &self.face_normals else {
-            return std::borrow::Cow::Borrowed(self);
+            return self;
         };
-        let mut normals = vec![Vec3::ZERO; 3 * faces.len()];
-        for (n, f) in normals.chunks_exact_mut(3).zip(faces) {
-            n.fill(*f);
-        }
-        std::borrow::Cow::Owned(Mesh {
-            positions: per_corner(&self.positions, &self.triangles),
-            normals,
-            triangles: (0..self.triangles.len() as u32)
-                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                .collect(),
-            uvs: per_corner(&self.uvs, &self.triangles),
-            uvs1: per_corner(&self.uvs1, &self.triangles),
-            colors: per_corner(&self.colors, &self.triangles),
-            tangents: per_corner(&self.tangents, &self.triangles),
-            face_normals: None,
+        self.vertex_form.0.get_or_init(|| {
+            let mut normals = vec![Vec3::ZERO; 3 * faces.len()];
+            for (n, f) in normals.chunks_exact_mut(3).zip(faces) {
+                n.fill(*f);
+            }
+            Box::new(Mesh {
+                positions: per_corner(&self.positions, &self.triangles),
+                normals,
+                triangles: (0..self.triangles.len() as u32)
+                    .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                    .collect(),
+                uvs: per_corner(&self.uvs, &self.triangles),
+                uvs1: per_corner(&self.uvs1, &self.triangles),
+                colors: per_corner(&self.colors, &self.triangles),
+                tangents: per_corner(&self.tangents, &self.triangles),
+                face_normals: None,
+                vertex_form: VertexForm::default(),
+            })
         })
     }
 
@@ -572,6 +616,7 @@ impl Mesh {
             colors: Vec::new(),
             tangents: Vec::new(),
             face_normals: None,
+            vertex_form: VertexForm::default(),
         };
         (mesh, remap)
     }
@@ -604,6 +649,7 @@ impl Mesh {
             colors: self.colors.clone(),
             tangents: Vec::new(),
             face_normals: None,
+            vertex_form: VertexForm::default(),
         }
     }
 
@@ -895,7 +941,7 @@ mod tests {
         let m = Mat4::from_scale(Vec3::new(-2.0, 1.0, 0.5));
         assert_eq!(
             corner_bits(&flat.clone().into_transformed(&m)),
-            corner_bits(&flat.with_vertex_normals().into_owned().into_transformed(&m))
+            corner_bits(&flat.with_vertex_normals().clone().into_transformed(&m))
         );
         let mut both = folded();
         both.append(&flat);
@@ -903,6 +949,30 @@ mod tests {
         want.append(&flat.with_vertex_normals());
         assert_eq!(corner_bits(&both), corner_bits(&want));
         assert!(both.face_normals().is_none());
+    }
+
+    /// A flat mesh's vertex form is made once, and a changed mesh (moved, given colours,
+    /// appended to) makes it again from what it now is; a copy starts without it.
+    #[test]
+    fn vertex_form_is_kept_until_the_mesh_changes() {
+        let flat = folded().flat_transformed(&Mat4::from_rotation_x(0.3), &crate::join::InTurn);
+        let first: *const Mesh = flat.with_vertex_normals();
+        assert!(std::ptr::eq(first, flat.with_vertex_normals()));
+        assert_eq!(corner_bits(flat.with_vertex_normals()), corner_bits(&flat));
+        let copy = flat.clone();
+        assert!(!std::ptr::eq(first, copy.with_vertex_normals()));
+        let moved = flat.into_transformed(&Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)));
+        assert_eq!(corner_bits(moved.with_vertex_normals()), corner_bits(&moved));
+        let n = moved.positions().len();
+        let coloured = moved.with_colors(vec![Color::new(0.25, 0.5, 1.0); n]).unwrap();
+        assert_eq!(corner_bits(coloured.with_vertex_normals()), corner_bits(&coloured));
+        let mut grown = copy.clone();
+        let _ = grown.with_vertex_normals();
+        grown.append(&folded());
+        assert_eq!(corner_bits(grown.with_vertex_normals()), corner_bits(&grown));
+        assert_eq!(grown.triangles().len(), 2 * copy.triangles().len());
+        // Equal meshes stay equal whether or not their form was made.
+        assert_eq!(copy, copy.clone());
     }
 
     #[test]

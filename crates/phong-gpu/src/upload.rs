@@ -60,7 +60,6 @@ impl Geometry {
             g.objects.push(GpuObject::new(&o.material, &o.shading, &view));
             // (A flat mesh's triangles with vertices of their own: a vertex carries its normal.)
             let m = o.mesh.with_vertex_normals();
-            let m = &*m;
             let base = g.vertices.len();
             let first = g.indices.len() as u32;
             let uv = |k: u32| {

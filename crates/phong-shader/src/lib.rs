@@ -572,7 +572,6 @@ pub struct VertexArrays {
 pub fn vertex_arrays(o: &Object) -> VertexArrays {
     // (A flat mesh's triangles with vertices of their own: a vertex carries its normal.)
     let m = o.mesh.with_vertex_normals();
-    let m = &*m;
     if o.shading.interpolation != Interpolation::Flat {
         return VertexArrays {
             positions: m.positions().to_vec(),

@@ -16,7 +16,6 @@ use crate::simd::{ColourPlanes, Planes};
 use crate::vertex::{FastVertex, VertexLighting, fast_vertices};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
-use std::borrow::Cow;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -35,7 +34,7 @@ impl Stage<'_> {
         let mesh = if gouraud {
             obj.mesh.with_vertex_normals()
         } else {
-            Cow::Borrowed(&obj.mesh)
+            &obj.mesh
         };
         let (positions, normals, faces) = (mesh.positions(), mesh.normals(), mesh.face_normals());
         // The normals at a triangle's corners.
@@ -44,7 +43,7 @@ impl Stage<'_> {
             None => tri.map(|i| normals[i as usize]),
         };
         self.fast_vertices(&mut scratch.vertices, positions);
-        let attrs = VertexAttributes(&mesh);
+        let attrs = VertexAttributes(mesh);
         let extra = plan.extra;
         let extra_of = |i: u32| extra.of(attrs.rgb(i), attrs.uv1(i), attrs.tangent(i));
         let lighting = gouraud.then(|| {

@@ -29,7 +29,6 @@ impl Stage<'_> {
         let view = self.plan.objects[oi].view;
         // (A flat mesh as three vertices a triangle: this path reads normals per vertex.)
         let mesh = obj.mesh.with_vertex_normals();
-        let mesh = &*mesh;
         let (gouraud, colour) = (interpolation == Interpolation::Gouraud, self.plan.colour_planes);
         let attrs = VertexAttributes(mesh);
         let lit = |p: Vec3, n: Vec3| obj.vertex_light(&scene.lighting, &view, p, n);
