@@ -104,6 +104,13 @@ pub fn index_at_least(indices: &[u32], n: usize) -> Option<usize> {
     }
 }
 
+/// `n` zero vectors, allocated zeroed: the allocator clears the memory in one pass (or not at
+/// all where it is fresh from the system), where a vector filled with `Vec3::ZERO` was written
+/// element by element (a model's normals before its own are computed, arrays written whole).
+pub fn zero_vectors(n: usize) -> Vec<Vec3> {
+    bytemuck::allocation::try_cast_vec(vec![0.0f32; 3 * n]).unwrap_or_else(|_| vec![Vec3::ZERO; n])
+}
+
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
 #[inline]
 pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
@@ -521,7 +528,7 @@ impl Mesh {
         }
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
-        let mut faces = vec![Vec3::ZERO; self.triangles.len()];
+        let mut faces = zero_vectors(self.triangles.len());
         let positions = &self.positions;
         let fill = |triangles: &[[u32; 3]], out: &mut [Vec3]| {
             facets::unit_normals_through(positions, triangles, &nm, out);
@@ -852,7 +859,7 @@ mod tests {
             let b = mesh.with_flat_normals().into_transformed(&m);
             let a = mesh.flat_transformed(&m, &crate::join::InTurn);
             proptest::prop_assert_eq!(corner_bits(&a), corner_bits(&b));
-            proptest::prop_assert_eq!(corner_bits(&a.with_vertex_normals()), corner_bits(&b));
+            proptest::prop_assert_eq!(corner_bits(a.with_vertex_normals()), corner_bits(&b));
         }
     }
 
@@ -904,7 +911,7 @@ mod tests {
                 );
                 assert_eq!(corner_bits(&a), corner_bits(&b));
                 assert_eq!(corner_bits(&reversed), corner_bits(&b));
-                assert_eq!(corner_bits(&a.with_vertex_normals()), corner_bits(&b));
+                assert_eq!(corner_bits(a.with_vertex_normals()), corner_bits(&b));
                 // The vertices stay shared, the normals are the triangles'.
                 assert_eq!(a.positions().len(), mesh.positions().len());
                 assert!(a.normals().is_empty());
@@ -946,7 +953,7 @@ mod tests {
         let mut both = folded();
         both.append(&flat);
         let mut want = folded();
-        want.append(&flat.with_vertex_normals());
+        want.append(flat.with_vertex_normals());
         assert_eq!(corner_bits(&both), corner_bits(&want));
         assert!(both.face_normals().is_none());
     }
@@ -973,6 +980,46 @@ mod tests {
         assert_eq!(grown.triangles().len(), 2 * copy.triangles().len());
         // Equal meshes stay equal whether or not their form was made.
         assert_eq!(copy, copy.clone());
+    }
+
+    #[test]
+    fn zero_vectors_are_n_zeros() {
+        for n in [0, 1, 7, 100_000] {
+            let v = zero_vectors(n);
+            assert_eq!(v.len(), n);
+            assert!(v.iter().all(|p| p.to_array().map(f32::to_bits) == [0; 3]));
+        }
+    }
+
+    /// New positions replace the old one for one, every other attribute kept (a flat mesh's
+    /// triangle normals as they were); a wrong count or a position not finite is refused.
+    #[test]
+    fn with_positions_moves_vertices_and_keeps_the_rest() {
+        let uvs: Vec<Vec2> = (0..5).map(|i| Vec2::new(i as f32 * 0.25, 0.5)).collect();
+        let m = folded().with_uvs(uvs.clone()).unwrap();
+        let moved: Vec<Vec3> = m.positions().iter().map(|p| *p * 2.0 + Vec3::X).collect();
+        let got = m.clone().with_positions(moved.clone()).unwrap();
+        assert_eq!(got.positions(), &moved[..]);
+        assert_eq!(
+            (got.normals(), got.triangles(), got.uvs()),
+            (m.normals(), m.triangles(), &uvs[..])
+        );
+        let flat = folded().flat_transformed(&Mat4::IDENTITY, &crate::join::InTurn);
+        let got = flat.clone().with_positions(moved.clone()).unwrap();
+        assert_eq!(got.face_normals(), flat.face_normals());
+        assert!(matches!(
+            m.clone().with_positions(moved[..4].to_vec()),
+            Err(Error::OutOfRange { what: "number of positions", value, .. }) if value == 4.0
+        ));
+        let mut bad = moved;
+        bad[3].y = f32::NAN;
+        assert!(matches!(
+            m.with_positions(bad),
+            Err(Error::InvalidPosition {
+                what: "mesh vertex",
+                ..
+            })
+        ));
     }
 
     #[test]

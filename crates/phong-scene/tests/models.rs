@@ -1380,7 +1380,8 @@ fn every_face_the_camera_sees_is_lit() {
 /// scene reader. Both give the same scene, bit for bit: camera, sides, and each object's
 /// positions, normals and triangles. Models of 20k triangles and more without normals: a
 /// smooth torus and a teapot with rims and a spout (creases, split vertices), as OBJ and as
-/// binary STL; and as glTF, drawn flat (one normal a triangle) and read alike either way.
+/// binary STL; and as glTF, drawn flat (one normal a triangle), which neither way computes
+/// beside the framing (the scene reader places it on both), read alike either way.
 #[test]
 fn normals_beside_the_framing_are_the_scene_readers() {
     let d = dir("beside");

@@ -172,9 +172,7 @@ impl Stage<'_> {
         }
         chunks
     }
-}
 
-impl Stage<'_> {
     /// Each of `positions` projected into its [`FastVertex`] record in `vertices`.
     fn fast_vertices(&self, vertices: &mut Vec<FastVertex>, positions: &[Vec3]) {
         let (isa, clip_from_world) = (self.plan.isa, self.plan.clip_from_world);
