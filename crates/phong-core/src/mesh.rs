@@ -104,13 +104,6 @@ pub fn index_at_least(indices: &[u32], n: usize) -> Option<usize> {
     }
 }
 
-/// `n` zero vectors, allocated zeroed: the allocator clears the memory in one pass (or not at
-/// all where it is fresh from the system), where a vector filled with `Vec3::ZERO` was written
-/// element by element (a model's normals before its own are computed, arrays written whole).
-pub fn zero_vectors(n: usize) -> Vec<Vec3> {
-    bytemuck::allocation::try_cast_vec(vec![0.0f32; 3 * n]).unwrap_or_else(|_| vec![Vec3::ZERO; n])
-}
-
 /// The facet normal of seed 001: `normalize((p2 − p1) × (p3 − p1))`; zero for a degenerate triangle.
 #[inline]
 pub fn facet_normal(p1: Vec3, p2: Vec3, p3: Vec3) -> Vec3 {
@@ -528,7 +521,7 @@ impl Mesh {
         }
         let nm = Mat3::from_mat4(*m).inverse().transpose();
         let flip = Mat3::from_mat4(*m).determinant() < 0.0;
-        let mut faces = zero_vectors(self.triangles.len());
+        let mut faces = vec![Vec3::ZERO; self.triangles.len()];
         let positions = &self.positions;
         let fill = |triangles: &[[u32; 3]], out: &mut [Vec3]| {
             facets::unit_normals_through(positions, triangles, &nm, out);
@@ -980,15 +973,6 @@ mod tests {
         assert_eq!(grown.triangles().len(), 2 * copy.triangles().len());
         // Equal meshes stay equal whether or not their form was made.
         assert_eq!(copy, copy.clone());
-    }
-
-    #[test]
-    fn zero_vectors_are_n_zeros() {
-        for n in [0, 1, 7, 100_000] {
-            let v = zero_vectors(n);
-            assert_eq!(v.len(), n);
-            assert!(v.iter().all(|p| p.to_array().map(f32::to_bits) == [0; 3]));
-        }
     }
 
     /// New positions replace the old one for one, every other attribute kept (a flat mesh's

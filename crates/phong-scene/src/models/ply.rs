@@ -626,7 +626,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         ));
     }
     let has_normals = normals.is_some() && !positions.is_empty();
-    let normals = normals.unwrap_or_else(|| phong_core::mesh::zero_vectors(positions.len()));
+    let normals = normals.unwrap_or_else(|| vec![Vec3::ZERO; positions.len()]);
     let mesh = Mesh::new(positions, normals, triangles)
         .and_then(|m| m.with_colors(colors.unwrap_or_default()))
         .map_err(|e| fail(e.to_string()))?;

@@ -50,7 +50,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         } else {
             points.iter().map(|p| (p.as_dvec3() - origin).as_vec3()).collect()
         };
-        let normals = phong_core::mesh::zero_vectors(positions.len());
+        let normals = vec![Vec3::ZERO; positions.len()];
         let mesh = Mesh::new(positions, normals, triangles).map_err(|e| fail(e.to_string()))?;
         let base = part_name(path);
         parts.push(ModelPart {

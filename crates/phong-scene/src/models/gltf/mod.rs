@@ -478,9 +478,9 @@ fn geometry(
                 })
                 .collect();
             let ok = ns.len() == n;
-            (if ok { ns } else { phong_core::mesh::zero_vectors(n) }, ok)
+            (if ok { ns } else { vec![Vec3::ZERO; n] }, ok)
         }
-        None => (phong_core::mesh::zero_vectors(n), false),
+        None => (vec![Vec3::ZERO; n], false),
     };
     // TANGENT (read with normals, as the format pairs them): a direction in the surface,
     // by the node's matrix itself; a mirror flips the bitangent's sign.

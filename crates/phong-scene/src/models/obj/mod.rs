@@ -356,7 +356,7 @@ fn part_of(
             .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
             .collect()
     } else {
-        phong_core::mesh::zero_vectors(positions.len())
+        vec![Vec3::ZERO; positions.len()]
     };
     let tris = match triangles {
         Some(t) => t,
