@@ -93,14 +93,27 @@ pub fn first_out_of_range(triangles: &[[u32; 3]], n: usize) -> Option<&[u32; 3]>
     index_at_least(triangles.as_flattened(), n).map(|k| &triangles[k / 3])
 }
 
-/// Where the first index at or past `n` is in `indices`: the largest found by one vectorised
-/// pass, the position searched only when it is out of range.
+/// Where the first index at or past `n` is in `indices`: decided by one vectorised pass, the
+/// position searched only when one is out of range.
 pub fn index_at_least(indices: &[u32], n: usize) -> Option<usize> {
-    let max = indices.iter().fold(0u32, |m, &i| m.max(i));
-    if indices.is_empty() || (max as usize) < n {
-        None
-    } else {
+    let any = match n {
+        0 => !indices.is_empty(),
+        // As `i32` (two vector operations an index: x86-64's baseline has no unsigned 32-bit
+        // max or comparison): an index of 2³¹ and more has its sign bit set, one below that
+        // is out of range where it is above `n − 1`.
+        1..=0x8000_0000 => {
+            let last = (n - 1) as i32;
+            let (bits, over) = indices
+                .iter()
+                .fold((0u32, 0u32), |(b, o), &i| (b | i, o | u32::from(i as i32 > last)));
+            bits >> 31 != 0 || over != 0
+        }
+        _ => indices.iter().fold(0u32, |m, &i| m.max(i)) as usize >= n,
+    };
+    if any {
         indices.iter().position(|&i| i as usize >= n)
+    } else {
+        None
     }
 }
 
@@ -693,6 +706,19 @@ fn append_attribute<T: Clone>(mine: &mut Vec<T>, theirs: &[T], n_mine: usize, n_
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// The first index at or past `n`, as the plain search finds it, for any indices and
+        /// counts (2³¹ and past included).
+        #[test]
+        fn index_at_least_is_the_plain_search(
+            indices in proptest::collection::vec(proptest::prop_oneof![0u32..40, proptest::prelude::any::<u32>()], 0..40),
+            n in proptest::prop_oneof![0usize..45, proptest::strategy::Just(0x7fff_ffff), proptest::strategy::Just(0x8000_0000), proptest::strategy::Just(0x8000_0001), proptest::strategy::Just(1usize << 33)],
+        ) {
+            let want = indices.iter().position(|&i| i as usize >= n);
+            proptest::prop_assert_eq!(index_at_least(&indices, n), want);
+        }
+    }
 
     /// The vectorised checks find what a plain search finds: the first point with a NaN or an
     /// infinity in any coordinate (none in a finite mesh, the largest finite values included),

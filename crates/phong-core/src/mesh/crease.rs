@@ -311,7 +311,7 @@ fn facets_summed<const SUMS: bool>(positions: &[Vec3], tris: &[[u32; 3]]) -> Fac
     for ((t, f_out), u_out) in tris.iter().zip(&mut facet).zip(&mut unit) {
         // (In `Vec3A`, glam's SSE form of the same operations in the same order: the same
         // bits in fewer instructions. Four at a time in `Vec4` lanes, as the flat normals
-        // are, was no fewer: about 60 instructions a face either way.)
+        // are, was no fewer: BENCHMARKS.md, L10.)
         let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3A::from(positions[i as usize]));
         let fa = (b - a).cross(c - a);
         let f = Vec3::from(fa);
