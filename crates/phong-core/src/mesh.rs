@@ -501,13 +501,20 @@ impl Mesh {
 
     /// Flat normals: every triangle gets its own three vertices carrying its facet normal.
     pub fn with_flat_normals(&self) -> Mesh {
-        let positions = per_corner(&self.positions, &self.triangles);
-        let mut normals = vec![Vec3::ZERO; positions.len()];
-        for (n, c) in normals.chunks_exact_mut(3).zip(positions.chunks_exact(3)) {
-            n.fill(facet_normal(c[0], c[1], c[2]));
+        let mut normals = vec![Vec3::ZERO; 3 * self.triangles.len()];
+        for (n, t) in normals.chunks_exact_mut(3).zip(&self.triangles) {
+            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+            n.fill(facet_normal(a, b, c));
         }
+        self.unshared(normals, false)
+    }
+
+    /// The mesh with three vertices of its own a triangle, each with its corner's position,
+    /// coordinates and colour (and tangent, where `tangents`), carrying `normals` (three a
+    /// triangle, in its corners' order).
+    fn unshared(&self, normals: Vec<Vec3>, tangents: bool) -> Mesh {
         Mesh {
-            positions,
+            positions: per_corner(&self.positions, &self.triangles),
             normals,
             triangles: (0..self.triangles.len() as u32)
                 .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
@@ -515,7 +522,11 @@ impl Mesh {
             uvs: per_corner(&self.uvs, &self.triangles),
             uvs1: per_corner(&self.uvs1, &self.triangles),
             colors: per_corner(&self.colors, &self.triangles),
-            tangents: Vec::new(),
+            tangents: if tangents {
+                per_corner(&self.tangents, &self.triangles)
+            } else {
+                Vec::new()
+            },
             face_normals: None,
             vertex_form: VertexForm::default(),
         }
@@ -592,19 +603,7 @@ impl Mesh {
             for (n, f) in normals.chunks_exact_mut(3).zip(faces) {
                 n.fill(*f);
             }
-            Box::new(Mesh {
-                positions: per_corner(&self.positions, &self.triangles),
-                normals,
-                triangles: (0..self.triangles.len() as u32)
-                    .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                    .collect(),
-                uvs: per_corner(&self.uvs, &self.triangles),
-                uvs1: per_corner(&self.uvs1, &self.triangles),
-                colors: per_corner(&self.colors, &self.triangles),
-                tangents: per_corner(&self.tangents, &self.triangles),
-                face_normals: None,
-                vertex_form: VertexForm::default(),
-            })
+            Box::new(self.unshared(normals, true))
         })
     }
 
