@@ -62,7 +62,8 @@ fn normalized(v: &[Vec4; 3]) -> [Vec4; 3] {
     ]
 }
 
-/// Each lane's square root (correctly rounded; the compiler makes it one vector instruction).
+/// Each lane's square root, correctly rounded as `f32::sqrt`: four scalar square roots (the
+/// vector intrinsic needs `unsafe`, which phong-core forbids).
 #[inline(always)]
 fn sqrt(v: Vec4) -> Vec4 {
     Vec4::new(v.x.sqrt(), v.y.sqrt(), v.z.sqrt(), v.w.sqrt())
