@@ -312,6 +312,7 @@ impl SceneCore {
             flat_without_normals: false,
             origin: glam::DVec3::ZERO,
             drawn: None,
+            fitted: None,
         };
         let model = ModelFile::from_parts(vec![part]);
         py.detach(|| guarded(|| SceneCore::framed_model(Path::new("mesh"), Arc::new(Backing { model }), options, None)))

@@ -1381,7 +1381,9 @@ fn every_face_the_camera_sees_is_lit() {
 /// positions, normals and triangles. Models of 20k triangles and more without normals: a
 /// smooth torus and a teapot with rims and a spout (creases, split vertices), as OBJ and as
 /// binary STL; and as glTF, drawn flat (one normal a triangle), which neither way computes
-/// beside the framing (the scene reader places it on both), read alike either way.
+/// beside the framing (the scene reader places it on both), read alike either way. Where the
+/// normals are not computed beside (the glTFs, a small OBJ of two parts), `phong render MODEL`
+/// hands the framing's fitted vertices to the scene reader, which computes them otherwise.
 #[test]
 fn normals_beside_the_framing_are_the_scene_readers() {
     let d = dir("beside");
@@ -1443,6 +1445,29 @@ fn normals_beside_the_framing_are_the_scene_readers() {
         files.push(write(&d, &format!("{name}.stl"), &stl(mesh)));
         files.push(write(&d, &format!("{name}.gltf"), &gltf(mesh)));
     }
+    // Two parts below that size (not beside the framing), moved apart: each takes its share of
+    // the framing's fitted vertices.
+    let (one, two) = (
+        phong_core::primitives::torus(12, 1.0, 0.3),
+        phong_core::primitives::torus(16, 1.0, 0.3),
+    );
+    let mut parts = String::new();
+    for (k, (name, m)) in [("one", &one), ("two", &two)].into_iter().enumerate() {
+        let base = if k == 0 { 0 } else { one.positions().len() };
+        parts += &format!("g {name}\n");
+        for p in m.positions() {
+            parts += &format!("v {} {} {}\n", p.x + 3.0 * k as f32, p.y, p.z);
+        }
+        for t in m.triangles() {
+            parts += &format!(
+                "f {} {} {}\n",
+                t[0] as usize + base + 1,
+                t[1] as usize + base + 1,
+                t[2] as usize + base + 1
+            );
+        }
+    }
+    files.push(write(&d, "parts.obj", parts.as_bytes()));
     let bits = |v: &[Vec3]| v.iter().map(|x| x.to_array().map(f32::to_bits)).collect::<Vec<_>>();
     // Each corner's normal in turn (a flat mesh's are its triangles').
     let corner_normals = |m: &phong_core::Mesh| -> Vec<Vec3> {

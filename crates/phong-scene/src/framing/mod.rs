@@ -149,6 +149,7 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     } else {
         framed(path, &model, options)
     };
+    hand_on_fitted(&mut model);
     let ModelFile {
         parts,
         warnings,
@@ -168,6 +169,27 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
     loaded.warnings.splice(0..0, warnings);
     loaded.sources = sources;
     Ok(loaded)
+}
+
+/// The framing's vertices in the fitted frame handed to the parts not already drawn, for the
+/// scene reader to take instead of computing them again (the model is read for one scene).
+fn hand_on_fitted(model: &mut ModelFile) {
+    let Some(Fitted { mut points, .. }) = model.fitted.take() else {
+        return;
+    };
+    // `points` holds every part's vertices in the parts' order: split from the last part.
+    for p in model.parts.iter_mut().rev() {
+        let rest = points.len().saturating_sub(p.mesh.positions().len());
+        // (The first part takes what is left as it is: `split_off(0)` would copy it.)
+        let own = if rest == 0 {
+            std::mem::take(&mut points)
+        } else {
+            points.split_off(rest)
+        };
+        if p.drawn.is_none() && own.len() == p.mesh.positions().len() {
+            p.fitted = Some(own);
+        }
+    }
 }
 
 /// Whether the framing and the normals of `parts` are worth computing side by side ([`Beside`]
@@ -861,6 +883,7 @@ mod tests {
             flat_without_normals: false,
             origin: DVec3::ZERO,
             drawn: None,
+            fitted: None,
         }
     }
 

@@ -32,6 +32,11 @@ pub struct ModelPart {
     /// `None` from the readers. The scene reader uses it for an object with `fit` and no
     /// `normals` or `crease` of its own, and computes the same otherwise.
     pub drawn: Option<Mesh>,
+    /// Its positions in the model's fitted frame (centred on the bounding sphere of the whole
+    /// model, radius 1), where `phong render MODEL` computed them for its framing; `None` from
+    /// the readers. The scene reader takes them for an object with `fit` instead of computing
+    /// the same again.
+    pub fitted: Option<Vec<glam::Vec3>>,
 }
 
 /// The name of a model's one part: its file name.

@@ -641,6 +641,7 @@ pub(crate) fn read_ply(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
         flat_without_normals: false,
         origin,
         drawn: None,
+        fitted: None,
     }])
 }
 

@@ -66,6 +66,7 @@ pub(crate) fn read_stl(path: &Path, bytes: &[u8]) -> Result<Vec<ModelPart>, Erro
             flat_without_normals: false,
             origin,
             drawn: None,
+            fitted: None,
         });
     }
     if parts.is_empty() {

@@ -344,11 +344,18 @@ fn mesh_objects(
             // Computed beside the model-alone scene's framing by this same function, for the
             // choice and crease it would be given here.
             Some(drawn) if fit && asked.is_none() && o.crease.is_none() => drawn,
-            _ if choice == "flat" => {
-                flat = true;
-                fitted(std::mem::take(&mut p.mesh), fit_frame).map_err(model_error)?
+            _ => {
+                let mesh = std::mem::take(&mut p.mesh);
+                // The framing's fitted vertices where it made them (the same values).
+                let mesh = match p.fitted.take() {
+                    Some(points) if fit_frame.is_some() => mesh.with_positions(points),
+                    _ => fitted(mesh, fit_frame),
+                }
+                .map_err(model_error)?;
+                flat = choice == "flat";
+                // Flat normals are made with the placement below.
+                if flat { mesh } else { with_normals(mesh, choice, crease) }
             }
-            _ => drawn_mesh(std::mem::take(&mut p.mesh), fit_frame, choice, crease).map_err(model_error)?,
         };
         // The scene's material replaces the file's, maps and all.
         let (material, maps) = material.clone().unwrap_or((p.material.unwrap_or_default(), p.maps));

@@ -539,6 +539,7 @@ fn into_parts(pending: Vec<Pending>, fail: &dyn Fn(String) -> Error) -> Result<V
                 flat_without_normals: true,
                 origin,
                 drawn: None,
+                fitted: None,
             })
         })
         .collect()

@@ -416,6 +416,7 @@ fn part_of(
             flat_without_normals: false,
             origin,
             drawn: None,
+            fitted: None,
         },
         m.material_id,
     )))
