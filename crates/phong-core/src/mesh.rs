@@ -482,8 +482,10 @@ impl Mesh {
         for p in &mut self.positions {
             *p = m.transform_point3(*p);
         }
-        for n in self.normals.iter_mut().chain(self.face_normals.iter_mut().flatten()) {
-            *n = (nm * *n).normalize_or_zero();
+        // (Four at a time: the same bits as `(nm * n).normalize_or_zero()`.)
+        facets::normals_through(&mut self.normals, &nm);
+        if let Some(faces) = &mut self.face_normals {
+            facets::normals_through(faces, &nm);
         }
         if flip {
             for t in &mut self.triangles {

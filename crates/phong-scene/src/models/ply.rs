@@ -781,16 +781,37 @@ fn plain_binary(h: &Header, bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> 
     if !positions.iter().all(|p| p.is_finite()) {
         return None;
     }
-    // Every face checked without a branch: its count 3, its largest index below `n`.
+    let (triangles, counts_ok, largest) = if big {
+        triangle_rows::<true>(&body[vertex_bytes..])
+    } else {
+        triangle_rows::<false>(&body[vertex_bytes..])
+    };
+    (counts_ok && (triangles.is_empty() || (largest as usize) < n)).then_some((positions, triangles))
+}
+
+/// The triangles of rows of 13 bytes (a count, then three 32-bit indices, big-endian where
+/// `BIG`), whether every count is 3, and the largest index: every row checked without a
+/// branch, its bytes read from a fixed-size array (no bounds check).
+fn triangle_rows<const BIG: bool>(rows: &[u8]) -> (Vec<[u32; 3]>, bool, u32) {
     let (mut counts_ok, mut largest) = (true, 0u32);
-    let triangles: Vec<[u32; 3]> = body[vertex_bytes..]
-        .chunks_exact(13)
-        .map(|face| {
-            let tri = [1, 5, 9].map(|o| word(face, o));
-            counts_ok &= face[0] == 3;
+    let triangles = rows
+        .as_chunks::<13>()
+        .0
+        .iter()
+        .map(|row| {
+            let word = |o: usize| {
+                let b = [row[o], row[o + 1], row[o + 2], row[o + 3]];
+                if BIG {
+                    u32::from_be_bytes(b)
+                } else {
+                    u32::from_le_bytes(b)
+                }
+            };
+            let tri = [word(1), word(5), word(9)];
+            counts_ok &= row[0] == 3;
             largest = largest.max(tri[0]).max(tri[1]).max(tri[2]);
             tri
         })
         .collect();
-    (counts_ok && (triangles.is_empty() || (largest as usize) < n)).then_some((positions, triangles))
+    (triangles, counts_ok, largest)
 }
