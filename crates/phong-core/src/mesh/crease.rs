@@ -235,45 +235,98 @@ fn merged(points: &[Vec3], ids: &[u32], distinct: usize) -> Vec<Vec3> {
 
 /// How many distinct positions `points` has (equal positions, 0 and −0 alike, are one), and
 /// per point the index of its position in the order first met: point `i`'s is `i` for every
-/// `i` exactly where the count is `points.len()`. An open-addressing table sized for the
-/// positions (at most half full) whose entries hold a tag of the position's hash and the first
-/// point at that position: a probe reads one entry, and a point only where the tags agree (a
-/// table of ids into a list of keys read both, two cache misses a probe; BENCHMARKS.md,
-/// "Loading against trimesh").
+/// `i` exactly where the count is `points.len()`.
+///
+/// The points are first sorted into buckets by their hash's top bits (a counting sort, in
+/// point order within a bucket), then each bucket is welded in an open-addressing table sized
+/// for it (at most half full, about 16 KiB: in the L1 cache), whose entries hold a tag of the
+/// position's hash and the first point at that position. One table for all the points missed
+/// the caches at nearly every probe (BENCHMARKS.md, "Loading against trimesh").
 pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
-    let size = (points.len() * 2).next_power_of_two().max(16);
-    let shift = 64 - size.trailing_zeros();
-    let key = |p: &Vec3| p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
-    // (tag << 32) | first point; empty: u64::MAX (no point has index u32::MAX: a mesh's
-    // vertices are indexed by u32).
-    let mut table = vec![u64::MAX; size];
-    let mut remap = Vec::with_capacity(points.len());
-    let mut distinct = 0u32;
-    for (n, p) in points.iter().enumerate() {
-        let k = key(p);
-        let h = ((u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
-        .wrapping_mul(0x2545_F491_4F6C_DD1D);
-        let mut i = (h >> shift) as usize;
-        let tag = h & 0xFFFF_FFFF;
-        let index = loop {
-            let e = table[i];
-            if e == u64::MAX {
-                table[i] = (tag << 32) | n as u64;
-                distinct += 1;
-                break distinct - 1;
-            }
-            if e >> 32 == tag {
-                let first = (e & 0xFFFF_FFFF) as usize;
-                if key(&points[first]) == k {
-                    break remap[first];
-                }
-            }
-            i = (i + 1) & (size - 1);
-        };
-        remap.push(index);
+    // Buckets of 1,024 to 2,047 points (one for fewer points), at most 4,096 of them.
+    let bits = (points.len() / 1024).max(1).ilog2().min(12);
+    weld_ids_in(points, bits)
+}
+
+/// A position's key: its bits, 0 for both zeros.
+#[inline(always)]
+fn weld_key(p: &Vec3) -> [u32; 3] {
+    p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+/// A key's 64-bit hash: its top `bits` bits choose the bucket, its low 32 are the tag (whose
+/// top bits choose the slot in the bucket's table).
+#[inline(always)]
+fn weld_hash(k: [u32; 3]) -> u64 {
+    ((u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+    .wrapping_mul(0x2545_F491_4F6C_DD1D)
+}
+
+/// [`weld_ids`] with `2^bits` buckets.
+fn weld_ids_in(points: &[Vec3], bits: u32) -> (usize, Vec<u32>) {
+    let n = points.len();
+    let buckets = 1usize << bits;
+    let bucket = |h: u64| (h.checked_shr(64 - bits).unwrap_or(0)) as usize;
+    let mut start = vec![0u32; buckets + 1];
+    for p in points {
+        start[bucket(weld_hash(weld_key(p))) + 1] += 1;
     }
-    (distinct as usize, remap)
+    for b in 0..buckets {
+        start[b + 1] += start[b];
+    }
+    // Per bucket, its points as `tag << 32 | point`, in point order.
+    let mut sorted = vec![0u64; n];
+    let mut fill = start[..buckets].to_vec();
+    for (i, p) in points.iter().enumerate() {
+        let h = weld_hash(weld_key(p));
+        let b = bucket(h);
+        sorted[fill[b] as usize] = (h << 32) | i as u64;
+        fill[b] += 1;
+    }
+    // Per point, the first point at its position (so that `first[i] <= i`).
+    let mut first = vec![0u32; n];
+    let largest = start.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0) as usize;
+    // (An entry's point is never u32::MAX: a mesh's vertices are indexed by u32.)
+    let mut table = vec![u64::MAX; (largest * 2).next_power_of_two().max(16)];
+    for w in start.windows(2) {
+        let list = &sorted[w[0] as usize..w[1] as usize];
+        let size = (list.len() * 2).next_power_of_two().max(16);
+        let table = &mut table[..size];
+        table.fill(u64::MAX);
+        let shift = 64 - size.trailing_zeros();
+        for &e in list {
+            let i = (e & 0xFFFF_FFFF) as usize;
+            let tag = e >> 32;
+            let mut slot = (e >> shift) as usize;
+            first[i] = loop {
+                let t = table[slot];
+                if t == u64::MAX {
+                    table[slot] = e;
+                    break i as u32;
+                }
+                if t >> 32 == tag {
+                    let f = (t & 0xFFFF_FFFF) as u32;
+                    if weld_key(&points[f as usize]) == weld_key(&points[i]) {
+                        break f;
+                    }
+                }
+                slot = (slot + 1) & (size - 1);
+            };
+        }
+    }
+    // Ids in the order first met, in place: `first[i] < i` is already an id.
+    let mut distinct = 0u32;
+    for i in 0..n {
+        let f = first[i] as usize;
+        first[i] = if f == i {
+            distinct += 1;
+            distinct - 1
+        } else {
+            first[f]
+        };
+    }
+    (distinct as usize, first)
 }
 
 /// Faces at a vertex up to which the mean direction may stand for all of them
@@ -724,7 +777,11 @@ mod crease_tests {
                     *first.entry(k).or_insert(next)
                 })
                 .collect();
-            proptest::prop_assert_eq!(weld_ids(&points), (first.len(), want));
+            proptest::prop_assert_eq!(weld_ids(&points), (first.len(), want.clone()));
+            // Several buckets (a few points each, some empty), as large inputs have them.
+            for bits in [1, 3, 6] {
+                proptest::prop_assert_eq!(weld_ids_in(&points, bits), (first.len(), want.clone()));
+            }
         }
     }
 
