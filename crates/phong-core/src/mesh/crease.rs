@@ -251,41 +251,46 @@ pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
 /// A position's key: its bits, 0 for both zeros.
 #[inline(always)]
 fn weld_key(p: &Vec3) -> [u32; 3] {
-    p.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+    let bits = |c: f32| {
+        let b = c.to_bits();
+        if b << 1 == 0 { 0 } else { b }
+    };
+    [bits(p.x), bits(p.y), bits(p.z)]
 }
 
-/// A key's 64-bit hash: its top `bits` bits choose the bucket, its low 32 are the tag (whose
-/// top bits choose the slot in the bucket's table).
+/// A key's 32-bit hash: its top `bits` bits choose the bucket, the bits below them the slot
+/// in the bucket's table; all of it is the tag an entry keeps.
 #[inline(always)]
-fn weld_hash(k: [u32; 3]) -> u64 {
-    ((u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+fn weld_hash(k: [u32; 3]) -> u32 {
+    (((u64::from(k[0]) | (u64::from(k[1]) << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15)
         ^ u64::from(k[2]).wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
     .wrapping_mul(0x2545_F491_4F6C_DD1D)
+        >> 32) as u32
 }
 
 /// [`weld_ids`] with `2^bits` buckets.
 fn weld_ids_in(points: &[Vec3], bits: u32) -> (usize, Vec<u32>) {
     let n = points.len();
     let buckets = 1usize << bits;
-    let bucket = |h: u64| (h.checked_shr(64 - bits).unwrap_or(0)) as usize;
+    let bucket = |h: u32| (h.checked_shr(32 - bits).unwrap_or(0)) as usize;
+    // Per point its hash (kept in `first` until the tables replace it), per bucket its size.
+    let mut first: Vec<u32> = points.iter().map(|p| weld_hash(weld_key(p))).collect();
     let mut start = vec![0u32; buckets + 1];
-    for p in points {
-        start[bucket(weld_hash(weld_key(p))) + 1] += 1;
+    for &h in &first {
+        start[bucket(h) + 1] += 1;
     }
     for b in 0..buckets {
         start[b + 1] += start[b];
     }
-    // Per bucket, its points as `tag << 32 | point`, in point order.
+    // Per bucket, its points as `hash << 32 | point`, in point order.
     let mut sorted = vec![0u64; n];
     let mut fill = start[..buckets].to_vec();
-    for (i, p) in points.iter().enumerate() {
-        let h = weld_hash(weld_key(p));
-        let b = bucket(h);
-        sorted[fill[b] as usize] = (h << 32) | i as u64;
-        fill[b] += 1;
+    for (i, &h) in first.iter().enumerate() {
+        let f = &mut fill[bucket(h)];
+        sorted[*f as usize] = u64::from(h) << 32 | i as u64;
+        *f += 1;
     }
     // Per point, the first point at its position (so that `first[i] <= i`).
-    let mut first = vec![0u32; n];
     let largest = start.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0) as usize;
     // (An entry's point is never u32::MAX: a mesh's vertices are indexed by u32.)
     let mut table = vec![u64::MAX; (largest * 2).next_power_of_two().max(16)];
@@ -294,11 +299,12 @@ fn weld_ids_in(points: &[Vec3], bits: u32) -> (usize, Vec<u32>) {
         let size = (list.len() * 2).next_power_of_two().max(16);
         let table = &mut table[..size];
         table.fill(u64::MAX);
-        let shift = 64 - size.trailing_zeros();
+        // The slot from the hash's bits below the bucket's (equal positions start alike).
+        let slot_bits = size.trailing_zeros().min(32 - bits);
         for &e in list {
             let i = (e & 0xFFFF_FFFF) as usize;
             let tag = e >> 32;
-            let mut slot = (e >> shift) as usize;
+            let mut slot = (((tag << bits) & 0xFFFF_FFFF) >> (32 - slot_bits)) as usize;
             first[i] = loop {
                 let t = table[slot];
                 if t == u64::MAX {
