@@ -681,6 +681,22 @@ impl Mesh {
         self.crease_normals(crease_deg).0
     }
 
+    /// [`Mesh::with_crease_normals`] of the mesh with each vertex moved to `f` of its position
+    /// (which must stay finite, as [`Mesh::with_positions_mapped`]): the positions mapped once,
+    /// straight into the new mesh's, and the mesh's own normals never copied.
+    pub fn crease_normals_mapped(&self, f: impl Fn(Vec3) -> Vec3, crease_deg: f32) -> Result<Mesh, Error> {
+        let positions: Vec<Vec3> = self.positions.iter().map(|&p| f(p)).collect();
+        if let Some(p) = first_not_finite(&positions) {
+            return Err(Error::InvalidPosition {
+                what: "mesh vertex",
+                value: p.to_array(),
+            });
+        }
+        Ok(self
+            .crease_of(positions.into(), (&self.triangles[..]).into(), crease_deg)
+            .0)
+    }
+
     /// [`Mesh::with_crease_normals`] of a mesh no longer needed: where its positions are all
     /// distinct and it has no other attribute, its arrays become the new mesh's (no copy).
     pub fn into_crease_normals(mut self, crease_deg: f32) -> Mesh {
@@ -795,6 +811,32 @@ mod tests {
         // With a crease of 100°, it is smooth again.
         let s = folded().with_crease_normals(100.0);
         assert_eq!(s.positions().len(), 5);
+    }
+
+    /// The positions mapped then the crease normals, in one step: the two steps' mesh bit for
+    /// bit (with and without texture coordinates), and a mapping to a non-finite position
+    /// refused as `with_positions_mapped` refuses it.
+    #[test]
+    fn crease_normals_of_mapped_positions() {
+        let move_it = |p: Vec3| (p - Vec3::new(0.25, -3.0, 1e-3)) * 1.7;
+        let sphere = crate::primitives::sphere(12);
+        let uvs: Vec<Vec2> = (0..sphere.positions().len())
+            .map(|i| Vec2::new(i as f32, 0.5))
+            .collect();
+        for m in [folded(), sphere.clone(), sphere.with_uvs(uvs).unwrap()] {
+            let two_steps = m
+                .clone()
+                .with_positions_mapped(move_it)
+                .unwrap()
+                .with_crease_normals(60.0);
+            let one = m.crease_normals_mapped(move_it, 60.0).unwrap();
+            assert_eq!(format!("{one:?}"), format!("{two_steps:?}"));
+        }
+        let far = |p: Vec3| p * f32::MAX * 4.0;
+        assert_eq!(
+            folded().crease_normals_mapped(far, 60.0).err(),
+            folded().with_positions_mapped(far).err()
+        );
     }
 
     #[test]

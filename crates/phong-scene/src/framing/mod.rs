@@ -131,7 +131,7 @@ pub(crate) fn scene_for_model(path: &Path, options: &ModelOptions) -> Result<Loa
         let fit = fit_of(parts);
         parts
             .iter()
-            .map(|p| drawn_mesh(p.mesh.clone(), fit, default_normals(p), DEFAULT_CREASE).ok())
+            .map(|p| drawn_mesh(&p.mesh, fit, default_normals(p), DEFAULT_CREASE).ok())
             .collect()
     };
     let (json, notes) = if beside_worth_it(&model) {

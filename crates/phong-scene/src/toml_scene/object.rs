@@ -214,22 +214,37 @@ fn computed_normals(p: &ModelPart) -> &'static str {
 /// A part's mesh as its object draws it: fitted to `fit_frame` (centre and radius, where the
 /// object has `fit`) and given the normals of `choice` (`crease` degrees for `"angle"`).
 pub(crate) fn drawn_mesh(
-    mesh: Mesh,
+    mesh: &Mesh,
     fit_frame: Option<(glam::DVec3, f64)>,
     choice: &str,
     crease: f32,
 ) -> Result<Mesh, phong_core::Error> {
-    Ok(with_normals(fitted(mesh, fit_frame)?, choice, crease))
+    if choice == "angle" {
+        // New arrays either way: the positions fitted straight into them, the mesh's own
+        // normals not copied.
+        return crate::timing::timed(
+            |t| &mut t.normals,
+            || match fit_frame {
+                Some(frame) => mesh.crease_normals_mapped(fit_map(frame), crease),
+                None => mesh.crease_normals_mapped(|p| p, crease),
+            },
+        );
+    }
+    Ok(with_normals(fitted(mesh.clone(), fit_frame)?, choice, crease))
+}
+
+/// A position moved into the frame of `centre` and `radius`: in f64 (coordinates near f32's
+/// largest, a radius whose inverse is below its smallest normal number). A uniform scale and
+/// a move: the file's normals keep their directions.
+fn fit_map((centre, radius): (glam::DVec3, f64)) -> impl Fn(Vec3) -> Vec3 {
+    move |x| ((x.as_dvec3() - centre) / radius).as_vec3()
 }
 
 /// `mesh` fitted to `fit_frame` (centre and radius), where given.
 fn fitted(mut mesh: Mesh, fit_frame: Option<(glam::DVec3, f64)>) -> Result<Mesh, phong_core::Error> {
-    if let Some((centre, radius)) = fit_frame {
-        // In f64 (coordinates near f32's largest, a radius whose inverse is below its
-        // smallest normal number). A uniform scale and a move: the file's normals keep
-        // their directions. Fitted before the normals are computed (at 1e30, f32 cross
-        // products overflow).
-        mesh = mesh.with_positions_mapped(|x| ((x.as_dvec3() - centre) / radius).as_vec3())?;
+    if let Some(frame) = fit_frame {
+        // Fitted before the normals are computed (at 1e30, f32 cross products overflow).
+        mesh = mesh.with_positions_mapped(fit_map(frame))?;
     }
     Ok(mesh)
 }
