@@ -685,7 +685,10 @@ impl Mesh {
     /// (which must stay finite, as [`Mesh::with_positions_mapped`]): the positions mapped once,
     /// straight into the new mesh's, and the mesh's own normals never copied.
     pub fn crease_normals_mapped(&self, f: impl Fn(Vec3) -> Vec3, crease_deg: f32) -> Result<Mesh, Error> {
-        let positions: Vec<Vec3> = self.positions.iter().map(|&p| f(p)).collect();
+        // (Room for the vertices a crease splits to go after them, which costs nothing until
+        // used: grown, the array would be copied.)
+        let mut positions = Vec::with_capacity(self.positions.len() + self.positions.len() / 4);
+        positions.extend(self.positions.iter().map(|&p| f(p)));
         if let Some(p) = first_not_finite(&positions) {
             return Err(Error::InvalidPosition {
                 what: "mesh vertex",

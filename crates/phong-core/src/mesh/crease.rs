@@ -98,7 +98,7 @@ impl Mesh {
         // rest follow (each corner's attributes as below, the vertices numbered otherwise).
         if plain && count.iter().all(|&c| c > 0) {
             let triangles = tris.into_owned();
-            let out = CornerVertices::in_place(positions.into_owned(), same);
+            let out = CornerVertices::in_place(positions.into_owned(), same, rest as usize);
             return (out.split_in_place(triangles, &mut others), others.work);
         }
         // A plain mesh makes at most one vertex for a vertex of one normal and one a corner for
@@ -365,7 +365,10 @@ fn facets_summed<const SUMS: bool>(positions: &[Vec3], tris: &[[u32; 3]]) -> Fac
     // (Sized at once and written in place: a push per face checked its room.)
     let mut facet = vec![Vec3::ZERO; tris.len()];
     let mut unit = vec![Vec3::ZERO; tris.len()];
-    let mut sum = vec![Vec3::ZERO; if SUMS { n } else { 0 }];
+    // (The sums become the normals of a plain mesh split in place, whose new vertices go
+    // after them: room for a quarter more, which costs nothing until used.)
+    let mut sum = Vec::with_capacity(if SUMS { n + n / 4 } else { 0 });
+    sum.resize(if SUMS { n } else { 0 }, Vec3::ZERO);
     let mut count = vec![0u32; n];
     for ((t, f_out), u_out) in tris.iter().zip(&mut facet).zip(&mut unit) {
         // (In `Vec3A`, glam's SSE form of the same operations in the same order: the same
@@ -553,8 +556,8 @@ impl CornerVertices {
     }
 
     /// The welded `positions` kept in place with their normals `same` (zero where a vertex
-    /// has several: [`CornerVertices::split_in_place`] fills them).
-    fn in_place(positions: Vec<Vec3>, same: Vec<Vec3>) -> CornerVertices {
+    /// has several, `several` of them: [`CornerVertices::split_in_place`] fills them).
+    fn in_place(positions: Vec<Vec3>, same: Vec<Vec3>, several: usize) -> CornerVertices {
         let n = positions.len();
         CornerVertices {
             positions,
@@ -562,7 +565,9 @@ impl CornerVertices {
             uvs: Vec::new(),
             uvs1: Vec::new(),
             colors: Vec::new(),
-            links: Vec::new(),
+            // (A link each at least, more where a vertex splits: room at once, not grown by
+            // copies.)
+            links: Vec::with_capacity(several + several / 2),
             head: vec![u32::MAX; n],
             many: FxHashMap::default(),
         }
