@@ -63,6 +63,12 @@ pub fn load(path: &Path) -> Result<Loaded, Error> {
     load_with(path, &ModelOptions::default())
 }
 
+/// Extensions of mesh formats phong does not read (OFF, as ModelNet's, COLLADA, FBX, USD, ...).
+const FOREIGN_MODELS: [&str; 20] = [
+    "off", "coff", "noff", "dae", "fbx", "3ds", "blend", "usd", "usda", "usdc", "usdz", "x3d", "wrl", "vrml", "3mf",
+    "amf", "abc", "ifc", "lwo", "ms3d",
+];
+
 /// Whether `path` is read as a model rather than a scene file (its extension, else its first
 /// bytes).
 pub fn is_model_path(path: &Path) -> bool {
@@ -70,6 +76,9 @@ pub fn is_model_path(path: &Path) -> bool {
     match ext.as_deref() {
         Some("toml") => false,
         Some("obj" | "ply" | "stl" | "gltf" | "glb") => true,
+        // Other formats of meshes: the model reader names the formats phong reads (as a scene,
+        // such a file would give a TOML syntax error).
+        Some(e) if FOREIGN_MODELS.contains(&e) => true,
         _ => sniff_model(path),
     }
 }

@@ -357,6 +357,19 @@ fn the_format_is_told_by_content_then_extension() {
         e.contains("points.xyz: not a model phong reads (OBJ .obj, PLY .ply, STL .stl, glTF .gltf/.glb)"),
         "{e}"
     );
+    // A mesh in a format phong does not read (ModelNet's OFF) is named as such, not read as a
+    // scene file (whose TOML error would be no help).
+    let off = write(&d, "chair.OFF", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    assert!(phong_scene::is_model_path(&off));
+    let e = load(&off).unwrap_err();
+    assert!(e.is_input(), "{e}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: not a model phong reads (OBJ .obj, PLY .ply, STL .stl, glTF .gltf/.glb); .off is not one of them",
+            off.display()
+        )
+    );
     let _ = std::fs::remove_dir_all(d);
 }
 
