@@ -239,11 +239,11 @@ fn merged(points: &[Vec3], ids: &[u32], distinct: usize) -> Vec<Vec3> {
 ///
 /// The points are first sorted into buckets by their hash's top bits (a counting sort, in
 /// point order within a bucket), then each bucket is welded in an open-addressing table sized
-/// for it (at most half full, about 16 KiB: in the L1 cache), whose entries hold a tag of the
+/// for it (at most half full, 16 to 32 KiB: in the L1 cache), whose entries hold a tag of the
 /// position's hash and the first point at that position. One table for all the points missed
 /// the caches at nearly every probe (BENCHMARKS.md, "Loading against trimesh").
 pub fn weld_ids(points: &[Vec3]) -> (usize, Vec<u32>) {
-    // Buckets of 1,024 to 2,047 points (one for fewer points), at most 4,096 of them.
+    // Buckets of 1,024 to 2,047 points on average (one for fewer points), at most 4,096 of them.
     let bits = (points.len() / 1024).max(1).ilog2().min(12);
     weld_ids_in(points, bits)
 }
